@@ -1,0 +1,101 @@
+"""Exception classes of cushion_clutch.
+
+Every class subclasses a builtin so that callers may catch either the
+specific class or the builtin it refines.
+"""
+from __future__ import annotations
+
+from typing import Sequence
+
+
+class ParameterError(ValueError):
+    """One or more parameters are invalid.
+
+    Parameters
+    ----------
+    problems : sequence of str
+        Every problem found, each naming the key and the allowed range.
+    source : str, optional
+        Where the parameters came from (a file name), for the message.
+    """
+
+    def __init__(self, problems: Sequence[str], source: str | None = None):
+        self.problems = list(problems)
+        self.source = source
+        where = f" in {source}" if source else ""
+        lines = "\n  - ".join(self.problems)
+        super().__init__(f"{len(self.problems)} invalid parameter(s){where}:\n  - {lines}")
+
+
+class CalculixNotFoundError(FileNotFoundError):
+    """The CalculiX executable ``ccx`` is not on the PATH."""
+
+    def __init__(self, executable: str = "ccx"):
+        super().__init__(
+            f"CalculiX executable '{executable}' not found on PATH. Install it with "
+            "'apt-get install -y calculix-ccx' (Debian/Ubuntu) or set CCX to its path."
+        )
+
+
+class CalculixError(RuntimeError):
+    """CalculiX ran but did not finish cleanly.
+
+    Attributes
+    ----------
+    returncode : int
+        The process exit code.
+    log_tail : str
+        The last lines of the solver output.
+    """
+
+    def __init__(self, message: str, returncode: int, log_tail: str):
+        self.returncode = returncode
+        self.log_tail = log_tail
+        super().__init__(f"{message} (ccx exit code {returncode})\n--- ccx log tail ---\n{log_tail}")
+
+
+class ConvergenceError(CalculixError):
+    """CalculiX did not converge.
+
+    Attributes
+    ----------
+    theta_degC : float or None
+        Temperature of the failing case, degC.
+    step : int or None
+        Step (1 thermal, 2 compression) that failed.
+    increment : int or None
+        Last increment attempted.
+    """
+
+    def __init__(self, message: str, returncode: int, log_tail: str, *,
+                 theta_degC: float | None = None, step: int | None = None,
+                 increment: int | None = None):
+        self.theta_degC = theta_degC
+        self.step = step
+        self.increment = increment
+        super().__init__(message, returncode, log_tail)
+
+
+class ResultError(RuntimeError):
+    """A finished FE case gives results that cannot be made into a table."""
+
+
+class SweepError(RuntimeError):
+    """A sweep had failed cases; finished cases are kept in the cache.
+
+    Attributes
+    ----------
+    failures : dict
+        Temperature (degC) to the exception raised for it.
+    """
+
+    def __init__(self, failures: dict):
+        self.failures = failures
+        lines = "\n".join(f"  theta = {t:g} degC: {e}" for t, e in sorted(failures.items()))
+        super().__init__(
+            f"{len(failures)} case(s) failed; finished cases are cached and no table was "
+            f"written:\n{lines}")
+
+
+class TableError(ValueError):
+    """A lookup table file is missing, malformed or inconsistent."""

@@ -1,0 +1,371 @@
+"""Spring parameters: frozen dataclasses loaded from TOML and checked on load.
+
+All quantities are SI (m, Pa, 1/K) unless a name says otherwise (``_deg``,
+``_degC``). Every dataclass checks itself in ``__post_init__`` and reports all
+problems at once through :class:`~cushion_clutch.errors.ParameterError`,
+naming the key and the allowed range. Unknown keys are rejected.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+import tomllib
+from dataclasses import dataclass, field, fields
+from pathlib import Path
+from typing import Any, Iterable
+
+from .errors import ParameterError
+
+DEFAULT_SPRING = Path(__file__).parent / "springs" / "default.toml"
+
+
+def _range_problem(key: str, value: Any, lo: float | None, hi: float | None,
+                   lo_open: bool = False, hi_open: bool = False) -> str | None:
+    """Return a message if ``value`` is not a finite number in the range, else None."""
+    lo_s = "-inf" if lo is None else f"{lo:g}"
+    hi_s = "inf" if hi is None else f"{hi:g}"
+    allowed = f"{'(' if lo_open or lo is None else '['}{lo_s}, {hi_s}{')' if hi_open or hi is None else ']'}"
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        return f"{key} = {value!r}: must be a finite number in {allowed}"
+    bad_lo = lo is not None and (value <= lo if lo_open else value < lo)
+    bad_hi = hi is not None and (value >= hi if hi_open else value > hi)
+    if bad_lo or bad_hi:
+        return f"{key} = {value!r}: out of range, allowed {allowed}"
+    return None
+
+
+class _Checked:
+    """Mixin: run ``_problems`` after init and raise if there are any."""
+
+    _section = ""
+
+    def __post_init__(self) -> None:
+        problems = list(self._problems())
+        if problems:
+            raise ParameterError(problems)
+
+    def _key(self, name: str) -> str:
+        return f"{self._section}.{name}" if self._section else name
+
+    def _ranges(self, spec: dict[str, tuple]) -> Iterable[str]:
+        for name, bounds in spec.items():
+            msg = _range_problem(self._key(name), getattr(self, name), *bounds)
+            if msg:
+                yield msg
+
+    def _problems(self) -> Iterable[str]:  # pragma: no cover - overridden
+        return ()
+
+
+@dataclass(frozen=True)
+class Geometry(_Checked):
+    """Plan shape and wave of one paddle (an annular sector).
+
+    Angles are measured along the circumference from the paddle's clamped
+    end. The paddle's mid-surface height above the carrier face is
+    ``t/2 + w(phi)``, with ``w = h/2 (1 - cos(2 pi s))`` for
+    ``s = (phi - wave_start)/(wave_end - wave_start)`` in [0, 1], else 0.
+    """
+
+    inner_radius_m: float = 0.072
+    outer_radius_m: float = 0.108
+    span_deg: float = 22.0
+    thickness_m: float = 0.4e-3
+    wave_height_m: float = 0.7e-3
+    wave_start_deg: float = 5.0
+    wave_end_deg: float = 20.0
+    clamp_start_deg: float = 0.0
+    clamp_end_deg: float = 4.0
+    carrier_clearance_m: float = 0.01e-3
+    """Clearance between the paddle's underside and the carrier face (the
+    back of the other paddle) outside the rivet zone, m. A few micrometres
+    keep the penalty contact from chattering at zero gap."""
+    far_end: str = "elastic"
+    """The flat far zone between ``wave_end_deg`` and ``span_deg`` sits in a
+    slot of the carrier that holds it axially (flat) but lets it slide in its
+    plane. How the carrier holds the far edge (``phi = span_deg``) in the
+    circumferential direction: ``"free"`` it slides freely; ``"locked"`` it
+    moves only with the carrier's thermal expansion; ``"elastic"`` it is held
+    through the carrier tab's stiffness ``carrier.far_end_stiffness_N_per_m``."""
+
+    _section = "geometry"
+
+    def _problems(self) -> Iterable[str]:
+        yield from self._ranges({
+            "inner_radius_m": (0.0, 0.5, True),
+            "outer_radius_m": (0.0, 0.5, True),
+            "span_deg": (0.0, 90.0, True),
+            "thickness_m": (0.05e-3, 5e-3),
+            "wave_height_m": (0.0, 5e-3),
+            "carrier_clearance_m": (0.0, 0.2e-3),
+            "wave_start_deg": (0.0, 90.0),
+            "wave_end_deg": (0.0, 90.0),
+            "clamp_start_deg": (0.0, 90.0),
+            "clamp_end_deg": (0.0, 90.0),
+        })
+        ok = lambda *n: all(isinstance(getattr(self, k), (int, float)) for k in n)  # noqa: E731
+        if ok("inner_radius_m", "outer_radius_m") and self.outer_radius_m <= self.inner_radius_m:
+            yield (f"geometry.outer_radius_m = {self.outer_radius_m!r}: must exceed "
+                   f"geometry.inner_radius_m = {self.inner_radius_m!r}")
+        if ok("clamp_start_deg", "clamp_end_deg", "wave_start_deg", "wave_end_deg", "span_deg"):
+            if not 0 <= self.clamp_start_deg < self.clamp_end_deg <= self.wave_start_deg:
+                yield ("geometry.clamp_start_deg/clamp_end_deg: need 0 <= clamp_start_deg < "
+                       f"clamp_end_deg <= wave_start_deg, got {self.clamp_start_deg!r}, "
+                       f"{self.clamp_end_deg!r}, wave_start_deg = {self.wave_start_deg!r}")
+            if not self.wave_start_deg < self.wave_end_deg <= self.span_deg:
+                yield ("geometry.wave_end_deg: need wave_start_deg < wave_end_deg <= span_deg, got "
+                       f"{self.wave_start_deg!r} < {self.wave_end_deg!r} <= {self.span_deg!r}")
+        if self.far_end not in ("free", "locked", "elastic"):
+            yield f"geometry.far_end = {self.far_end!r}: allowed 'free', 'locked' or 'elastic'"
+
+
+@dataclass(frozen=True)
+class Carrier(_Checked):
+    """The clutch-disc carrier that holds the rivet (clamp) zone and the far end.
+
+    ``temperature_ratio`` (kappa, dimensionless) states how much of the
+    paddle's temperature rise the carrier sees: the carrier is at
+    ``theta_ref + kappa (theta - theta_ref)`` and expands freely in its plane,
+    carrying the clamped nodes and the anchor of the far edge with it.
+    kappa = 1: carrier as hot as the paddle, no mismatch; kappa = 0: a cold
+    carrier. The paddle expands more than its carrier because it sits between
+    the hot facings while the carrier is further from them.
+
+    ``far_end_stiffness_N_per_m`` (used with ``geometry.far_end =
+    "elastic"``) is the circumferential stiffness of the carrier tab that
+    holds the paddle's far edge, N/m over the whole edge. It decides how much
+    of the paddle-carrier length mismatch goes into growth of the wave (the
+    kiss-point shift) and how much into sliding: 0 is a free end (a few
+    micrometres of growth), infinity a locked end (tenths of a millimetre,
+    and snap-through under compression).
+    """
+
+    temperature_ratio: float = 0.3
+    far_end_stiffness_N_per_m: float = 4.5e6
+
+    _section = "carrier"
+
+    def _problems(self) -> Iterable[str]:
+        yield from self._ranges({"temperature_ratio": (0.0, 1.0),
+                                 "far_end_stiffness_N_per_m": (0.0, 1e12)})
+
+
+@dataclass(frozen=True)
+class Material(_Checked):
+    """Isotropic linear elastic material, E(theta) piecewise linear (paper Table 1)."""
+
+    temperatures_degC: tuple[float, ...] = (20.0, 80.0, 200.0, 350.0)
+    youngs_modulus_Pa: tuple[float, ...] = (206e9, 202e9, 196e9, 186e9)
+    poisson_ratio: float = 0.3
+    expansion_coefficient_per_K: float = 1.12e-5
+    reference_temperature_degC: float = 20.0
+
+    _section = "material"
+
+    def _problems(self) -> Iterable[str]:
+        yield from self._ranges({
+            "poisson_ratio": (0.0, 0.5, False, True),
+            "expansion_coefficient_per_K": (0.0, 1e-3),
+            "reference_temperature_degC": (-273.15, 1500.0, True),
+        })
+        temps, moduli = self.temperatures_degC, self.youngs_modulus_Pa
+        if len(temps) == 0 or len(temps) != len(moduli):
+            yield (f"material.temperatures_degC / youngs_modulus_Pa: need equal, non-zero "
+                   f"lengths, got {len(temps)} and {len(moduli)}")
+        for i, t in enumerate(temps):
+            msg = _range_problem(f"material.temperatures_degC[{i}]", t, -273.15, 1500.0, True)
+            if msg:
+                yield msg
+        for i, e in enumerate(moduli):
+            msg = _range_problem(f"material.youngs_modulus_Pa[{i}]", e, 1e6, 1e13)
+            if msg:
+                yield msg
+        if all(isinstance(t, (int, float)) for t in temps) and list(temps) != sorted(set(temps)):
+            yield "material.temperatures_degC: must be strictly increasing"
+
+    def youngs_modulus(self, theta_degC: float) -> float:
+        """E at ``theta_degC`` in Pa, linear between table points, constant outside."""
+        import numpy as np
+        return float(np.interp(theta_degC, self.temperatures_degC, self.youngs_modulus_Pa))
+
+
+@dataclass(frozen=True)
+class Sweep(_Checked):
+    """Temperatures to compute and the kiss-point definition."""
+
+    temperatures_degC: tuple[float, ...] = (20.0, 80.0, 195.0, 250.0, 300.0)
+    kiss_force_N: float = 10.0
+    """Force of one paddle pair at which the kiss point (first contact) is taken."""
+    thermal_distortion: bool = True
+    """False sets the expansion coefficient to zero (stiffness change only)."""
+
+    _section = "sweep"
+
+    def _problems(self) -> Iterable[str]:
+        yield from self._ranges({"kiss_force_N": (0.0, 1e4, True)})
+        if len(self.temperatures_degC) == 0:
+            yield "sweep.temperatures_degC: needs at least one temperature"
+        for i, t in enumerate(self.temperatures_degC):
+            msg = _range_problem(f"sweep.temperatures_degC[{i}]", t, -60.0, 600.0)
+            if msg:
+                yield msg
+        if not isinstance(self.thermal_distortion, bool):
+            yield f"sweep.thermal_distortion = {self.thermal_distortion!r}: must be true or false"
+
+
+@dataclass(frozen=True)
+class Mesh(_Checked):
+    """Target shell element edge length, m."""
+
+    element_size_m: float = 1.0e-3
+
+    _section = "mesh"
+
+    def _problems(self) -> Iterable[str]:
+        yield from self._ranges({"element_size_m": (0.1e-3, 10e-3)})
+
+
+@dataclass(frozen=True)
+class Solver(_Checked):
+    """CalculiX options.
+
+    ``initial_gap_m`` is the clearance between the paddle crest and the
+    pressure plate before heating; it must exceed the thermal growth of one
+    paddle. Penalty contact: ``penalty_stiffness_N_per_m`` is the slope of
+    the linear pressure-overclosure law for node-to-surface contact (N/m per
+    slave node) and ``tension_N`` its small tension force at large gaps (node-to-surface).
+    """
+
+    contact: str = "node_to_surface"
+    penalty_stiffness_N_per_m: float = 1e8
+    tension_N: float = 0.01
+    initial_gap_m: float = 0.15e-3
+    compression_increments: int = 60
+    max_increments: int = 1000
+    flatten_fraction: float = 0.97
+    """Fraction of the paddle's wave height by which it is pressed (1 = flat)."""
+    threads: int = 1
+
+    _section = "solver"
+
+    def _problems(self) -> Iterable[str]:
+        yield from self._ranges({
+            "penalty_stiffness_N_per_m": (1e5, 1e12),
+            "tension_N": (0.0, 10.0),
+            "initial_gap_m": (0.0, 2e-3, True),
+            "compression_increments": (30, 1000),
+            "max_increments": (30, 100000),
+            "flatten_fraction": (0.5, 1.0, True),
+            "threads": (1, 64),
+        })
+        if self.contact not in ("node_to_surface", "surface_to_surface"):
+            yield f"solver.contact = {self.contact!r}: allowed 'node_to_surface' or 'surface_to_surface'"
+        for k in ("compression_increments", "max_increments", "threads"):
+            if not isinstance(getattr(self, k), int) or isinstance(getattr(self, k), bool):
+                yield f"solver.{k} = {getattr(self, k)!r}: must be an integer"
+
+
+@dataclass(frozen=True)
+class SpringParams(_Checked):
+    """A whole cushion spring: ``n_pairs`` identical paddle pairs in parallel."""
+
+    name: str = "default"
+    description: str = ""
+    n_pairs: int = 8
+    geometry: Geometry = field(default_factory=Geometry)
+    carrier: Carrier = field(default_factory=Carrier)
+    material: Material = field(default_factory=Material)
+    sweep: Sweep = field(default_factory=Sweep)
+    mesh: Mesh = field(default_factory=Mesh)
+    solver: Solver = field(default_factory=Solver)
+
+    def _problems(self) -> Iterable[str]:
+        if isinstance(self.n_pairs, bool) or not isinstance(self.n_pairs, int) or not 1 <= self.n_pairs <= 64:
+            yield f"n_pairs = {self.n_pairs!r}: must be an integer in [1, 64]"
+        ref = self.material.reference_temperature_degC
+        if not any(abs(t - ref) < 1e-9 for t in self.sweep.temperatures_degC):
+            yield (f"sweep.temperatures_degC = {list(self.sweep.temperatures_degC)}: must include "
+                   f"material.reference_temperature_degC = {ref:g} (the kiss-point reference)")
+        if not isinstance(self.name, str) or not self.name or not all(
+                c.isalnum() or c in "-_." for c in self.name):
+            yield f"name = {self.name!r}: must be a non-empty name of letters, digits, '-', '_', '.'"
+
+    def replace(self, **sections: Any) -> "SpringParams":
+        """Return a copy with top-level fields or whole sections replaced.
+
+        A section may be given as a dict of its fields to change, e.g.
+        ``params.replace(mesh={"element_size_m": 2e-3})``.
+        """
+        changes = {}
+        for key, value in sections.items():
+            current = getattr(self, key)
+            if isinstance(value, dict) and dataclasses.is_dataclass(current):
+                value = dataclasses.replace(current, **value)
+            changes[key] = value
+        return dataclasses.replace(self, **changes)
+
+    def to_dict(self) -> dict[str, Any]:
+        """All parameters as plain TOML/JSON-able data."""
+        return dataclasses.asdict(self)
+
+
+_SECTIONS = {f.name: f.type for f in fields(SpringParams)}
+_SECTION_CLASSES = {"geometry": Geometry, "carrier": Carrier, "material": Material,
+                    "sweep": Sweep, "mesh": Mesh, "solver": Solver}
+
+
+def params_from_dict(data: dict[str, Any], source: str | None = None) -> SpringParams:
+    """Build :class:`SpringParams` from nested dicts, rejecting unknown keys.
+
+    All problems in all sections are collected before raising.
+    """
+    problems: list[str] = []
+    top: dict[str, Any] = {}
+    for key, value in data.items():
+        if key in _SECTION_CLASSES:
+            cls = _SECTION_CLASSES[key]
+            if not isinstance(value, dict):
+                problems.append(f"[{key}]: must be a table")
+                continue
+            allowed = {f.name for f in fields(cls)}
+            unknown = sorted(set(value) - allowed)
+            for k in unknown:
+                problems.append(f"{key}.{k}: unknown key (allowed: {', '.join(sorted(allowed))})")
+            kwargs = {k: (tuple(v) if isinstance(v, list) else v)
+                      for k, v in value.items() if k in allowed}
+            try:
+                top[key] = cls(**kwargs)
+            except ParameterError as exc:
+                problems.extend(exc.problems)
+        elif key in ("name", "description", "n_pairs"):
+            top[key] = value
+        else:
+            problems.append(f"{key}: unknown key (allowed: {', '.join(sorted(_SECTIONS))})")
+    if not problems:
+        try:
+            return SpringParams(**top)
+        except ParameterError as exc:
+            problems.extend(exc.problems)
+    else:
+        # still check the top-level keys so that the report is complete
+        try:
+            SpringParams(**{k: v for k, v in top.items() if k in ("name", "description", "n_pairs")})
+        except ParameterError as exc:
+            problems.extend(exc.problems)
+    raise ParameterError(problems, source)
+
+
+def load_params(path: str | Path = DEFAULT_SPRING) -> SpringParams:
+    """Load and check a spring parameter TOML file.
+
+    Raises
+    ------
+    ParameterError
+        On a TOML syntax error, an unknown key or an out-of-range value.
+    """
+    path = Path(path)
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except tomllib.TOMLDecodeError as exc:
+        raise ParameterError([f"TOML syntax error: {exc}"], str(path)) from exc
+    return params_from_dict(data, str(path))

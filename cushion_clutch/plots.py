@@ -1,0 +1,46 @@
+"""Matplotlib PNG plots of the tables (paper Figs. 11 and 12 style)."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from .tables import TableSet  # noqa: E402
+
+
+def plot_force_deflection(tables: TableSet, path: Path, title: str = "") -> Path:
+    """F(u) family over temperature, u from the 20 degC kiss point (paper Fig. 11)."""
+    ref = int(np.argmin(np.abs(tables.theta_degC - 20.0)))
+    fig, (ax, zoom) = plt.subplots(1, 2, figsize=(11, 4.5))
+    for t, u, f, d in zip(tables.theta_degC, tables.u_m, tables.force_N, tables.delta_kiss_m):
+        shift = d - tables.delta_kiss_m[ref]
+        for a in (ax, zoom):
+            a.plot((u - shift) * 1e3, f / 1e3, label=f"{t:g} °C")
+    ax.set(xlabel="compression from the 20 °C kiss point u [mm]", ylabel="spring force F [kN]",
+           title=title or "Cushion spring load-deflection")
+    zoom.set(xlim=(-0.2, 0.4), ylim=(0, 0.6), xlabel="u [mm]", ylabel="F [kN]",
+             title="zoom: the kiss point moves with temperature")
+    for a in (ax, zoom):
+        a.grid(True, alpha=0.3)
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return Path(path)
+
+
+def plot_kiss_shift(tables: TableSet, path: Path) -> Path:
+    """delta_kiss(theta): growth of the free height of one pair."""
+    fig, ax = plt.subplots(figsize=(5.5, 4))
+    ax.plot(tables.theta_degC, tables.delta_kiss_m * 1e3, "o-")
+    ax.set(xlabel="cushion-spring temperature θ [°C]", ylabel="kiss-point shift δ [mm]",
+           title="Thermal growth of the pair's free height")
+    ax.grid(True, alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return Path(path)

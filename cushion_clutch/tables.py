@@ -1,0 +1,215 @@
+"""From FE case results to lookup tables, written atomically.
+
+Table files (all SI):
+
+``force_deflection.csv``
+    ``theta_degC,u_m,force_N``: cushion-spring temperature (degC), compression
+    of one paddle pair measured from that temperature's own kiss point (m;
+    negative in the toe before the kiss point), axial force of the whole
+    spring (all pairs, N). Non-decreasing in u for every temperature.
+``kiss_point.csv``
+    ``theta_degC,delta_kiss_m``: growth of the spring's free height relative
+    to the reference temperature, i.e. how far the kiss point moves towards
+    the open side (m).
+``metadata.json``
+    Parameters, mesh, solver, statistics, date and code version.
+"""
+from __future__ import annotations
+
+import csv
+import json
+import os
+import shutil
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .errors import ResultError, TableError
+from .results import CaseResult
+
+#: relative force decrease (of the case's largest force) treated as solver noise
+MONOTONE_TOLERANCE = 0.005
+
+
+@dataclass(frozen=True)
+class Curve:
+    """Force-deflection curve of one temperature.
+
+    Attributes
+    ----------
+    theta_degC : float
+    u_m : ndarray
+        Pair compression from the kiss point, m (first entry <= 0: first contact).
+    force_N : ndarray
+        Whole-spring force, N, non-decreasing.
+    kiss_travel_m : float
+        Pair travel of the plates from their start to the kiss point, m.
+    removed_decrease_N : float
+        Largest force decrease (whole spring) smoothed out as solver noise, N.
+    """
+
+    theta_degC: float
+    u_m: np.ndarray
+    force_N: np.ndarray
+    kiss_travel_m: float
+    removed_decrease_N: float
+
+
+def curve_from_case(case: CaseResult, n_pairs: int, kiss_force_N: float) -> Curve:
+    """Locate the kiss point and express the curve from it.
+
+    The kiss point is where the force of one pair first passes
+    ``kiss_force_N`` (linear between increments). The curve starts at the
+    last increment before it with no contact force; force is clipped at zero
+    (the penalty law's small tension can pull a few tenths of a newton).
+
+    Raises
+    ------
+    ResultError
+        If the force never reaches the kiss force, contact existed before
+        compression, or the force falls by more than ``MONOTONE_TOLERANCE``
+        of its maximum (snap-through: a table would lie).
+    """
+    s, f = case.pair_travel_m, case.force_N
+    above = np.flatnonzero(f >= kiss_force_N)
+    if len(above) == 0:
+        raise ResultError(f"theta = {case.theta_degC:g} degC: force never reached the kiss force "
+                          f"{kiss_force_N:g} N (max {f.max():.3g} N)")
+    k = above[0]
+    if k == 0:
+        raise ResultError(f"theta = {case.theta_degC:g} degC: the paddle already pressed the plate "
+                          f"with {f[0]:.3g} N after heating; increase solver.initial_gap_m")
+    s_kiss = float(s[k - 1] + (kiss_force_N - f[k - 1]) * (s[k] - s[k - 1]) / (f[k] - f[k - 1]))
+    zero = np.flatnonzero(f[:k] <= 0.0)
+    start = zero[-1] if len(zero) else 0
+    u = s[start:] - s_kiss
+    force = np.maximum(f[start:], 0.0)
+    drops = np.maximum.accumulate(force) - force
+    if drops.max() > MONOTONE_TOLERANCE * force.max():
+        i = int(np.argmax(drops))
+        raise ResultError(
+            f"theta = {case.theta_degC:g} degC: force falls by {drops.max():.3g} N at u = "
+            f"{u[i] * 1e3:.4f} mm (snap-through); this curve cannot be tabulated")
+    force = np.maximum.accumulate(force)
+    # the kiss point itself as a row: u = 0, F = kiss force
+    u = np.concatenate([u[u < 0], [0.0], u[u > 0]])
+    force = np.concatenate([force[:k - start], [kiss_force_N], force[k - start:]])
+    keep = np.concatenate([[True], np.diff(u) > 1e-12])
+    return Curve(case.theta_degC, u[keep], n_pairs * force[keep], s_kiss,
+                 n_pairs * float(drops.max()))
+
+
+def kiss_shift(curves: list[Curve], reference_degC: float) -> dict[float, float]:
+    """delta_kiss(theta) = kiss travel at reference - kiss travel at theta, m."""
+    ref = [c for c in curves if abs(c.theta_degC - reference_degC) < 1e-9]
+    if not ref:
+        raise ResultError(f"no curve at the reference temperature {reference_degC:g} degC")
+    return {c.theta_degC: ref[0].kiss_travel_m - c.kiss_travel_m for c in curves}
+
+
+def write_tables(out_dir: Path, curves: list[Curve], reference_degC: float,
+                 metadata: dict) -> Path:
+    """Write a table set atomically: all files appear together or not at all.
+
+    The set is built in a temporary sibling folder and renamed into place;
+    an existing set is replaced only after the new one is complete.
+    """
+    out_dir = Path(out_dir)
+    out_dir.parent.mkdir(parents=True, exist_ok=True)
+    shifts = kiss_shift(curves, reference_degC)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", dir=out_dir.parent))
+    try:
+        with open(tmp / "force_deflection.csv", "w", newline="") as fh:
+            w = csv.writer(fh)
+            w.writerow(["theta_degC", "u_m", "force_N"])
+            for c in sorted(curves, key=lambda c: c.theta_degC):
+                for u, f in zip(c.u_m, c.force_N):
+                    w.writerow([f"{c.theta_degC:g}", f"{u:.9e}", f"{f:.6f}"])
+        with open(tmp / "kiss_point.csv", "w", newline="") as fh:
+            w = csv.writer(fh)
+            w.writerow(["theta_degC", "delta_kiss_m"])
+            for t in sorted(shifts):
+                w.writerow([f"{t:g}", f"{shifts[t]:.9e}"])
+        (tmp / "metadata.json").write_text(json.dumps(metadata, indent=2, default=_jsonable) + "\n")
+        backup = None
+        if out_dir.exists():
+            backup = out_dir.with_name(f".{out_dir.name}.old")
+            if backup.exists():
+                shutil.rmtree(backup)
+            os.replace(out_dir, backup)
+        os.replace(tmp, out_dir)
+        if backup is not None:
+            shutil.rmtree(backup)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    return out_dir
+
+
+def _jsonable(obj):
+    if isinstance(obj, np.ndarray):
+        return obj.tolist()
+    if isinstance(obj, (np.floating, np.integer)):
+        return obj.item()
+    if isinstance(obj, Path):
+        return str(obj)
+    raise TypeError(f"not JSON serialisable: {type(obj)}")
+
+
+@dataclass(frozen=True)
+class TableSet:
+    """A table set read back: per-temperature curves and kiss shifts (SI)."""
+
+    theta_degC: np.ndarray
+    u_m: tuple[np.ndarray, ...]
+    force_N: tuple[np.ndarray, ...]
+    delta_kiss_m: np.ndarray
+    metadata: dict
+
+
+def read_tables(table_dir: Path) -> TableSet:
+    """Read and check a table set.
+
+    Raises
+    ------
+    TableError
+        Missing files, wrong columns, non-finite or non-monotone data.
+    """
+    table_dir = Path(table_dir)
+    try:
+        fd = _read_csv(table_dir / "force_deflection.csv", ["theta_degC", "u_m", "force_N"])
+        kp = _read_csv(table_dir / "kiss_point.csv", ["theta_degC", "delta_kiss_m"])
+    except OSError as exc:
+        raise TableError(f"cannot read table set {table_dir}: {exc}") from exc
+    meta_path = table_dir / "metadata.json"
+    metadata = json.loads(meta_path.read_text()) if meta_path.exists() else {}
+    thetas = np.unique(fd[:, 0])
+    us, fs = [], []
+    for t in thetas:
+        rows = fd[fd[:, 0] == t]
+        if len(rows) < 2 or np.any(np.diff(rows[:, 1]) <= 0) or np.any(np.diff(rows[:, 2]) < 0):
+            raise TableError(f"{table_dir}/force_deflection.csv: theta = {t:g} needs >= 2 rows, "
+                             "u strictly increasing and force non-decreasing")
+        us.append(rows[:, 1])
+        fs.append(rows[:, 2])
+    order = np.argsort(kp[:, 0])
+    if not np.array_equal(np.sort(kp[:, 0]), thetas):
+        raise TableError(f"{table_dir}: kiss_point.csv temperatures {kp[order, 0]} differ from "
+                         f"force_deflection.csv temperatures {thetas}")
+    return TableSet(thetas, tuple(us), tuple(fs), kp[order, 1], metadata)
+
+
+def _read_csv(path: Path, columns: list[str]) -> np.ndarray:
+    with open(path, newline="") as fh:
+        rows = list(csv.reader(fh))
+    if not rows or [c.strip() for c in rows[0]] != columns:
+        raise TableError(f"{path}: header must be {','.join(columns)}")
+    try:
+        data = np.array([[float(v) for v in r] for r in rows[1:] if r], dtype=float)
+    except ValueError as exc:
+        raise TableError(f"{path}: {exc}") from exc
+    if data.ndim != 2 or data.shape[1] != len(columns) or not np.all(np.isfinite(data)):
+        raise TableError(f"{path}: needs {len(columns)} finite numbers per row")
+    return data

@@ -1,0 +1,75 @@
+import math
+
+import pytest
+
+from cushion_clutch.errors import ParameterError
+from cushion_clutch.params import DEFAULT_SPRING, SpringParams, load_params, params_from_dict
+
+
+def test_default_file_loads_and_matches_paper():
+    p = load_params(DEFAULT_SPRING)
+    assert p.n_pairs == 8
+    assert p.geometry.thickness_m == pytest.approx(0.4e-3)
+    assert p.geometry.wave_height_m == pytest.approx(0.7e-3)
+    assert p.material.youngs_modulus_Pa == (206e9, 202e9, 196e9, 186e9)
+    assert p.material.temperatures_degC == (20.0, 80.0, 200.0, 350.0)
+    assert p.sweep.temperatures_degC == (20.0, 80.0, 195.0, 250.0, 300.0)
+    assert p.material.expansion_coefficient_per_K == pytest.approx(1.12e-5)
+
+
+def test_youngs_modulus_interpolates_table():
+    m = load_params().material
+    assert m.youngs_modulus(20.0) == pytest.approx(206e9)
+    assert m.youngs_modulus(140.0) == pytest.approx(199e9)
+    assert m.youngs_modulus(400.0) == pytest.approx(186e9)
+
+
+def test_unknown_key_is_named(tmp_path):
+    f = tmp_path / "s.toml"
+    f.write_text(DEFAULT_SPRING.read_text().replace("[mesh]", "[mesh]\nelement_sise_m = 1e-3"))
+    with pytest.raises(ParameterError, match=r"mesh\.element_sise_m: unknown key"):
+        load_params(f)
+
+
+def test_out_of_range_names_key_and_range(tmp_path):
+    f = tmp_path / "s.toml"
+    text = DEFAULT_SPRING.read_text().replace("thickness_m = 0.4e-3", "thickness_m = 0.04")
+    text = text.replace("poisson_ratio = 0.3", "poisson_ratio = 0.7")
+    f.write_text(text)
+    with pytest.raises(ParameterError) as info:
+        load_params(f)
+    msg = str(info.value)
+    # all problems are collected before raising
+    assert "geometry.thickness_m = 0.04: out of range, allowed [5e-05, 0.005]" in msg
+    assert "material.poisson_ratio = 0.7" in msg and "[0, 0.5)" in msg
+    assert len(info.value.problems) == 2
+
+
+def test_corrupted_toml(tmp_path):
+    f = tmp_path / "s.toml"
+    f.write_text(DEFAULT_SPRING.read_text()[:200] + "\n[geometry\nx = ")
+    with pytest.raises(ParameterError, match="TOML syntax error"):
+        load_params(f)
+
+
+def test_nan_and_wrong_types_rejected():
+    with pytest.raises(ParameterError, match="carrier.temperature_ratio"):
+        params_from_dict({"carrier": {"temperature_ratio": math.nan}})
+    with pytest.raises(ParameterError, match="n_pairs"):
+        params_from_dict({"n_pairs": 2.5})
+
+
+def test_cross_field_checks():
+    with pytest.raises(ParameterError, match="outer_radius_m"):
+        params_from_dict({"geometry": {"inner_radius_m": 0.1, "outer_radius_m": 0.09}})
+    with pytest.raises(ParameterError, match="must include material.reference_temperature_degC"):
+        params_from_dict({"sweep": {"temperatures_degC": [80.0, 195.0]}})
+    with pytest.raises(ParameterError, match="far_end"):
+        params_from_dict({"geometry": {"far_end": "welded"}})
+
+
+def test_replace_rechecks():
+    p = SpringParams()
+    assert p.replace(mesh={"element_size_m": 2e-3}).mesh.element_size_m == 2e-3
+    with pytest.raises(ParameterError, match="mesh.element_size_m"):
+        p.replace(mesh={"element_size_m": -1.0})

@@ -1,0 +1,120 @@
+"""Coarse-mesh sweeps of the default spring through the whole FE pipeline."""
+import numpy as np
+import pytest
+
+from cushion_clutch.errors import ConvergenceError, SweepError
+from cushion_clutch.sweep import build_tables, run_sweep, solve_case
+from cushion_clutch.tables import read_tables
+
+pytestmark = pytest.mark.ccx
+
+
+@pytest.fixture(scope="module")
+def two_temps(coarse):
+    return coarse.replace(sweep={"temperatures_degC": (20.0, 195.0)})
+
+
+@pytest.fixture(scope="module")
+def coarse_tables(two_temps, case_cache, tmp_path_factory):
+    out = tmp_path_factory.mktemp("tables") / "default"
+    outcomes = run_sweep(two_temps, cache_dir=case_cache)
+    build_tables(two_temps, outcomes, out)
+    return read_tables(out)
+
+
+def test_tables_have_the_paper_properties(coarse_tables):
+    t = coarse_tables
+    assert list(t.theta_degC) == [20.0, 195.0]
+    for u, f in zip(t.u_m, t.force_N):
+        assert np.all(np.diff(f) >= 0), "F must be non-decreasing in u"
+        assert np.count_nonzero(u > 0) >= 30
+        # the kiss point row: 10 N per pair, 8 pairs
+        assert np.interp(0.0, u, f) == pytest.approx(80.0)
+        # full compression of a passenger-car spring: 3-8 kN
+        assert 3e3 <= f[-1] <= 8e3
+        # about 2 x 0.7 mm of travel from the kiss point to full compression
+        assert 1.0e-3 < u[-1] < 1.5e-3
+    # paper: about 0.1 mm axial kiss-point shift at 195 degC
+    assert t.delta_kiss_m[0] == 0.0
+    assert 0.07e-3 <= t.delta_kiss_m[1] <= 0.14e-3
+    # Young's modulus drops: at equal compression well past the toe, less force when hot
+    u_mid = 0.8e-3
+    assert np.interp(u_mid, t.u_m[1], t.force_N[1]) < np.interp(u_mid, t.u_m[0], t.force_N[0])
+
+
+def test_metadata_records_provenance(coarse_tables):
+    m = coarse_tables.metadata
+    assert m["solver"]["name"] == "CalculiX ccx" and m["solver"]["version"] != "unknown"
+    assert m["mesh"]["nodes"] > 0 and m["mesh"]["elements"] > 0
+    assert m["spring"]["geometry"]["thickness_m"] == pytest.approx(0.4e-3)
+    for case in m["cases"].values():
+        assert case["increments"] > 30 and case["iterations"] > 0 and case["wall_time_s"] > 0
+
+
+def test_rerun_is_served_from_cache(two_temps, case_cache, coarse_tables):
+    events = []
+    run_sweep(two_temps, cache_dir=case_cache, progress=lambda t, e, v: events.append((t, e)))
+    assert not [e for e in events if e[1] == "start"]
+    assert sorted(events) == [(20.0, "done"), (195.0, "done")]
+
+
+def test_non_convergence_names_case_keeps_finished_and_resumes(two_temps, tmp_path):
+    cache, out = tmp_path / "cache", tmp_path / "tables"
+    run_sweep(two_temps.replace(sweep={"temperatures_degC": (20.0,)}), cache_dir=cache)
+    # 60 compression increments cannot fit under a cap of 30
+    capped = two_temps.replace(solver={"max_increments": 30})
+    with pytest.raises(SweepError) as info:
+        run_sweep(capped, cache_dir=cache)
+    err = info.value.failures[195.0]
+    assert isinstance(err, ConvergenceError)
+    assert (err.theta_degC, err.step, err.increment) == (195.0, 2, 30)
+    assert "195 degC" in str(err) and "step 2, increment 30" in str(err) and err.log_tail
+    assert 20.0 not in info.value.failures and not out.exists()
+    events = []
+    outcomes = run_sweep(two_temps, cache_dir=cache, progress=lambda t, e, v: events.append((t, e)))
+    assert [t for t, e in events if e == "start"] == [195.0]
+    build_tables(two_temps, outcomes, out)
+    assert (out / "force_deflection.csv").exists()
+
+
+def test_half_pair_in_series_matches_full_pair(coarse, tmp_path):
+    """The series composition of one paddle equals the back-to-back pair within 2 %."""
+    for theta in (20.0, 195.0):
+        half = solve_case(coarse, theta, tmp_path / f"h{theta}", paddles=1).result
+        pair = solve_case(coarse, theta, tmp_path / f"p{theta}", paddles=2).result
+        s = pair.pair_travel_m
+        f_half = np.interp(s, half.pair_travel_m, half.force_N)
+        loaded = pair.force_N > 0.05 * pair.force_N.max()
+        assert np.abs(f_half[loaded] / pair.force_N[loaded] - 1).max() < 0.02
+
+
+def test_mesh_refinement_2mm_vs_1mm(coarse, tmp_path):
+    fine = coarse.replace(mesh={"element_size_m": 1e-3}, sweep={"temperatures_degC": (20.0,)})
+    c2 = solve_case(coarse, 20.0, tmp_path / "m2").result
+    c1 = solve_case(fine, 20.0, tmp_path / "m1").result
+    s = c1.pair_travel_m
+    mid = (c1.force_N > 0.1 * c1.force_N.max()) & (s < 0.9 * s.max())
+    rel = np.abs(np.interp(s[mid], c2.pair_travel_m, c2.force_N) / c1.force_N[mid] - 1)
+    assert rel.max() < 0.15, f"2 mm vs 1 mm differ by {rel.max():.1%}"
+
+
+def test_without_thermal_distortion_force_scales_with_youngs_modulus(coarse, tmp_path):
+    p = coarse.replace(sweep={"thermal_distortion": False})
+    cold = solve_case(p, 20.0, tmp_path / "c").result
+    hot = solve_case(p, 300.0, tmp_path / "h").result
+    assert abs(hot.crest_rise_m) < 1e-7
+    s = cold.pair_travel_m
+    loaded = (cold.force_N > 0.1 * cold.force_N.max())
+    ratio = np.interp(s[loaded], hot.pair_travel_m, hot.force_N) / cold.force_N[loaded]
+    e_ratio = p.material.youngs_modulus(300.0) / p.material.youngs_modulus(20.0)
+    assert ratio == pytest.approx(np.full(len(ratio), e_ratio), rel=0.01)
+
+
+def test_dask_local_cluster_gives_the_same_tables(two_temps, case_cache, coarse_tables, tmp_path):
+    distributed = pytest.importorskip("distributed")
+    p = two_temps.replace(sweep={"temperatures_degC": (20.0,)})
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as cluster, distributed.Client(cluster) as client:
+        out = run_sweep(p, cache_dir=tmp_path, scheduler=client)
+    local = run_sweep(p, cache_dir=case_cache)
+    assert np.array_equal(out[20.0].result.force_N, local[20.0].result.force_N)

@@ -1,0 +1,60 @@
+"""Table building and writing, on hand-made case results (no solver needed)."""
+import numpy as np
+import pytest
+
+from cushion_clutch.errors import ResultError, TableError
+from cushion_clutch.results import CaseResult
+from cushion_clutch.tables import curve_from_case, read_tables, write_tables
+
+
+def case(theta, travel, force):
+    return CaseResult(theta, 1, 0.0, np.asarray(travel, float), np.asarray(force, float), 0.0)
+
+
+def test_kiss_point_is_interpolated_at_the_kiss_force():
+    # paddle travel 0..0.5 mm; pair travel is twice that
+    c = curve_from_case(case(20.0, [0, 1e-4, 2e-4, 3e-4, 5e-4], [0, 0, 5, 15, 60]), 8, 10.0)
+    assert c.kiss_travel_m == pytest.approx(5e-4)            # pair: 2 x 2.5e-4
+    assert c.u_m[0] == pytest.approx(2e-4 - 5e-4)            # starts at last zero-force point
+    assert np.interp(0.0, c.u_m, c.force_N) == pytest.approx(80.0)
+    assert c.force_N[-1] == pytest.approx(480.0)
+
+
+def test_snap_through_is_refused():
+    with pytest.raises(ResultError, match="snap-through"):
+        curve_from_case(case(300.0, np.linspace(0, 5e-4, 6), [0, 20, 60, 40, 50, 90]), 8, 10.0)
+
+
+def test_contact_before_compression_is_refused():
+    with pytest.raises(ResultError, match="initial_gap_m"):
+        curve_from_case(case(300.0, [0, 1e-4], [12.0, 30.0]), 8, 10.0)
+
+
+def _curves():
+    return [curve_from_case(case(t, [0, 1e-4, 2e-4, 4e-4], [0, 5, 20 - t / 100, 90]), 8, 10.0)
+            for t in (20.0, 195.0)]
+
+
+def test_written_tables_read_back(tmp_path):
+    out = write_tables(tmp_path / "set", _curves(), 20.0, {"solver": "test"})
+    t = read_tables(out)
+    assert list(t.theta_degC) == [20.0, 195.0]
+    assert t.delta_kiss_m[0] == 0.0
+    assert (out / "force_deflection.csv").read_text().startswith("theta_degC,u_m,force_N\n")
+    assert (out / "kiss_point.csv").read_text().startswith("theta_degC,delta_kiss_m\n")
+
+
+def test_failed_write_leaves_previous_set_untouched(tmp_path):
+    out = write_tables(tmp_path / "set", _curves(), 20.0, {"run": 1})
+    before = {p.name: p.read_bytes() for p in out.iterdir()}
+    with pytest.raises(TypeError):
+        write_tables(out, _curves(), 20.0, {"bad": object()})
+    assert {p.name: p.read_bytes() for p in out.iterdir()} == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["set"]       # no half-written folder
+
+
+def test_malformed_table_is_named(tmp_path):
+    out = write_tables(tmp_path / "set", _curves(), 20.0, {})
+    (out / "kiss_point.csv").write_text("theta,delta\n20,0\n")
+    with pytest.raises(TableError, match="kiss_point.csv: header"):
+        read_tables(out)

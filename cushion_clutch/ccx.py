@@ -164,7 +164,8 @@ def run_ccx(deck_text: str, workdir: Path, job: str = "case", *, threads: int = 
         raise ConvergenceError(
             f"CalculiX did not converge{where}: step {step}, increment {inc}", returncode, tail,
             theta_degC=theta_degC, step=step, increment=inc)
-    if "*ERROR" in log_text or "*WARNING in calinput" in log_text or "cannot be interpreted" in log_text:
+    squashed = re.sub(r"\s+", "", log_text)         # ccx breaks long words across columns
+    if "*ERROR" in log_text or "*WARNING in calinput" in log_text or "cannotbeinterpreted" in squashed:
         raise CalculixError(f"CalculiX reported an error{where}", returncode, tail)
     if returncode != 0:
         raise CalculixError(f"CalculiX failed{where}", returncode, tail)

@@ -59,6 +59,86 @@ def _sweep(args: argparse.Namespace) -> int:
     return 0
 
 
+def _simulate(args: argparse.Namespace) -> int:
+    import csv
+
+    from .engagements import (EngagementCycle, plot_engagements, plot_thermal_step,
+                              plot_torque_characteristic, simulate)
+    from .fmu_build import build_fmu
+    from .model import load_table
+
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    fmu = Path(args.fmu) if args.fmu else build_fmu(Path(args.tables), out / "CushionClutch.fmu")
+    print(f"simulating {args.engagements} engagements with {fmu} (fmpy, step {args.step:g} s) ...")
+    start = time.perf_counter()
+    res = simulate(fmu, EngagementCycle(), n_engagements=args.engagements, step_s=args.step)
+    wall = time.perf_counter() - start
+    with open(out / "engagements.csv", "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(["time_s", "x_to_m", "theta_cm_K", "torque_Nm", "force_N", "theta_cs_K", "u_f_m", "x_kiss_m"])
+        for row in res:
+            w.writerow([f"{v:.9g}" for v in row])
+    plots = [plot_engagements(res, out / "engagements.png"),
+             plot_torque_characteristic(load_table(args.tables), out / "torque_characteristic.png"),
+             plot_thermal_step(out / "thermal_step_response.png")]
+    period = EngagementCycle().period_s
+    print(f"{'engagement':>10} {'theta_cm max [degC]':>20} {'theta_cs max [degC]':>20} "
+          f"{'x_kiss min [mm]':>16} {'T max [N.m]':>12}")
+    for k in range(args.engagements):
+        m = (res["time"] >= k * period) & (res["time"] < (k + 1) * period)
+        print(f"{k + 1:>10d} {res['theta_cm'][m].max() - 273.15:>20.1f} "
+              f"{res['theta_cs'][m].max() - 273.15:>20.1f} {res['x_kiss'][m].min() * 1e3:>16.4f} "
+              f"{res['torque'][m].max():>12.1f}")
+    sim_time = res["time"][-1]
+    print(f"simulated {sim_time:g} s in {wall:.2f} s wall ({sim_time / wall:.0f}x real time); wrote "
+          f"{out / 'engagements.csv'} and " + ", ".join(str(p) for p in plots))
+    return 0
+
+
+def _launch(args: argparse.Namespace) -> int:
+    from rich.progress import Progress
+
+    from .fmu_build import build_fmu
+    from .launch_report import metrics_table, run_both, write_outputs
+    from .model import load_table
+    from .scenario import load_scenario
+
+    sc = load_scenario(args.scenario)
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    fmu = Path(args.fmu) if args.fmu else build_fmu(Path(args.tables), out / "CushionClutch.fmu")
+    total = sc.run.launches * sc.run.period_s
+    start = time.perf_counter()
+    with Progress() as bar:
+        tasks = {n: bar.add_task(f"{n} TCU", total=total) for n in ("naive", "aware")}
+        results = run_both(fmu, sc, load_table(args.tables),
+                           progress=lambda n, t: bar.update(tasks[n], completed=t))
+        for task in tasks.values():
+            bar.update(task, completed=total)
+    wall = time.perf_counter() - start
+    paths = write_outputs(results, out)
+    print(metrics_table(results))
+    for name, res in results.items():
+        e = res.energy
+        print(f"{name}: energy balance residual {e.residual():.3g} J of {e.engine_work / 1e3:.1f} kJ engine "
+              f"work; real-time factor {total / res.wall_time_s:.0f}x")
+    print(f"scenario '{sc.name}': {sc.run.launches} launches with both TCUs in {wall:.1f} s; wrote "
+          + ", ".join(str(p) for p in paths))
+    return 0
+
+
+def _export(args: argparse.Namespace) -> int:
+    from .exports import export_mat, export_modelica
+
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    mat = export_mat(Path(args.tables), out / "cushion_spring_tables.mat")
+    mo = export_modelica(Path(args.tables), out / "cushion_spring_tables.txt")
+    print(f"wrote {mat} (Simulink 2-D Lookup Table) and {mo} (Modelica CombiTable2Ds, #1 format)")
+    return 0
+
+
 def _check(args: argparse.Namespace) -> int:
     from .params import load_params
     p = load_params(args.spring)
@@ -69,6 +149,7 @@ def _check(args: argparse.Namespace) -> int:
 
 def build_parser() -> argparse.ArgumentParser:
     from .params import DEFAULT_SPRING
+    from .scenario import DEFAULT_SCENARIO
     from .sweep import DEFAULT_CACHE
 
     parser = argparse.ArgumentParser(prog="cushion-clutch", description=__doc__)
@@ -83,6 +164,26 @@ def build_parser() -> argparse.ArgumentParser:
     sw.add_argument("--scheduler", help="Dask scheduler address, e.g. tcp://host:8786")
     sw.add_argument("--cache", default=DEFAULT_CACHE, help="case cache folder")
     sw.set_defaults(func=_sweep)
+
+    sm = sub.add_parser("simulate", help="repeated engagements through the FMU with fmpy, with plots")
+    sm.add_argument("--fmu", help="FMU to simulate (default: build one from --tables into --out)")
+    sm.add_argument("--tables", default=DEFAULT_TABLES, help="table folder")
+    sm.add_argument("--out", default="out", help="output folder")
+    sm.add_argument("--engagements", type=int, default=12, help="number of engagements (60 s apart)")
+    sm.add_argument("--step", type=float, default=0.1, help="communication step [s]")
+    sm.set_defaults(func=_simulate)
+
+    la = sub.add_parser("launch", help="repeated launches, naive vs temperature-aware TCU (main job)")
+    la.add_argument("--scenario", default=DEFAULT_SCENARIO, help="scenario TOML")
+    la.add_argument("--fmu", help="clutch FMU (default: build one from --tables into --out)")
+    la.add_argument("--tables", default=DEFAULT_TABLES, help="table folder")
+    la.add_argument("--out", default="out", help="output folder")
+    la.set_defaults(func=_launch)
+
+    ex = sub.add_parser("export", help="write the tables for Simulink (.mat) and Modelica (CombiTable)")
+    ex.add_argument("--tables", default=DEFAULT_TABLES, help="table folder")
+    ex.add_argument("--out", default="out", help="output folder")
+    ex.set_defaults(func=_export)
 
     ck = sub.add_parser("check-spring", help="validate a spring parameter TOML")
     ck.add_argument("spring")

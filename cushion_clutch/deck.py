@@ -270,7 +270,7 @@ def strip_deck(mesh: ShellMesh, material: Material, *, tip_force_N: float = 0.0,
                theta_degC: float | None = None) -> str:
     """Deck of a flat strip for closed-form checks (linear, one step).
 
-    With ``tip_force_N`` the strip is a cantilever clamped at ``END0`` and
+    With ``tip_force_N`` the strip is a cantilever clamped (all six DOFs) at ``END0`` and
     loaded in -z at ``END1`` (shared equally by its nodes). With
     ``theta_degC`` it is heated uniformly, held only against rigid-body
     motion (``ORIGIN`` fixed, ``CORNER_Y`` fixed in x and z, ``END1`` in z).
@@ -283,7 +283,7 @@ def strip_deck(mesh: ShellMesh, material: Material, *, tip_force_N: float = 0.0,
     ref_t = material.reference_temperature_degC
     lines += ["*INITIAL CONDITIONS, TYPE=TEMPERATURE", f"NPADDLE, {_fmt(ref_t)}", "*BOUNDARY"]
     if theta_degC is None:
-        lines.append("END0, 1, 3")
+        lines.append("END0, 1, 6")          # rotations too: a shell edge held in translation is a hinge
     else:
         lines += ["ORIGIN, 1, 3", "CORNER_Y, 1, 1", "CORNER_Y, 3, 3", "END1, 3, 3"]
     lines += ["*STEP", "*STATIC"]

@@ -217,7 +217,7 @@ class Sweep(_Checked):
 class Mesh(_Checked):
     """Target shell element edge length, m."""
 
-    element_size_m: float = 1.0e-3
+    element_size_m: float = 0.5e-3
 
     _section = "mesh"
 
@@ -309,27 +309,26 @@ class SpringParams(_Checked):
         return dataclasses.asdict(self)
 
 
-_SECTIONS = {f.name: f.type for f in fields(SpringParams)}
-_SECTION_CLASSES = {"geometry": Geometry, "carrier": Carrier, "material": Material,
-                    "sweep": Sweep, "mesh": Mesh, "solver": Solver}
+def build_checked(top_cls: type, data: dict[str, Any], source: str | None = None) -> Any:
+    """Build a checked dataclass of sections (``top_cls``) from nested dicts.
 
-
-def params_from_dict(data: dict[str, Any], source: str | None = None) -> SpringParams:
-    """Build :class:`SpringParams` from nested dicts, rejecting unknown keys.
-
-    All problems in all sections are collected before raising.
+    Sections are the fields whose default is a dataclass; other fields are
+    plain top-level keys. Unknown keys are rejected and all problems of all
+    sections are collected before one :class:`ParameterError` is raised.
     """
+    sections = {f.name: type(f.default_factory()) for f in fields(top_cls)
+                if f.default_factory is not dataclasses.MISSING}
+    plain = {f.name for f in fields(top_cls)} - set(sections)
     problems: list[str] = []
     top: dict[str, Any] = {}
     for key, value in data.items():
-        if key in _SECTION_CLASSES:
-            cls = _SECTION_CLASSES[key]
+        if key in sections:
+            cls = sections[key]
             if not isinstance(value, dict):
                 problems.append(f"[{key}]: must be a table")
                 continue
             allowed = {f.name for f in fields(cls)}
-            unknown = sorted(set(value) - allowed)
-            for k in unknown:
+            for k in sorted(set(value) - allowed):
                 problems.append(f"{key}.{k}: unknown key (allowed: {', '.join(sorted(allowed))})")
             kwargs = {k: (tuple(v) if isinstance(v, list) else v)
                       for k, v in value.items() if k in allowed}
@@ -337,22 +336,31 @@ def params_from_dict(data: dict[str, Any], source: str | None = None) -> SpringP
                 top[key] = cls(**kwargs)
             except ParameterError as exc:
                 problems.extend(exc.problems)
-        elif key in ("name", "description", "n_pairs"):
+        elif key in plain:
             top[key] = value
         else:
-            problems.append(f"{key}: unknown key (allowed: {', '.join(sorted(_SECTIONS))})")
-    if not problems:
-        try:
-            return SpringParams(**top)
-        except ParameterError as exc:
-            problems.extend(exc.problems)
-    else:
-        # still check the top-level keys so that the report is complete
-        try:
-            SpringParams(**{k: v for k, v in top.items() if k in ("name", "description", "n_pairs")})
-        except ParameterError as exc:
-            problems.extend(exc.problems)
+            problems.append(f"{key}: unknown key (allowed: {', '.join(sorted(plain | set(sections)))})")
+    try:
+        if not problems:
+            return top_cls(**top)
+        top_cls(**{k: v for k, v in top.items() if k in plain})   # complete the report
+    except ParameterError as exc:
+        problems.extend(exc.problems)
     raise ParameterError(problems, source)
+
+
+def params_from_dict(data: dict[str, Any], source: str | None = None) -> SpringParams:
+    """Build :class:`SpringParams` from nested dicts, rejecting unknown keys."""
+    return build_checked(SpringParams, data, source)
+
+
+def load_toml(path: str | Path) -> dict[str, Any]:
+    """Read a TOML file; a syntax error becomes a :class:`ParameterError`."""
+    path = Path(path)
+    try:
+        return tomllib.loads(path.read_text(encoding="utf-8"))
+    except tomllib.TOMLDecodeError as exc:
+        raise ParameterError([f"TOML syntax error: {exc}"], str(path)) from exc
 
 
 def load_params(path: str | Path = DEFAULT_SPRING) -> SpringParams:
@@ -363,9 +371,4 @@ def load_params(path: str | Path = DEFAULT_SPRING) -> SpringParams:
     ParameterError
         On a TOML syntax error, an unknown key or an out-of-range value.
     """
-    path = Path(path)
-    try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except tomllib.TOMLDecodeError as exc:
-        raise ParameterError([f"TOML syntax error: {exc}"], str(path)) from exc
-    return params_from_dict(data, str(path))
+    return params_from_dict(load_toml(path), str(Path(path)))

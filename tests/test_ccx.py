@@ -46,7 +46,8 @@ def test_missing_ccx_says_how_to_install(monkeypatch, tmp_path):
 
 
 def test_input_error_is_reported_not_ignored(tmp_path):
-    deck = strip_deck(strip_mesh(L, B, T, 4e-3), Material()).replace("*STATIC", "*STATICK")
+    # ccx exits 0 on a misspelled keyword and only warns; the runner must catch it
+    deck = strip_deck(strip_mesh(L, B, T, 4e-3), Material()).replace("*BOUNDARY", "*BOUNDRY")
     with pytest.raises(CalculixError) as info:
         run_ccx(deck, tmp_path, theta_degC=20.0)
     assert not isinstance(info.value, ConvergenceError)

@@ -1,0 +1,265 @@
+"""The built CushionClutch FMU, simulated with fmpy (committed default tables)."""
+import math
+import resource
+import shutil
+
+import numpy as np
+import pytest
+from fmpy import extract, read_model_description
+from fmpy.fmi1 import FMICallException
+from fmpy.fmi2 import FMU2Slave
+from fmpy.validation import validate_fmu
+from scipy.interpolate import PchipInterpolator
+from scipy.io import loadmat
+
+from cushion_clutch.exports import export_mat, export_modelica, read_modelica
+from cushion_clutch.fmu_build import build_fmu
+from cushion_clutch.model import DEFAULT_TABLES
+from cushion_clutch.tables import read_tables
+
+pytestmark = pytest.mark.fmu
+
+OUT = ["torque", "force", "theta_cs", "u_f", "x_kiss"]
+
+
+@pytest.fixture(scope="module")
+def fmu(tmp_path_factory):
+    path = build_fmu(DEFAULT_TABLES, tmp_path_factory.mktemp("fmu") / "CushionClutch.fmu")
+    md = read_model_description(str(path))
+    unzip = extract(str(path))
+    yield path, md, unzip
+    shutil.rmtree(unzip, ignore_errors=True)
+
+
+@pytest.fixture(scope="module")
+def tables():
+    return read_tables(DEFAULT_TABLES)
+
+
+class Instance:
+    """A started FMU instance with name-based access."""
+
+    def __init__(self, fmu, name="clutch", **start):
+        path, md, unzip = fmu
+        self.vr = {v.name: v.valueReference for v in md.modelVariables}
+        self.s = FMU2Slave(guid=md.guid, unzipDirectory=unzip,
+                           modelIdentifier=md.coSimulation.modelIdentifier, instanceName=name)
+        self.s.instantiate(loggingOn=True)
+        self.start(**start)
+        self.t = 0.0
+
+    def start(self, **start):
+        self.s.setupExperiment(startTime=0.0)
+        if start:
+            self.set(**start)
+        self.s.enterInitializationMode()
+        self.s.exitInitializationMode()
+
+    def set(self, **values):
+        self.s.setReal([self.vr[k] for k in values], list(values.values()))
+
+    def get(self, *names):
+        vals = self.s.getReal([self.vr[n] for n in names])
+        return vals[0] if len(names) == 1 else dict(zip(names, vals))
+
+    def step(self, h):
+        self.s.doStep(self.t, h)
+        self.t += h
+
+    def close(self):
+        self.s.terminate()
+        self.s.freeInstance()
+
+
+def test_fmpy_validate_is_clean(fmu):
+    assert validate_fmu(str(fmu[0])) == []
+
+
+def test_units_are_declared(fmu):
+    md = fmu[1]
+    units = {v.name: (v.unit, v.displayUnit) for v in md.modelVariables}
+    assert units["x_to"][0] == "m" and units["torque"][0] == "N.m" and units["force"][0] == "N"
+    assert units["theta_cm"] == ("K", "degC") and units["theta_cs"] == ("K", "degC")
+    assert units["U"][0] == "W/K" and units["C"][0] == "J/K"
+    k = {u.name: u for u in md.unitDefinitions}["K"]
+    assert k.displayUnits[0].name == "degC" and k.displayUnits[0].offset == -273.15
+
+
+@pytest.mark.parametrize("h", [1e-3, 0.1, 5.0])
+def test_theta_cm_step_matches_closed_form(fmu, h):
+    inst = Instance(fmu)
+    U, H, C, theta_a = 0.1, 0.04, 1.0, 293.15
+    theta_cm = 493.15
+    inst.set(theta_cm=theta_cm)
+    gain, tau = U / (U + H), C / (U + H)
+    assert tau == pytest.approx(7.142857, rel=1e-6)
+    theta_inf = gain * theta_cm + (1 - gain) * theta_a
+    n = int(round(30.0 / h))
+    worst = 0.0
+    for k in range(1, n + 1):
+        inst.step(h)
+        exact = theta_inf + (theta_a - theta_inf) * math.exp(-k * h / tau)
+        worst = max(worst, abs(inst.get("theta_cs") / exact - 1))
+    assert worst < 1e-9
+    inst.close()
+
+
+def test_torque_equals_n_mu_r_f_from_the_table(fmu, tables):
+    """At table temperatures and table u points the FMU returns the CSV force exactly."""
+    n, mu, r = 2.0, 0.28, 0.089
+    for theta, u, f, d in zip(tables.theta_degC, tables.u_m, tables.force_N, tables.delta_kiss_m):
+        inst = Instance(fmu, theta_cs_start=theta + 273.15)
+        x_kiss = 0.004 - 3.0 * d
+        for i in np.linspace(0, len(u) - 1, 9).astype(int):
+            inst.set(x_to=x_kiss + 3.0 * u[i], theta_cm=theta + 273.15)
+            inst.step(0.0)
+            got = inst.get(*OUT)
+            assert got["force"] == pytest.approx(f[i], rel=1e-9, abs=1e-9)
+            assert got["torque"] == pytest.approx(n * mu * r * f[i], rel=1e-9, abs=1e-9)
+            assert got["u_f"] == pytest.approx(max(u[i], 0.0), abs=1e-15)
+        # between table points: SciPy's PCHIP of the same rows
+        um = 0.5 * (u[len(u) // 2] + u[len(u) // 2 + 1])
+        inst.set(x_to=x_kiss + 3.0 * um)
+        inst.step(0.0)
+        assert inst.get("force") == pytest.approx(float(PchipInterpolator(u, f)(um)), rel=1e-9)
+        # past full compression the force stays at its full-compression value
+        inst.set(x_to=x_kiss + 3.0 * (u[-1] + 1e-3))
+        inst.step(0.0)
+        assert inst.get("force") == pytest.approx(f[-1], rel=1e-12)
+        inst.close()
+
+
+def test_kiss_point_moves_by_lever_ratio_times_delta(fmu, tables):
+    d195 = dict(zip(tables.theta_degC, tables.delta_kiss_m))[195.0]
+    cold = Instance(fmu, theta_cs_start=293.15)
+    hot = Instance(fmu, "hot", theta_cs_start=195.0 + 273.15, theta_cm=195.0 + 273.15)
+    shift = cold.get("x_kiss") - hot.get("x_kiss")
+    assert shift == pytest.approx(3.0 * d195, rel=1e-12)
+    assert 0.2e-3 < shift < 0.42e-3               # paper: about 0.3 mm at the bearing
+    cold.close(), hot.close()
+
+
+def test_state_save_restore_and_serialize(fmu):
+    inst = Instance(fmu)
+    inst.set(x_to=0.005, theta_cm=550.0)
+    for _ in range(10):
+        inst.step(0.5)
+    state = inst.s.getFMUstate()
+    blob = inst.s.serializeFMUstate(state)
+    inst.step(3.0)
+    after = inst.get(*OUT)
+    inst.set(theta_cm=300.0, x_to=0.0)
+    inst.step(7.0)
+    inst.s.setFMUstate(state)
+    inst.set(x_to=0.005, theta_cm=550.0)
+    inst.step(3.0)
+    assert inst.get(*OUT) == after
+    other = Instance(fmu, "other")
+    other.s.setFMUstate(other.s.deSerializeFMUstate(blob))
+    other.set(x_to=0.005, theta_cm=550.0)
+    other.step(3.0)
+    assert other.get(*OUT) == after
+    inst.s.freeFMUstate(state)
+    inst.close(), other.close()
+
+
+def test_reset_returns_to_start(fmu):
+    inst = Instance(fmu)
+    inst.set(theta_cm=600.0)
+    inst.step(20.0)
+    assert inst.get("theta_cs") > 400.0
+    inst.s.reset()
+    inst.start()
+    assert inst.get("theta_cs") == 293.15
+    inst.close()
+
+
+def test_two_instances_are_independent(fmu):
+    a, b = Instance(fmu, "a"), Instance(fmu, "b")
+    a.set(theta_cm=600.0, x_to=0.006)
+    b.set(theta_cm=300.0, x_to=0.0)
+    for _ in range(5):
+        a.step(1.0)
+        b.step(1.0)
+    def closed_form(theta_cm, t):
+        inf = (0.1 * theta_cm + 0.04 * 293.15) / 0.14
+        return inf + (293.15 - inf) * math.exp(-t * 0.14 / 1.0)
+
+    assert a.get("theta_cs") == pytest.approx(closed_form(600.0, 5.0), rel=1e-12)
+    assert b.get("theta_cs") == pytest.approx(closed_form(300.0, 5.0), rel=1e-12)
+    assert a.get("torque") > 0.0 and b.get("torque") == 0.0
+    a.close(), b.close()
+
+
+@pytest.mark.parametrize("name,value", [("x_to", math.nan), ("x_to", math.inf),
+                                        ("theta_cm", math.nan), ("theta_cm", -math.inf)])
+def test_bad_input_is_refused_and_logged(fmu, capfd, name, value):
+    inst = Instance(fmu)
+    inst.step(0.1)
+    before = inst.get("theta_cs")
+    inst.set(**{name: value})
+    with pytest.raises(FMICallException, match="discard|error"):
+        inst.step(0.1)
+    assert f"input {name} = {value!r}" in capfd.readouterr().out
+    assert inst.get("theta_cs") == before            # nothing advanced
+    inst.set(x_to=0.005, theta_cm=400.0)             # and the instance recovers
+    inst.step(0.1)
+    assert inst.get("torque") > 0
+    inst.close()
+
+
+@pytest.mark.parametrize("name,value", [("C", 0.0), ("mu", -0.1), ("lever_ratio", 0.0),
+                                        ("R_eq", math.nan), ("U", -1.0)])
+def test_bad_parameter_is_refused_and_logged(fmu, capfd, name, value):
+    inst = Instance(fmu, **{name: value})
+    with pytest.raises(FMICallException, match="discard|error"):
+        inst.step(0.1)
+    assert f"parameter {name} = {value!r}" in capfd.readouterr().out
+    inst.close()
+
+
+def test_out_of_table_temperature_warns_once(fmu, capfd):
+    inst = Instance(fmu, theta_cs_start=700.0, theta_cm=700.0, x_to=0.006)
+    for _ in range(5):
+        inst.step(0.1)
+    out = capfd.readouterr().out
+    assert out.count("outside the table range") == 1
+    assert inst.get("torque") > 0
+    inst.close()
+
+
+def test_million_steps_do_not_grow_memory(fmu):
+    inst = Instance(fmu)
+    s, vx, vt, vo = inst.s, [inst.vr["x_to"], inst.vr["theta_cm"]], 0.0, [inst.vr["torque"]]
+    h = 1e-3
+
+    def run(n, t0):
+        for k in range(n):
+            s.setReal(vx, [0.004 + 0.003 * ((k % 1000) / 1000.0), 400.0])
+            s.doStep(t0 + k * h, h)
+            s.getReal(vo)
+        return t0 + n * h
+
+    t = run(100_000, 0.0)
+    rss0 = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    run(1_000_000, t)
+    rss1 = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    assert rss1 - rss0 < 20_000                       # kB: no per-step leak
+    inst.close()
+
+
+def test_exports_read_back_equal_to_tables(tables, tmp_path):
+    mat = loadmat(export_mat(DEFAULT_TABLES, tmp_path / "t.mat"))
+    mo = read_modelica(export_modelica(DEFAULT_TABLES, tmp_path / "t.txt"))
+    assert np.array_equal(mat["theta_degC"].ravel(), tables.theta_degC)
+    assert np.array_equal(mo["force_N"][0, 1:], tables.theta_degC)
+    u_mat, u_mo = mat["u_m"].ravel(), mo["force_N"][1:, 0]
+    for j, (u, f) in enumerate(zip(tables.u_m, tables.force_N)):
+        i = np.searchsorted(u_mat, u)
+        assert np.array_equal(u_mat[i], u)
+        assert mat["force_N"][i, j] == pytest.approx(f, rel=1e-12, abs=1e-12)
+        k = np.searchsorted(u_mo, u)
+        assert u_mo[k] == pytest.approx(u, rel=1e-11) and mo["force_N"][1 + k, 1 + j] == pytest.approx(f, rel=1e-11)
+    assert mat["delta_kiss_m"].ravel() == pytest.approx(tables.delta_kiss_m)
+    assert mo["delta_kiss_m"][:, 1] == pytest.approx(tables.delta_kiss_m, rel=1e-11)
+    assert "force_N [N]" in str(mat["units"])

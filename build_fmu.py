@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Build CushionClutch.fmu (FMI 2.0 co-simulation) from a lookup-table folder.
 
-    python build_fmu.py [--tables lookup_tables/default] [-o CushionClutch.fmu]
+    python build_fmu.py [--tables lookup_tables/default] [-o CushionClutch.fmu] [--backend python|native]
 """
 from __future__ import annotations
 
@@ -21,13 +21,16 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--tables", type=Path, default=HERE / "lookup_tables" / "default",
                     help="table folder (force_deflection.csv, kiss_point.csv, metadata.json)")
     ap.add_argument("-o", "--output", type=Path, default=Path("CushionClutch.fmu"), help="FMU file")
+    ap.add_argument("--backend", choices=("python", "native"), default="python",
+                    help="python: pythonfmu (needs Python + numpy where it runs); "
+                         "native: C compiled with gcc, loads in any FMI host")
     args = ap.parse_args(argv)
     try:
-        out = build_fmu(args.tables, args.output)
-    except TableError as exc:
+        out = build_fmu(args.tables, args.output, backend=args.backend)
+    except (TableError, RuntimeError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
-    print(f"built {out} from {args.tables}")
+    print(f"built {out} ({args.backend}) from {args.tables}")
     return 0
 
 

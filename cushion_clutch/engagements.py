@@ -107,9 +107,9 @@ def simulate(fmu: Path, cycle: EngagementCycle = EngagementCycle(), n_engagement
 
 def plot_engagements(res: np.ndarray, path: Path) -> Path:
     """theta_cm and theta_cs over repeated engagements (paper Fig. 10), and the torque."""
-    import matplotlib
-    matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+
+    from .plots import finish_figure
 
     fig, (a1, a2) = plt.subplots(2, 1, figsize=(9, 6), sharex=True)
     a1.plot(res["time"], res["theta_cm"] - KELVIN, label="facing θ_cm")
@@ -118,19 +118,14 @@ def plot_engagements(res: np.ndarray, path: Path) -> Path:
     a1.legend()
     a2.plot(res["time"], res["torque"], color="C2")
     a2.set(xlabel="time [s]", ylabel="clutch torque [N·m]")
-    for a in (a1, a2):
-        a.grid(True, alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return Path(path)
+    return finish_figure(fig, [a1, a2], path, legend=False)
 
 
 def plot_torque_characteristic(table: SpringTable, path: Path, p: ClutchParameters = ClutchParameters()) -> Path:
     """T(x_to) at each table temperature (paper Fig. 12), from the shared model."""
-    import matplotlib
-    matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+
+    from .plots import finish_figure
 
     x = np.linspace(p.x_kiss_ref - 1.0e-3, p.x_kiss_ref + p.lever_ratio * 1.45e-3, 600)
     fig, ax = plt.subplots(figsize=(7, 4.5))
@@ -139,20 +134,15 @@ def plot_torque_characteristic(table: SpringTable, path: Path, p: ClutchParamete
     ax.axvline(p.x_kiss_ref * 1e3, color="k", lw=0.8, ls=":")
     ax.set(xlabel="throwout-bearing position x_to [mm]", ylabel="clutch torque T [N·m]",
            title="Clutch torque characteristic vs cushion-spring temperature")
-    ax.grid(True, alpha=0.3)
-    ax.legend()
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return Path(path)
+    return finish_figure(fig, ax, path)
 
 
 def plot_thermal_step(path: Path, p: ClutchParameters = ClutchParameters()) -> Path:
     """Step response of the python-control thermal model to a 100 K facing step."""
     import control
-    import matplotlib
-    matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+
+    from .plots import finish_figure
 
     from .model import thermal_system
 
@@ -165,9 +155,4 @@ def plot_thermal_step(path: Path, p: ClutchParameters = ClutchParameters()) -> P
     ax.axvline(p.C / (p.U + p.H), ls=":", color="k", lw=0.8, label="τ = C/(U+H)")
     ax.set(xlabel="time [s]", ylabel="temperature rise [K]",
            title="Cushion-spring response to a 100 K facing step")
-    ax.grid(True, alpha=0.3)
-    ax.legend()
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return Path(path)
+    return finish_figure(fig, ax, path)

@@ -73,9 +73,9 @@ def metrics_table(results: dict[str, LaunchResult]) -> str:
 
 def plot_launches(results: dict[str, LaunchResult], out: Path) -> list[Path]:
     """Speeds, bearing, torque demanded vs delivered (last launch), temperatures over all launches."""
-    import matplotlib
-    matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+
+    from .plots import finish_figure
 
     nv, aw = results["naive"].series, results["aware"].series
     last = nv["launch"].max()
@@ -99,23 +99,11 @@ def plot_launches(results: dict[str, LaunchResult], out: Path) -> list[Path]:
     ax.plot(tn, nv["torque_capacity_Nm"][sel_n], label="delivered (naive)")
     ax.plot(ta, aw["torque_capacity_Nm"][sel_a], "--", label="delivered (aware)")
     ax.set(ylabel="clutch torque [N·m]", xlabel="time since launch start [s]", xlim=(0, 4))
-    for a in axes:
-        a.grid(True, alpha=0.3)
-        a.legend(fontsize=8)
-    fig.tight_layout()
-    p1 = out / "launch_last.png"
-    fig.savefig(p1, dpi=120)
-    plt.close(fig)
+    p1 = finish_figure(fig, axes, out / "launch_last.png", fontsize=8)
 
     fig, ax = plt.subplots(figsize=(9, 4))
     ax.plot(nv["time_s"], nv["theta_cm_K"] - KELVIN, label="facing θ_cm")
     ax.plot(nv["time_s"], nv["theta_cs_K"] - KELVIN, label="cushion spring θ_cs (FMU)")
     ax.plot(aw["time_s"], aw["theta_cs_tcu_K"] - KELVIN, "--", label="θ_cs estimated by the aware TCU")
     ax.set(xlabel="time [s]", ylabel="temperature [°C]", title="Temperatures over the repeated launches")
-    ax.grid(True, alpha=0.3)
-    ax.legend()
-    fig.tight_layout()
-    p2 = out / "launch_temperatures.png"
-    fig.savefig(p2, dpi=120)
-    plt.close(fig)
-    return [p1, p2]
+    return [p1, finish_figure(fig, ax, out / "launch_temperatures.png")]

@@ -12,6 +12,18 @@ import numpy as np  # noqa: E402
 from .tables import TableSet  # noqa: E402
 
 
+def finish_figure(fig, axes, path: Path, legend: bool = True, fontsize=None) -> Path:
+    """Grid (and legend) on every axis, tight layout, save as PNG at 120 dpi, close."""
+    for ax in np.atleast_1d(axes):
+        ax.grid(True, alpha=0.3)
+        if legend:
+            ax.legend(fontsize=fontsize)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return Path(path)
+
+
 def plot_force_deflection(tables: TableSet, path: Path, title: str = "") -> Path:
     """F(u) family over temperature, u from the 20 degC kiss point (paper Fig. 11)."""
     ref = int(np.argmin(np.abs(tables.theta_degC - 20.0)))
@@ -24,13 +36,8 @@ def plot_force_deflection(tables: TableSet, path: Path, title: str = "") -> Path
            title=title or "Cushion spring load-deflection")
     zoom.set(xlim=(-0.2, 0.4), ylim=(0, 0.6), xlabel="u [mm]", ylabel="F [kN]",
              title="zoom: the kiss point moves with temperature")
-    for a in (ax, zoom):
-        a.grid(True, alpha=0.3)
     ax.legend()
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return Path(path)
+    return finish_figure(fig, [ax, zoom], path, legend=False)
 
 
 def plot_kiss_shift(tables: TableSet, path: Path) -> Path:
@@ -39,8 +46,4 @@ def plot_kiss_shift(tables: TableSet, path: Path) -> Path:
     ax.plot(tables.theta_degC, tables.delta_kiss_m * 1e3, "o-")
     ax.set(xlabel="cushion-spring temperature θ [°C]", ylabel="kiss-point shift δ [mm]",
            title="Thermal growth of the pair's free height")
-    ax.grid(True, alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return Path(path)
+    return finish_figure(fig, ax, path, legend=False)

@@ -1,65 +1,117 @@
-"""Benchmark: time per step of the CushionClutch FMU through fmpy, and of the model alone.
+"""Benchmark: time per step of the CushionClutch FMUs (pythonfmu and native C).
 
-    python -m cushion_clutch.benchmarks.fmu [--steps 200000] [--fmu FILE]
+Through fmpy (FMU2Slave: set 2 inputs, doStep, get 5 outputs), in our small C
+host (tests/c_host/fmi2_host.c, dlopen), and the Python model alone.
+
+    python -m cushion_clutch.benchmarks.fmu [--steps 200000]
 """
 from __future__ import annotations
 
 import argparse
+import os
 import shutil
+import subprocess
+import sysconfig
 import tempfile
 import time
+import zipfile
 from pathlib import Path
 
+REPO = Path(__file__).resolve().parents[2]
+HOST_SRC = REPO / "tests" / "c_host" / "fmi2_host.c"
 
-def main(argv=None) -> None:
+
+def time_fmpy(fmu: Path, n: int, h: float = 1e-3) -> tuple[float, float]:
+    """(us per set+doStep+get, us per doStep alone) through fmpy's FMU2Slave."""
     from fmpy import extract, read_model_description
     from fmpy.fmi2 import FMU2Slave
 
+    md = read_model_description(str(fmu))
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    unzip = extract(str(fmu))
+    s = FMU2Slave(guid=md.guid, unzipDirectory=unzip, modelIdentifier="CushionClutch", instanceName="bench")
+    s.instantiate()
+    s.setupExperiment(startTime=0.0)
+    s.enterInitializationMode()
+    s.exitInitializationMode()
+    vin = [vr["x_to"], vr["theta_cm"]]
+    vout = [vr[k] for k in ("torque", "force", "theta_cs", "u_f", "x_kiss")]
+    xs = [0.003 + 0.004 * (k % 1000) / 1000.0 for k in range(1000)]
+    t0 = time.perf_counter()
+    for k in range(n):
+        s.setReal(vin, [xs[k % 1000], 450.0])
+        s.doStep(k * h, h)
+        s.getReal(vout)
+    full = (time.perf_counter() - t0) / n
+    t0 = time.perf_counter()
+    for k in range(n):
+        s.doStep((n + k) * h, h)
+    step_only = (time.perf_counter() - t0) / n
+    s.terminate()
+    s.freeInstance()
+    shutil.rmtree(unzip, ignore_errors=True)
+    return full * 1e6, step_only * 1e6
+
+
+def compile_host(dest: Path) -> Path:
+    from cushion_clutch.fmu_build import fmi2_header_dir
+    subprocess.run([shutil.which("gcc") or "cc", "-std=c99", "-D_POSIX_C_SOURCE=199309L", "-O2",
+                    f"-I{fmi2_header_dir()}", str(HOST_SRC), "-o", str(dest), "-ldl"], check=True)
+    return dest
+
+
+def time_c_host(host: Path, fmu: Path, n: int, python: bool, workdir: Path) -> tuple[float, int, str]:
+    """(us per set+doStep+get in the C host, exit code, stderr tail)."""
+    from fmpy import read_model_description
+
+    unzip = workdir / fmu.stem
+    zipfile.ZipFile(fmu).extractall(unzip)
+    env = dict(os.environ)
+    if python:   # a pythonfmu binary loads only with libpython preloaded
+        env["LD_PRELOAD"] = os.path.join(sysconfig.get_config_var("LIBDIR"), sysconfig.get_config_var("LDLIBRARY"))
+        import numpy
+        env["PYTHONPATH"] = str(Path(numpy.__file__).parents[1])
+    res = subprocess.run([str(host), str(unzip / "binaries/linux64/CushionClutch.so"),
+                          (unzip / "resources").as_uri(), read_model_description(str(fmu)).guid, str(n), "0.001"],
+                         capture_output=True, text=True, env=env)
+    us = float("nan")
+    for line in res.stdout.splitlines():
+        if line.startswith("us_per_step"):
+            us = float(line.split()[1])
+    return us, res.returncode, res.stderr.strip()[-200:]
+
+
+def main(argv=None) -> None:
     from cushion_clutch.fmu_build import build_fmu
     from cushion_clutch.model import DEFAULT_TABLES, ClutchParameters, load_table, outputs, thermal_step
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--steps", type=int, default=200_000)
-    ap.add_argument("--fmu", type=Path, help="FMU to time (default: build from the default tables)")
     args = ap.parse_args(argv)
-    n, h = args.steps, 1e-3
+    n = args.steps
     with tempfile.TemporaryDirectory() as tmp:
-        fmu = args.fmu or build_fmu(DEFAULT_TABLES, Path(tmp) / "CushionClutch.fmu")
-        md = read_model_description(str(fmu))
-        vr = {v.name: v.valueReference for v in md.modelVariables}
-        unzip = extract(str(fmu))
-        s = FMU2Slave(guid=md.guid, unzipDirectory=unzip, modelIdentifier="CushionClutch",
-                      instanceName="bench")
-        s.instantiate()
-        s.setupExperiment(startTime=0.0)
-        s.enterInitializationMode()
-        s.exitInitializationMode()
-        vin, vout = [vr["x_to"], vr["theta_cm"]], [vr[k] for k in ("torque", "force", "theta_cs", "u_f", "x_kiss")]
-        xs = [0.003 + 0.004 * (k % 1000) / 1000.0 for k in range(1000)]
-        t0 = time.perf_counter()
-        for k in range(n):
-            s.setReal(vin, [xs[k % 1000], 450.0])
-            s.doStep(k * h, h)
-            s.getReal(vout)
-        full = (time.perf_counter() - t0) / n
-        t0 = time.perf_counter()
-        for k in range(n):
-            s.doStep((n + k) * h, h)
-        step_only = (time.perf_counter() - t0) / n
-        s.terminate()
-        s.freeInstance()
-        shutil.rmtree(unzip, ignore_errors=True)
+        tmp = Path(tmp)
+        fmus = {b: build_fmu(DEFAULT_TABLES, tmp / f"{b}.fmu", backend=b) for b in ("python", "native")}
+        host = compile_host(tmp / "host")
+        print(f"steps: {n}, communication step 1 ms")
+        fm = {}
+        for b, path in fmus.items():
+            fm[b] = time_fmpy(path, n)
+            print(f"fmpy, {b:>6} FMU: set+doStep+get {fm[b][0]:8.3f} us/step, doStep alone {fm[b][1]:8.3f} us/step")
+        ch = {}
+        for b, path in fmus.items():
+            ch[b] = time_c_host(host, path, n * (10 if b == "native" else 1), b == "python", tmp)
+            note = "" if ch[b][1] == 0 else f"  (host exit code {ch[b][1]}: {ch[b][2]!r})"
+            print(f"C host, {b:>6} FMU: set+doStep+get {ch[b][0]:8.3f} us/step{note}")
+        print(f"native speed-up: {ch['python'][0] / ch['native'][0]:.0f}x in the C host, "
+              f"{fm['python'][0] / fm['native'][0]:.1f}x through fmpy")
     table, p = load_table(), ClutchParameters()
     theta = 293.15
     t0 = time.perf_counter()
     for k in range(n):
-        theta = thermal_step(theta, 450.0, h, p)
-        outputs(xs[k % 1000], theta, table, p)
-    model = (time.perf_counter() - t0) / n
-    print(f"steps: {n}, communication step {h:g} s")
-    print(f"fmpy FMU2Slave set(2 inputs) + doStep + get(5 outputs): {full * 1e6:7.2f} us/step")
-    print(f"fmpy FMU2Slave doStep alone:                           {step_only * 1e6:7.2f} us/step")
-    print(f"model alone (thermal_step + outputs, Python):          {model * 1e6:7.2f} us/step")
+        theta = thermal_step(theta, 450.0, 1e-3, p)
+        outputs(0.003 + 0.004 * (k % 1000) / 1000.0, theta, table, p)
+    print(f"Python model alone (thermal_step + outputs): {(time.perf_counter() - t0) / n * 1e6:8.3f} us/step")
 
 
 if __name__ == "__main__":

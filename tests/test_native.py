@@ -1,0 +1,227 @@
+"""The native C FMU: conformance, agreement with the pythonfmu FMU and the model, C host, sanitizers."""
+import math
+import shutil
+import subprocess
+import zipfile
+
+import numpy as np
+import pytest
+from fmpy import extract, read_model_description
+from fmpy.fmi1 import FMICallException
+from fmpy.fmi2 import FMU2Slave
+from fmpy.validation import validate_fmu
+
+from cushion_clutch.fmu_build import build_fmu, fmi2_header_dir
+from cushion_clutch.model import DEFAULT_TABLES, ClutchParameters, load_table, outputs, thermal_step
+
+pytestmark = pytest.mark.fmu
+
+HOST_SRC = __import__("pathlib").Path(__file__).parent / "c_host" / "fmi2_host.c"
+OUT = ["torque", "force", "theta_cs", "u_f", "x_kiss"]
+
+
+@pytest.fixture(scope="module")
+def fmus(tmp_path_factory):
+    d = tmp_path_factory.mktemp("fmus")
+    return {"native": build_fmu(DEFAULT_TABLES, d / "native.fmu", backend="native"),
+            "python": build_fmu(DEFAULT_TABLES, d / "python.fmu", backend="python")}
+
+
+def open_slave(path, unzip=None, name="i", **start):
+    md = read_model_description(str(path))
+    unzip = unzip or extract(str(path))
+    s = FMU2Slave(guid=md.guid, unzipDirectory=unzip, modelIdentifier=md.coSimulation.modelIdentifier,
+                  instanceName=name)
+    s.instantiate(loggingOn=True)
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    s.setupExperiment(startTime=0.0)
+    if start:
+        s.setReal([vr[k] for k in start], list(start.values()))
+    s.enterInitializationMode()
+    s.exitInitializationMode()
+    return s, vr
+
+
+def test_validate_and_sources(fmus):
+    assert validate_fmu(str(fmus["native"])) == []
+    names = zipfile.ZipFile(fmus["native"]).namelist()
+    for f in ("binaries/linux64/CushionClutch.so", "sources/CushionClutch.c", "sources/fmi2Functions.h",
+              "resources/tables/force_deflection.csv", "resources/tables/kiss_point.csv"):
+        assert f in names
+    md = read_model_description(str(fmus["native"]))
+    assert md.buildConfigurations[0].sourceFileSets[0].sourceFiles == ["CushionClutch.c"]
+    assert md.coSimulation.canGetAndSetFMUstate and md.coSimulation.canSerializeFMUstate
+    py = read_model_description(str(fmus["python"]))
+    same = lambda m: [(v.name, v.valueReference, v.causality, v.unit, v.displayUnit,  # noqa: E731
+                       None if v.start is None else float(v.start)) for v in m.modelVariables]
+    assert same(md) == same(py)
+
+
+@pytest.mark.skipif(shutil.which("cmake") is None, reason="fmpy compile needs CMake")
+def test_sources_build_with_fmpy_compile(fmus, tmp_path):
+    """Another platform can rebuild the binary from sources/ (here: fmpy compile, CMake)."""
+    src_only = tmp_path / "src_only.fmu"
+    with zipfile.ZipFile(fmus["native"]) as zin, zipfile.ZipFile(src_only, "w") as zout:
+        for item in zin.infolist():
+            if not item.filename.startswith("binaries/"):
+                zout.writestr(item, zin.read(item.filename))
+    subprocess.run(["fmpy", "compile", str(src_only)], check=True, capture_output=True)
+    assert "binaries/linux64/CushionClutch.so" in zipfile.ZipFile(src_only).namelist()
+    s, vr = open_slave(src_only, name="rebuilt", theta_cs_start=468.15)
+    s.setReal([vr["x_to"]], [0.005])
+    s.doStep(0.0, 0.0)
+    table, p = load_table(), ClutchParameters()
+    assert s.getReal([vr["torque"]])[0] == pytest.approx(outputs(0.005, 468.15, table, p).torque, rel=1e-12)
+
+
+def test_native_pythonfmu_and_model_agree_over_a_long_random_sequence(fmus):
+    rng = np.random.default_rng(7)
+    n = 20_000
+    x_to = rng.uniform(-0.001, 0.010, n)
+    theta_cm = rng.uniform(250.0, 750.0, n)           # beyond the table range too
+    h = rng.choice([1e-4, 1e-3, 0.01, 0.1, 1.0, 5.0], n)
+    nat, vr = open_slave(fmus["native"], name="native")
+    pyf, _ = open_slave(fmus["python"], name="python")
+    table, p = load_table(), ClutchParameters()
+    theta, t, worst = p.theta_cs_start, 0.0, 0.0
+    vin, vout = [vr["x_to"], vr["theta_cm"]], [vr[k] for k in OUT]
+    for k in range(n):
+        for s in (nat, pyf):
+            s.setReal(vin, [x_to[k], theta_cm[k]])
+            s.doStep(t, h[k])
+        theta = thermal_step(theta, theta_cm[k], h[k], p)
+        o = outputs(x_to[k], theta, table, p)
+        ref = np.array([o.torque, o.force, theta, o.u_f, o.x_kiss])
+        a, b = np.array(nat.getReal(vout)), np.array(pyf.getReal(vout))
+        scale = np.maximum(np.abs(ref), 1e-12)
+        worst = max(worst, float(np.max(np.abs(a - ref) / scale)), float(np.max(np.abs(b - ref) / scale)))
+        t += h[k]
+    assert worst < 1e-9, worst
+
+
+def test_shared_object_does_not_need_python(fmus, tmp_path):
+    with zipfile.ZipFile(fmus["native"]) as z:
+        z.extract("binaries/linux64/CushionClutch.so", tmp_path)
+    so = tmp_path / "binaries/linux64/CushionClutch.so"
+    ldd = subprocess.run(["ldd", str(so)], capture_output=True, text=True, check=True).stdout
+    assert "python" not in ldd.lower()
+    undefined = subprocess.run(["nm", "-D", "--undefined-only", str(so)], capture_output=True, text=True,
+                               check=True).stdout
+    assert not [ln for ln in undefined.splitlines() if " Py" in ln or "_Py" in ln]
+    exported = subprocess.run(["nm", "-D", "--defined-only", str(so)], capture_output=True, text=True,
+                              check=True).stdout
+    assert "fmi2DoStep" in exported and "table_load" not in exported       # only the FMI API
+
+
+def _host(tmp_path, fmus, flags=()):
+    unzip = tmp_path / "fmu"
+    zipfile.ZipFile(fmus["native"]).extractall(unzip)
+    cc = shutil.which("gcc")
+    host = tmp_path / "host"
+    subprocess.run([cc, "-std=c99", "-D_POSIX_C_SOURCE=199309L", "-O1", "-g", *flags, f"-I{fmi2_header_dir()}",
+                    str(HOST_SRC), "-o", str(host), "-ldl"], check=True)
+    lib = unzip / "binaries/linux64/CushionClutch.so"
+    if flags:   # rebuild the FMU library with the same instrumentation
+        subprocess.run([cc, "-std=c99", "-O1", "-g", "-fPIC", "-shared", *flags, f"-I{fmi2_header_dir()}",
+                        str(unzip / "sources/CushionClutch.c"), "-o", str(lib), "-lm"], check=True)
+    guid = read_model_description(str(fmus["native"])).guid
+    return [str(host), str(lib), (unzip / "resources").as_uri(), guid]
+
+
+def _model_final(steps, h):
+    table, p = load_table(), ClutchParameters()
+    theta = p.theta_cs_start
+    for k in range(steps):
+        x = 0.003 + 0.005 * ((k * 7919) % 1000) / 1000.0
+        th = 300.0 + 300.0 * ((k * 104729) % 1000) / 1000.0
+        theta = thermal_step(theta, th, h, p)
+    o = outputs(x, theta, table, p)
+    return [o.torque, o.force, theta, o.u_f, o.x_kiss]
+
+
+def test_c_host_drives_a_simulation(fmus, tmp_path):
+    cmd = _host(tmp_path, fmus)
+    out = subprocess.run(cmd + ["20000", "0.01"], capture_output=True, text=True, check=True).stdout
+    got = [float(v) for v in out.splitlines()[0].split()[1:]]
+    assert got == pytest.approx(_model_final(20000, 0.01), rel=1e-12, abs=1e-15)
+
+
+def test_c_host_under_address_sanitizer_is_clean(fmus, tmp_path):
+    cmd = _host(tmp_path, fmus, flags=("-fsanitize=address,undefined", "-fno-omit-frame-pointer"))
+    res = subprocess.run(cmd + ["5000", "0.01"], capture_output=True, text=True,
+                         env={"ASAN_OPTIONS": "detect_leaks=1:abort_on_error=0",
+                              "UBSAN_OPTIONS": "halt_on_error=1", "PATH": "/usr/bin:/bin"})
+    assert res.returncode == 0, res.stderr
+    assert "AddressSanitizer" not in res.stderr and "runtime error" not in res.stderr
+
+
+@pytest.mark.skipif(shutil.which("valgrind") is None, reason="valgrind not installed")
+def test_c_host_under_valgrind_is_clean(fmus, tmp_path):
+    cmd = _host(tmp_path, fmus)
+    res = subprocess.run(["valgrind", "--error-exitcode=3", "--leak-check=full", "--errors-for-leak-kinds=all",
+                          *cmd, "2000", "0.01"], capture_output=True, text=True)
+    assert res.returncode == 0, res.stderr[-3000:]
+    assert "ERROR SUMMARY: 0 errors" in res.stderr
+
+
+def test_state_reset_and_instances(fmus):
+    a, vr = open_slave(fmus["native"], name="a")
+    b, _ = open_slave(fmus["native"], name="b")
+    vin, vout = [vr["x_to"], vr["theta_cm"]], [vr[k] for k in OUT]
+    a.setReal(vin, [0.005, 600.0])
+    b.setReal(vin, [0.0, 300.0])
+    for k in range(5):
+        a.doStep(k, 1.0)
+        b.doStep(k, 1.0)
+    assert a.getReal([vr["theta_cs"]])[0] > 400 > b.getReal([vr["theta_cs"]])[0]
+    state = a.getFMUstate()
+    blob = a.serializeFMUstate(state)
+    a.doStep(5.0, 2.0)
+    after = a.getReal(vout)
+    a.setReal(vin, [0.0, 300.0])
+    a.doStep(7.0, 9.0)
+    a.setFMUstate(state)
+    a.setReal(vin, [0.005, 600.0])
+    a.doStep(5.0, 2.0)
+    assert a.getReal(vout) == after
+    b.setFMUstate(b.deSerializeFMUstate(blob))
+    b.setReal(vin, [0.005, 600.0])
+    b.doStep(5.0, 2.0)
+    assert b.getReal(vout) == after
+    a.freeFMUstate(state)
+    a.reset()
+    a.setupExperiment(startTime=0.0)
+    a.enterInitializationMode()
+    a.exitInitializationMode()
+    assert a.getReal([vr["theta_cs"]]) == [293.15]
+    for s in (a, b):
+        s.terminate()
+        s.freeInstance()
+
+
+def test_bad_inputs_and_parameters_give_statuses_and_messages(fmus, capfd):
+    s, vr = open_slave(fmus["native"], name="bad")
+    s.setReal([vr["x_to"]], [math.nan])
+    with pytest.raises(FMICallException, match="discard"):
+        s.doStep(0.0, 0.1)
+    assert "input x_to = nan" in capfd.readouterr().out
+    s.setReal([vr["x_to"]], [0.005])
+    s.doStep(0.0, 0.1)                                   # recovers
+    s.terminate()
+    s.freeInstance()
+    with pytest.raises(FMICallException, match="error"):
+        open_slave(fmus["native"], name="badC", C=0.0, mu=-1.0)
+    out = capfd.readouterr().out
+    assert "parameter C = 0" in out and "parameter mu = -1" in out
+
+
+def test_malformed_table_is_an_error_not_a_crash(fmus, tmp_path, capfd):
+    unzip = tmp_path / "fmu"
+    zipfile.ZipFile(fmus["native"]).extractall(unzip)
+    csv = unzip / "resources/tables/force_deflection.csv"
+    lines = csv.read_text().splitlines()
+    lines[5] = "20,oops,1"
+    csv.write_text("\n".join(lines) + "\n")
+    with pytest.raises(FMICallException, match="error"):
+        open_slave(fmus["native"], unzip=str(unzip), name="malformed")
+    assert "force_deflection.csv line 6: expected 3 finite numbers" in capfd.readouterr().out

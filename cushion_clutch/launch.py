@@ -40,7 +40,7 @@ COLUMNS = ("time_s", "launch", "w_engine_rad_s", "w_disc_rad_s", "v_m_s", "accel
 
 
 @dataclass
-class Tcu:
+class TcuController:
     """Commands the bearing from the torque demand through the model's inverse.
 
     ``aware``: estimates theta_cs with the thermal model from the measured
@@ -144,7 +144,7 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, aware: bool,
     theta_a = fac.ambient_degC + KELVIN
     theta0 = fac.initial_degC + KELVIN
     p = ClutchParameters(theta_a=theta_a, theta_cs_start=theta0)
-    tcu = Tcu(table, p, aware, theta_est=theta0)
+    tcu = TcuController(table, p, aware, theta_est=theta0)
     clutch = ClutchFmu(fmu, {"theta_a": theta_a, "theta_cs_start": theta0})
     profile = _facing_profile(fac.profile_csv) if fac.profile_csv else None
 
@@ -208,8 +208,7 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, aware: bool,
             else:
                 phase, t_dem, x_cmd = "open", 0.0, 0.0
         x_act = x_cmd + (x_act - x_cmd) * act
-        # -- facing temperature (input held over the step) --------------------
-        theta_cm_step = theta_cm
+        theta_cm_step = theta_cm                                   # held over the step
         # -- clutch FMU -----------------------------------------------------------
         t_cap, theta_cs, x_kiss = clutch.step(t, h, x_act, theta_cm_step)
         if rec["kiss_err"] is None and phase == "launch":      # at the launch start
@@ -288,9 +287,11 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, aware: bool,
             theta_cm = profile(t + h)
         else:
             p_slip = fac.heat_share * abs(t_c * (wm_e - wm_d))
-            theta_inf = theta_a + p_slip / fac.loss_W_per_K if fac.loss_W_per_K > 0 else theta_cm
-            theta_cm = theta_inf + (theta_cm - theta_inf) * fac_decay if fac.loss_W_per_K > 0 \
-                else theta_cm + p_slip * h / fac.capacity_J_per_K
+            if fac.loss_W_per_K > 0:                               # exact for p_slip held
+                theta_inf = theta_a + p_slip / fac.loss_W_per_K
+                theta_cm = theta_inf + (theta_cm - theta_inf) * fac_decay
+            else:
+                theta_cm += p_slip * h / fac.capacity_J_per_K
         # -- metrics -------------------------------------------------------------------
         accel = (v_new - v) / h
         a_filt += jerk_alpha * (accel - a_filt)

@@ -19,7 +19,7 @@ from .errors import ParameterError
 DEFAULT_SPRING = Path(__file__).parent / "springs" / "default.toml"
 
 
-def _range_problem(key: str, value: Any, lo: float | None, hi: float | None,
+def range_problem(key: str, value: Any, lo: float | None, hi: float | None,
                    lo_open: bool = False, hi_open: bool = False) -> str | None:
     """Return a message if ``value`` is not a finite number in the range, else None."""
     lo_s = "-inf" if lo is None else f"{lo:g}"
@@ -34,7 +34,7 @@ def _range_problem(key: str, value: Any, lo: float | None, hi: float | None,
     return None
 
 
-class _Checked:
+class Checked:
     """Mixin: run ``_problems`` after init and raise if there are any."""
 
     _section = ""
@@ -49,7 +49,7 @@ class _Checked:
 
     def _ranges(self, spec: dict[str, tuple]) -> Iterable[str]:
         for name, bounds in spec.items():
-            msg = _range_problem(self._key(name), getattr(self, name), *bounds)
+            msg = range_problem(self._key(name), getattr(self, name), *bounds)
             if msg:
                 yield msg
 
@@ -58,7 +58,7 @@ class _Checked:
 
 
 @dataclass(frozen=True)
-class Geometry(_Checked):
+class Geometry(Checked):
     """Plan shape and wave of one paddle (an annular sector).
 
     Angles are measured along the circumference from the paddle's clamped
@@ -120,7 +120,7 @@ class Geometry(_Checked):
 
 
 @dataclass(frozen=True)
-class Carrier(_Checked):
+class Carrier(Checked):
     """The clutch-disc carrier that holds the rivet (clamp) zone and the far end.
 
     ``temperature_ratio`` (kappa, dimensionless) states how much of the
@@ -151,7 +151,7 @@ class Carrier(_Checked):
 
 
 @dataclass(frozen=True)
-class Material(_Checked):
+class Material(Checked):
     """Isotropic linear elastic material, E(theta) piecewise linear (paper Table 1)."""
 
     temperatures_degC: tuple[float, ...] = (20.0, 80.0, 200.0, 350.0)
@@ -173,11 +173,11 @@ class Material(_Checked):
             yield (f"material.temperatures_degC / youngs_modulus_Pa: need equal, non-zero "
                    f"lengths, got {len(temps)} and {len(moduli)}")
         for i, t in enumerate(temps):
-            msg = _range_problem(f"material.temperatures_degC[{i}]", t, -273.15, 1500.0, True)
+            msg = range_problem(f"material.temperatures_degC[{i}]", t, -273.15, 1500.0, True)
             if msg:
                 yield msg
         for i, e in enumerate(moduli):
-            msg = _range_problem(f"material.youngs_modulus_Pa[{i}]", e, 1e6, 1e13)
+            msg = range_problem(f"material.youngs_modulus_Pa[{i}]", e, 1e6, 1e13)
             if msg:
                 yield msg
         if all(isinstance(t, (int, float)) for t in temps) and list(temps) != sorted(set(temps)):
@@ -190,7 +190,7 @@ class Material(_Checked):
 
 
 @dataclass(frozen=True)
-class Sweep(_Checked):
+class Sweep(Checked):
     """Temperatures to compute and the kiss-point definition."""
 
     temperatures_degC: tuple[float, ...] = (20.0, 80.0, 195.0, 250.0, 300.0)
@@ -206,7 +206,7 @@ class Sweep(_Checked):
         if len(self.temperatures_degC) == 0:
             yield "sweep.temperatures_degC: needs at least one temperature"
         for i, t in enumerate(self.temperatures_degC):
-            msg = _range_problem(f"sweep.temperatures_degC[{i}]", t, -60.0, 600.0)
+            msg = range_problem(f"sweep.temperatures_degC[{i}]", t, -60.0, 600.0)
             if msg:
                 yield msg
         if not isinstance(self.thermal_distortion, bool):
@@ -214,7 +214,7 @@ class Sweep(_Checked):
 
 
 @dataclass(frozen=True)
-class Mesh(_Checked):
+class Mesh(Checked):
     """Target shell element edge length, m."""
 
     element_size_m: float = 0.5e-3
@@ -226,7 +226,7 @@ class Mesh(_Checked):
 
 
 @dataclass(frozen=True)
-class Solver(_Checked):
+class Solver(Checked):
     """CalculiX options.
 
     ``initial_gap_m`` is the clearance between the paddle crest and the
@@ -266,7 +266,7 @@ class Solver(_Checked):
 
 
 @dataclass(frozen=True)
-class SpringParams(_Checked):
+class SpringParams(Checked):
     """A whole cushion spring: ``n_pairs`` identical paddle pairs in parallel."""
 
     name: str = "default"

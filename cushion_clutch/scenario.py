@@ -8,13 +8,13 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Iterable
 
-from .params import _Checked, _range_problem, build_checked, load_toml
+from .params import Checked, range_problem, build_checked, load_toml
 
 DEFAULT_SCENARIO = Path(__file__).parent / "scenarios" / "default.toml"
 
 
 @dataclass(frozen=True)
-class Engine(_Checked):
+class Engine(Checked):
     """Engine and flywheel: ``T = throttle T_max(w) - drag_Nm_per_rad_s w``.
 
     The engine control's speed governor (PI, anti-windup) sets the throttle to
@@ -46,13 +46,13 @@ class Engine(_Checked):
         elif list(self.torque_curve_rpm) != sorted(set(self.torque_curve_rpm)):
             yield "engine.torque_curve_rpm: must be strictly increasing"
         for i, v in enumerate(self.torque_curve_Nm):
-            msg = _range_problem(f"engine.torque_curve_Nm[{i}]", v, 0.0, 5000.0)
+            msg = range_problem(f"engine.torque_curve_Nm[{i}]", v, 0.0, 5000.0)
             if msg:
                 yield msg
 
 
 @dataclass(frozen=True)
-class Driveline(_Checked):
+class Driveline(Checked):
     """Clutch disc side: gearbox in launch gear, final drive, wheels."""
 
     disc_inertia_kg_m2: float = 0.03
@@ -70,7 +70,7 @@ class Driveline(_Checked):
 
 
 @dataclass(frozen=True)
-class Vehicle(_Checked):
+class Vehicle(Checked):
     """Vehicle on a slope; the service brake stops it between launches."""
 
     mass_kg: float = 1900.0
@@ -90,7 +90,7 @@ class Vehicle(_Checked):
 
 
 @dataclass(frozen=True)
-class Facing(_Checked):
+class Facing(Checked):
     """Lumped facing thermal model heated by the slip power.
 
     ``C_f dtheta_cm/dt = share T w_slip - G_f (theta_cm - theta_a)``; with
@@ -115,7 +115,7 @@ class Facing(_Checked):
 
 
 @dataclass(frozen=True)
-class Tcu(_Checked):
+class Tcu(Checked):
     """Launch strategy shared by both TCUs: the same clutch-torque demand profile.
 
     The demand ramps at ``torque_ramp_Nm_per_s`` to ``torque_target_Nm`` and is
@@ -145,7 +145,7 @@ class Tcu(_Checked):
 
 
 @dataclass(frozen=True)
-class Run(_Checked):
+class Run(Checked):
     """Repetition and co-simulation step."""
 
     launches: int = 12
@@ -161,7 +161,7 @@ class Run(_Checked):
 
 
 @dataclass(frozen=True)
-class Scenario(_Checked):
+class Scenario(Checked):
     """A repeated-launch scenario."""
 
     name: str = "default"

@@ -27,6 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from .errors import ResultError, TableError
+from .fmu_src.clutch_model import load_csv
 from .results import CaseResult
 
 #: relative force decrease (of the case's largest force) treated as solver noise
@@ -178,11 +179,8 @@ def read_tables(table_dir: Path) -> TableSet:
         Missing files, wrong columns, non-finite or non-monotone data.
     """
     table_dir = Path(table_dir)
-    try:
-        fd = _read_csv(table_dir / "force_deflection.csv", ["theta_degC", "u_m", "force_N"])
-        kp = _read_csv(table_dir / "kiss_point.csv", ["theta_degC", "delta_kiss_m"])
-    except OSError as exc:
-        raise TableError(f"cannot read table set {table_dir}: {exc}") from exc
+    fd = _read_csv(table_dir / "force_deflection.csv", ["theta_degC", "u_m", "force_N"])
+    kp = _read_csv(table_dir / "kiss_point.csv", ["theta_degC", "delta_kiss_m"])
     meta_path = table_dir / "metadata.json"
     metadata = json.loads(meta_path.read_text()) if meta_path.exists() else {}
     thetas = np.unique(fd[:, 0])
@@ -202,14 +200,8 @@ def read_tables(table_dir: Path) -> TableSet:
 
 
 def _read_csv(path: Path, columns: list[str]) -> np.ndarray:
-    with open(path, newline="") as fh:
-        rows = list(csv.reader(fh))
-    if not rows or [c.strip() for c in rows[0]] != columns:
-        raise TableError(f"{path}: header must be {','.join(columns)}")
+    """The model's own table reader (the one the FMU uses), errors as TableError."""
     try:
-        data = np.array([[float(v) for v in r] for r in rows[1:] if r], dtype=float)
+        return load_csv(path, tuple(columns))
     except ValueError as exc:
-        raise TableError(f"{path}: {exc}") from exc
-    if data.ndim != 2 or data.shape[1] != len(columns) or not np.all(np.isfinite(data)):
-        raise TableError(f"{path}: needs {len(columns)} finite numbers per row")
-    return data
+        raise TableError(str(exc)) from exc

@@ -154,8 +154,8 @@ class SpringTable:
             With the file name, if a file is malformed.
         """
         folder = Path(folder)
-        fd = _load_csv(folder / "force_deflection.csv", ("theta_degC", "u_m", "force_N"))
-        kp = _load_csv(folder / "kiss_point.csv", ("theta_degC", "delta_kiss_m"))
+        fd = load_csv(folder / "force_deflection.csv", ("theta_degC", "u_m", "force_N"))
+        kp = load_csv(folder / "kiss_point.csv", ("theta_degC", "delta_kiss_m"))
         thetas = np.unique(fd[:, 0])
         if not np.array_equal(np.sort(kp[:, 0]), thetas):
             raise ValueError(f"{folder}: kiss_point.csv and force_deflection.csv temperatures differ")
@@ -200,7 +200,8 @@ class SpringTable:
         return min(c.x_min for c in self._active(theta_degC))
 
 
-def _load_csv(path: Path, columns: tuple[str, ...]) -> np.ndarray:
+def load_csv(path: Path, columns: tuple[str, ...]) -> np.ndarray:
+    """Rows of a table CSV with exactly ``columns`` as header; ValueError names the file."""
     try:
         with open(path) as fh:
             header = fh.readline().strip().split(",")
@@ -208,7 +209,7 @@ def _load_csv(path: Path, columns: tuple[str, ...]) -> np.ndarray:
     except (OSError, ValueError) as exc:
         raise ValueError(f"{path}: {exc}") from exc
     if tuple(h.strip() for h in header) != columns or data.shape[1] != len(columns):
-        raise ValueError(f"{path}: expected columns {','.join(columns)}")
+        raise ValueError(f"{path}: header must be {','.join(columns)}")
     if not np.all(np.isfinite(data)):
         raise ValueError(f"{path}: non-finite value")
     return data

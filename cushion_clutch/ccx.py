@@ -6,6 +6,7 @@ output, no ``*ERROR`` and no input-reading warning.
 """
 from __future__ import annotations
 
+import functools
 import logging
 import os
 import re
@@ -58,7 +59,12 @@ def ccx_executable() -> str:
 
 def ccx_version() -> str:
     """The CalculiX version string, e.g. ``2.20``."""
-    out = subprocess.run([ccx_executable(), "-v"], capture_output=True, text=True, timeout=30)
+    return _version_of(ccx_executable())
+
+
+@functools.lru_cache(maxsize=None)
+def _version_of(executable: str) -> str:
+    out = subprocess.run([executable, "-v"], capture_output=True, text=True, timeout=30)
     m = re.search(r"Version\s+([\w.]+)", out.stdout + out.stderr)
     return m.group(1) if m else "unknown"
 

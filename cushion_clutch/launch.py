@@ -84,7 +84,8 @@ class ClutchFmu:
                            modelIdentifier=md.coSimulation.modelIdentifier, instanceName="clutch")
         self.s.instantiate()
         self.s.setupExperiment(startTime=0.0)
-        self.s.setReal([self.vr[k] for k in start], list(start.values()))
+        if start:
+            self.s.setReal([self.vr[k] for k in start], list(start.values()))
         self.s.enterInitializationMode()
         self.s.exitInitializationMode()
         self.vin = [self.vr["x_to"], self.vr["theta_cm"]]
@@ -155,6 +156,7 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, aware: bool,
     f_roll = veh.rolling_resistance * veh.mass_kg * G * math.cos(slope)
     m_eq = veh.mass_kg + eta * dl.disc_inertia_kg_m2 * (i_tot / r) ** 2
     j_kin = dl.disc_inertia_kg_m2 + veh.mass_kg * (r / i_tot) ** 2         # disc side, at disc speed
+    j_d = m_eq * r * r / (eta * i_tot * i_tot)     # disc side as the clutch feels it (efficiency)
     j_e = e.inertia_kg_m2
     curve_w = [x * RPM for x in e.torque_curve_rpm]
     w_idle, w_stall, w_max = e.idle_speed_rpm * RPM, e.stall_speed_rpm * RPM, e.max_speed_rpm * RPM
@@ -229,10 +231,10 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, aware: bool,
         w_d = v * i_tot / r
         f_air = 0.5 * veh.air_density_kg_m3 * veh.drag_area_m2 * v * v
         f_res = f_roll * (1.0 if v > 0 else 0.0) + f_air + f_grade
+        t_load = f_res * r / (eta * i_tot)                         # resistance felt at the clutch
         braking = phase == "open" and tl >= tc.drive_time_s
         if locked:
-            t_load = f_res * r / (eta * i_tot)
-            dw = (t_e - t_load) / (j_e + m_eq * r * r / (eta * i_tot * i_tot)) * h
+            dw = (t_e - t_load) / (j_e + j_d) * h
             t_c = t_e - j_e * dw / h
             if abs(t_c) > t_cap:
                 locked = False
@@ -269,8 +271,6 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, aware: bool,
         # -- lock-up: the slip speed crosses zero and the locked torque fits the capacity
         w_d_new = v_new * i_tot / r
         if not locked and t_cap > 0 and phase != "open" and (w_e - w_d) * (w_e_new - w_d_new) <= 0.0:
-            t_load = f_res * r / (eta * i_tot)
-            j_d = m_eq * r * r / (eta * i_tot * i_tot)
             if abs((j_d * t_e + j_e * t_load) / (j_e + j_d)) <= t_cap:
                 ke_before = kinetic(w_e_new, v_new)
                 w = (j_e * w_e_new + j_kin * w_d_new) / (j_e + j_kin)

@@ -20,7 +20,7 @@ DEFAULT_SPRING = Path(__file__).parent / "springs" / "default.toml"
 
 
 def range_problem(key: str, value: Any, lo: float | None, hi: float | None,
-                   lo_open: bool = False, hi_open: bool = False) -> str | None:
+                  lo_open: bool = False, hi_open: bool = False) -> str | None:
     """Return a message if ``value`` is not a finite number in the range, else None."""
     lo_s = "-inf" if lo is None else f"{lo:g}"
     hi_s = "inf" if hi is None else f"{hi:g}"
@@ -52,6 +52,12 @@ class Checked:
             msg = range_problem(self._key(name), getattr(self, name), *bounds)
             if msg:
                 yield msg
+
+    def _integers(self, *names: str) -> Iterable[str]:
+        for name in names:
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int):
+                yield f"{self._key(name)} = {value!r}: must be an integer"
 
     def _problems(self) -> Iterable[str]:  # pragma: no cover - overridden
         return ()
@@ -260,9 +266,7 @@ class Solver(Checked):
         })
         if self.contact not in ("node_to_surface", "surface_to_surface"):
             yield f"solver.contact = {self.contact!r}: allowed 'node_to_surface' or 'surface_to_surface'"
-        for k in ("compression_increments", "max_increments", "threads"):
-            if not isinstance(getattr(self, k), int) or isinstance(getattr(self, k), bool):
-                yield f"solver.{k} = {getattr(self, k)!r}: must be an integer"
+        yield from self._integers("compression_increments", "max_increments", "threads")
 
 
 @dataclass(frozen=True)

@@ -156,8 +156,7 @@ class Run(Checked):
 
     def _problems(self) -> Iterable[str]:
         yield from self._ranges({"launches": (1, 1000), "period_s": (5.0, 3600.0), "step_s": (1e-5, 0.1)})
-        if isinstance(self.launches, bool) or not isinstance(self.launches, int):
-            yield f"run.launches = {self.launches!r}: must be an integer"
+        yield from self._integers("launches")
 
 
 @dataclass(frozen=True)

@@ -23,17 +23,10 @@ HOST_SRC = REPO / "tests" / "c_host" / "fmi2_host.c"
 
 def time_fmpy(fmu: Path, n: int, h: float = 1e-3) -> tuple[float, float]:
     """(us per set+doStep+get, us per doStep alone) through fmpy's FMU2Slave."""
-    from fmpy import extract, read_model_description
-    from fmpy.fmi2 import FMU2Slave
+    from cushion_clutch.launch import ClutchFmu
 
-    md = read_model_description(str(fmu))
-    vr = {v.name: v.valueReference for v in md.modelVariables}
-    unzip = extract(str(fmu))
-    s = FMU2Slave(guid=md.guid, unzipDirectory=unzip, modelIdentifier="CushionClutch", instanceName="bench")
-    s.instantiate()
-    s.setupExperiment(startTime=0.0)
-    s.enterInitializationMode()
-    s.exitInitializationMode()
+    clutch = ClutchFmu(fmu, {})
+    s, vr = clutch.s, clutch.vr
     vin = [vr["x_to"], vr["theta_cm"]]
     vout = [vr[k] for k in ("torque", "force", "theta_cs", "u_f", "x_kiss")]
     xs = [0.003 + 0.004 * (k % 1000) / 1000.0 for k in range(1000)]
@@ -47,9 +40,7 @@ def time_fmpy(fmu: Path, n: int, h: float = 1e-3) -> tuple[float, float]:
     for k in range(n):
         s.doStep((n + k) * h, h)
     step_only = (time.perf_counter() - t0) / n
-    s.terminate()
-    s.freeInstance()
-    shutil.rmtree(unzip, ignore_errors=True)
+    clutch.close()
     return full * 1e6, step_only * 1e6
 
 

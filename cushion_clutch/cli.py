@@ -7,24 +7,25 @@ import sys
 import time
 from pathlib import Path
 
+from .data import DEFAULT_TABLES, tables_root
 from .errors import CalculixNotFoundError, ParameterError, SweepError, TableError
-
-REPO = Path(__file__).resolve().parents[1]
-DEFAULT_TABLES = REPO / "lookup_tables" / "default"
 
 
 def _sweep(args: argparse.Namespace) -> int:
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
-    from .params import load_params
-    from .plots import plot_force_deflection, plot_kiss_shift
-    from .sweep import build_tables, run_sweep
-    from .tables import read_tables
+    from .fe.params import load_params
+    from .fe.plots import plot_force_deflection, plot_kiss_shift
+    from .fe.sweep import build_tables, run_sweep
+    from .fe.tables import read_tables
 
     params = load_params(args.spring)
     if args.mesh_size is not None:
         params = params.replace(mesh={"element_size_m": args.mesh_size})
-    out = Path(args.out) if args.out else REPO / "lookup_tables" / params.name
+    out = Path(args.out) if args.out else Path("lookup_tables") / params.name
+    if not args.force and out.resolve().is_relative_to(tables_root().resolve()):
+        raise ParameterError([f"--out {out} is a table set shipped with cushion-clutch; give another --out, "
+                              "or --force to overwrite it"])
     expected = params.solver.compression_increments + 8
     start = time.perf_counter()
     with Progress(TextColumn("{task.description}"), BarColumn(), TextColumn("{task.fields[status]}"),
@@ -62,14 +63,15 @@ def _sweep(args: argparse.Namespace) -> int:
 def _simulate(args: argparse.Namespace) -> int:
     import csv
 
-    from .engagements import (EngagementCycle, plot_engagements, plot_thermal_step,
+    from .fmu.engagements import (EngagementCycle, plot_engagements, plot_thermal_step,
                               plot_torque_characteristic, simulate)
-    from .fmu_build import build_fmu
-    from .model import load_table
+    from .fmu.build import build_fmu
+    from .fmu.model import load_table
 
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    fmu = Path(args.fmu) if args.fmu else build_fmu(Path(args.tables), out / "CushionClutch.fmu")
+    fmu = Path(args.fmu) if args.fmu else build_fmu(Path(args.tables), out / "CushionClutch.fmu",
+                                                    backend=args.backend)
     print(f"simulating {args.engagements} engagements with {fmu} (fmpy, step {args.step:g} s) ...")
     start = time.perf_counter()
     res = simulate(fmu, EngagementCycle(), n_engagements=args.engagements, step_s=args.step)
@@ -99,15 +101,16 @@ def _simulate(args: argparse.Namespace) -> int:
 def _launch(args: argparse.Namespace) -> int:
     from rich.progress import Progress
 
-    from .fmu_build import build_fmu
-    from .launch_report import metrics_table, run_both, write_outputs
-    from .model import load_table
-    from .scenario import load_scenario
+    from .fmu.build import build_fmu
+    from .launch.report import metrics_table, run_both, write_outputs
+    from .fmu.model import load_table
+    from .launch.scenario import load_scenario
 
     sc = load_scenario(args.scenario)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    fmu = Path(args.fmu) if args.fmu else build_fmu(Path(args.tables), out / "CushionClutch.fmu")
+    fmu = Path(args.fmu) if args.fmu else build_fmu(Path(args.tables), out / "CushionClutch.fmu",
+                                                    backend=args.backend)
     total = sc.run.launches * sc.run.period_s
     start = time.perf_counter()
     with Progress() as bar:
@@ -129,7 +132,7 @@ def _launch(args: argparse.Namespace) -> int:
 
 
 def _export(args: argparse.Namespace) -> int:
-    from .exports import export_mat, export_modelica
+    from .fmu.exports import export_mat, export_modelica
 
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -140,17 +143,24 @@ def _export(args: argparse.Namespace) -> int:
 
 
 def _check(args: argparse.Namespace) -> int:
-    from .params import load_params
+    from .fe.params import load_params
     p = load_params(args.spring)
     print(f"{args.spring}: spring '{p.name}' is valid ({p.n_pairs} pairs, "
           f"{len(p.sweep.temperatures_degC)} temperatures)")
     return 0
 
 
+def _build_fmu(args: argparse.Namespace) -> int:
+    from .fmu.build import build_from_args
+    print(build_from_args(args))
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
-    from .params import DEFAULT_SPRING
-    from .scenario import DEFAULT_SCENARIO
-    from .sweep import DEFAULT_CACHE
+    from .fmu.build import add_backend, add_build_arguments
+    from .fe.params import DEFAULT_SPRING
+    from .launch.scenario import DEFAULT_SCENARIO
+    from .fe.sweep import DEFAULT_CACHE
 
     parser = argparse.ArgumentParser(prog="cushion-clutch", description=__doc__)
     parser.add_argument("-v", "--verbose", action="store_true", help="log progress details")
@@ -158,7 +168,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     sw = sub.add_parser("sweep", help="run the CalculiX temperature sweep and write lookup tables")
     sw.add_argument("--spring", default=DEFAULT_SPRING, help="spring parameter TOML")
-    sw.add_argument("--out", help="table folder (default lookup_tables/<spring name>)")
+    sw.add_argument("--out", help="table folder (default ./lookup_tables/<spring name>)")
+    sw.add_argument("--force", action="store_true", help="allow overwriting a table set shipped with the package")
     sw.add_argument("--mesh-size", type=float, help="override mesh.element_size_m [m]")
     sw.add_argument("--jobs", type=int, help="parallel ccx jobs (default: cores)")
     sw.add_argument("--scheduler", help="Dask scheduler address, e.g. tcp://host:8786")
@@ -168,6 +179,7 @@ def build_parser() -> argparse.ArgumentParser:
     sm = sub.add_parser("simulate", help="repeated engagements through the FMU with fmpy, with plots")
     sm.add_argument("--fmu", help="FMU to simulate (default: build one from --tables into --out)")
     sm.add_argument("--tables", default=DEFAULT_TABLES, help="table folder")
+    add_backend(sm)
     sm.add_argument("--out", default="out", help="output folder")
     sm.add_argument("--engagements", type=int, default=12, help="number of engagements (60 s apart)")
     sm.add_argument("--step", type=float, default=0.1, help="communication step [s]")
@@ -177,6 +189,7 @@ def build_parser() -> argparse.ArgumentParser:
     la.add_argument("--scenario", default=DEFAULT_SCENARIO, help="scenario TOML")
     la.add_argument("--fmu", help="clutch FMU (default: build one from --tables into --out)")
     la.add_argument("--tables", default=DEFAULT_TABLES, help="table folder")
+    add_backend(la)
     la.add_argument("--out", default="out", help="output folder")
     la.set_defaults(func=_launch)
 
@@ -184,6 +197,10 @@ def build_parser() -> argparse.ArgumentParser:
     ex.add_argument("--tables", default=DEFAULT_TABLES, help="table folder")
     ex.add_argument("--out", default="out", help="output folder")
     ex.set_defaults(func=_export)
+
+    bf = sub.add_parser("build-fmu", help="build the clutch FMU from a table set (native C by default)")
+    add_build_arguments(bf)
+    bf.set_defaults(func=_build_fmu)
 
     ck = sub.add_parser("check-spring", help="validate a spring parameter TOML")
     ck.add_argument("spring")

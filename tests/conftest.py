@@ -5,7 +5,7 @@ import shutil
 
 import pytest
 
-from cushion_clutch.params import load_params
+from cushion_clutch.fe.params import load_params
 
 COARSE_M = 2e-3
 

@@ -2,12 +2,12 @@
 import numpy as np
 import pytest
 
-from cushion_clutch.ccx import run_ccx
-from cushion_clutch.deck import strip_deck
+from cushion_clutch.fe.ccx import run_ccx
+from cushion_clutch.fe.deck import strip_deck
 from cushion_clutch.errors import CalculixError, CalculixNotFoundError, ConvergenceError
-from cushion_clutch.geometry import strip_mesh
-from cushion_clutch.params import Material
-from cushion_clutch.results import read_dat
+from cushion_clutch.fe.geometry import strip_mesh
+from cushion_clutch.fe.params import Material
+from cushion_clutch.fe.results import read_dat
 
 pytestmark = pytest.mark.ccx
 

@@ -1,7 +1,7 @@
 import pytest
 
 from cushion_clutch.cli import main
-from cushion_clutch.params import DEFAULT_SPRING
+from cushion_clutch.fe.params import DEFAULT_SPRING
 
 
 def test_check_spring_accepts_the_default(capsys):

@@ -7,9 +7,9 @@ from pathlib import Path
 
 import pytest
 
-from cushion_clutch.deck import paddle_deck, strip_deck
-from cushion_clutch.geometry import half_pair_assembly, pair_assembly, strip_mesh
-from cushion_clutch.params import Material, SpringParams
+from cushion_clutch.fe.deck import paddle_deck, strip_deck
+from cushion_clutch.fe.geometry import half_pair_assembly, pair_assembly, strip_mesh
+from cushion_clutch.fe.params import Material, SpringParams
 
 GOLDEN = Path(__file__).parent / "golden"
 

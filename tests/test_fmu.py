@@ -12,10 +12,10 @@ from fmpy.validation import validate_fmu
 from scipy.interpolate import PchipInterpolator
 from scipy.io import loadmat
 
-from cushion_clutch.exports import export_mat, export_modelica, read_modelica
-from cushion_clutch.fmu_build import build_fmu
-from cushion_clutch.model import DEFAULT_TABLES
-from cushion_clutch.tables import read_tables
+from cushion_clutch.fmu.exports import export_mat, export_modelica, read_modelica
+from cushion_clutch.fmu.build import build_fmu
+from cushion_clutch.fmu.model import DEFAULT_TABLES
+from cushion_clutch.fe.tables import read_tables
 
 pytestmark = pytest.mark.fmu
 
@@ -24,7 +24,7 @@ OUT = ["torque", "force", "theta_cs", "u_f", "x_kiss"]
 
 @pytest.fixture(scope="module")
 def fmu(tmp_path_factory):
-    path = build_fmu(DEFAULT_TABLES, tmp_path_factory.mktemp("fmu") / "CushionClutch.fmu")
+    path = build_fmu(DEFAULT_TABLES, tmp_path_factory.mktemp("fmu") / "CushionClutch.fmu", backend="python")
     md = read_model_description(str(path))
     unzip = extract(str(path))
     yield path, md, unzip

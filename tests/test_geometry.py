@@ -1,8 +1,8 @@
 import numpy as np
 import pytest
 
-from cushion_clutch.geometry import half_pair_assembly, pair_assembly, paddle_mesh, strip_mesh, wave_height
-from cushion_clutch.params import Geometry
+from cushion_clutch.fe.geometry import half_pair_assembly, pair_assembly, paddle_mesh, strip_mesh, wave_height
+from cushion_clutch.fe.params import Geometry
 
 
 def test_wave_is_one_minus_cos_between_its_angles():

@@ -5,10 +5,10 @@ import numpy as np
 import pytest
 
 from cushion_clutch.errors import ParameterError
-from cushion_clutch.fmu_build import build_fmu
-from cushion_clutch.launch import simulate_launches
-from cushion_clutch.model import DEFAULT_TABLES, load_table
-from cushion_clutch.scenario import DEFAULT_SCENARIO, load_scenario
+from cushion_clutch.fmu.build import build_fmu
+from cushion_clutch.launch.simulate import simulate_launches
+from cushion_clutch.fmu.model import DEFAULT_TABLES, load_table
+from cushion_clutch.launch.scenario import DEFAULT_SCENARIO, load_scenario
 
 pytestmark = pytest.mark.fmu
 

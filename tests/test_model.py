@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 from scipy.interpolate import PchipInterpolator
 
-from cushion_clutch.model import (KELVIN, ClutchParameters, load_table, outputs, thermal_step,
+from cushion_clutch.fmu.model import (KELVIN, ClutchParameters, load_table, outputs, thermal_step,
                                   thermal_system, x_to_for_torque)
-from cushion_clutch.tables import read_tables
+from cushion_clutch.fe.tables import read_tables
 
 P = ClutchParameters()
 

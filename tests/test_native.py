@@ -11,12 +11,14 @@ from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import FMU2Slave
 from fmpy.validation import validate_fmu
 
-from cushion_clutch.fmu_build import build_fmu, fmi2_header_dir
-from cushion_clutch.model import DEFAULT_TABLES, ClutchParameters, load_table, outputs, thermal_step
+from cushion_clutch.data import fmu_sources
+from cushion_clutch.fmu.build import build_fmu
+from cushion_clutch.fmu.native import fmi2_header_dir
+from cushion_clutch.fmu.model import DEFAULT_TABLES, ClutchParameters, load_table, outputs, thermal_step
 
 pytestmark = pytest.mark.fmu
 
-HOST_SRC = __import__("pathlib").Path(__file__).parent / "c_host" / "fmi2_host.c"
+HOST_SRC = fmu_sources() / "fmi2_host.c"
 OUT = ["torque", "force", "theta_cs", "u_f", "x_kiss"]
 
 

@@ -3,7 +3,7 @@ import math
 import pytest
 
 from cushion_clutch.errors import ParameterError
-from cushion_clutch.params import DEFAULT_SPRING, SpringParams, load_params, params_from_dict
+from cushion_clutch.fe.params import DEFAULT_SPRING, SpringParams, load_params, params_from_dict
 
 
 def test_default_file_loads_and_matches_paper():

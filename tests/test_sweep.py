@@ -3,8 +3,8 @@ import numpy as np
 import pytest
 
 from cushion_clutch.errors import ConvergenceError, SweepError
-from cushion_clutch.sweep import build_tables, run_sweep, solve_case
-from cushion_clutch.tables import read_tables
+from cushion_clutch.fe.sweep import build_tables, run_sweep, solve_case
+from cushion_clutch.fe.tables import read_tables
 
 pytestmark = pytest.mark.ccx
 

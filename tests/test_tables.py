@@ -3,8 +3,8 @@ import numpy as np
 import pytest
 
 from cushion_clutch.errors import ResultError, TableError
-from cushion_clutch.results import CaseResult
-from cushion_clutch.tables import curve_from_case, read_tables, write_tables
+from cushion_clutch.fe.results import CaseResult
+from cushion_clutch.fe.tables import curve_from_case, read_tables, write_tables
 
 
 def case(theta, travel, force):

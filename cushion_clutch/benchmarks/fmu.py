@@ -17,13 +17,11 @@ import time
 import zipfile
 from pathlib import Path
 
-REPO = Path(__file__).resolve().parents[2]
-HOST_SRC = REPO / "tests" / "c_host" / "fmi2_host.c"
 
 
 def time_fmpy(fmu: Path, n: int, h: float = 1e-3) -> tuple[float, float]:
     """(us per set+doStep+get, us per doStep alone) through fmpy's FMU2Slave."""
-    from cushion_clutch.launch import ClutchFmu
+    from cushion_clutch.launch.simulate import ClutchFmu
 
     clutch = ClutchFmu(fmu, {})
     s, vr = clutch.s, clutch.vr
@@ -45,9 +43,10 @@ def time_fmpy(fmu: Path, n: int, h: float = 1e-3) -> tuple[float, float]:
 
 
 def compile_host(dest: Path) -> Path:
-    from cushion_clutch.fmu_build import fmi2_header_dir
+    from cushion_clutch.data import fmu_sources
+    from cushion_clutch.fmu.native import fmi2_header_dir
     subprocess.run([shutil.which("gcc") or "cc", "-std=c99", "-D_POSIX_C_SOURCE=199309L", "-O2",
-                    f"-I{fmi2_header_dir()}", str(HOST_SRC), "-o", str(dest), "-ldl"], check=True)
+                    f"-I{fmi2_header_dir()}", str(fmu_sources() / "fmi2_host.c"), "-o", str(dest), "-ldl"], check=True)
     return dest
 
 
@@ -73,8 +72,8 @@ def time_c_host(host: Path, fmu: Path, n: int, python: bool, workdir: Path) -> t
 
 
 def main(argv=None) -> None:
-    from cushion_clutch.fmu_build import build_fmu
-    from cushion_clutch.model import DEFAULT_TABLES, ClutchParameters, load_table, outputs, thermal_step
+    from cushion_clutch.fmu.build import build_fmu
+    from cushion_clutch.fmu.model import DEFAULT_TABLES, ClutchParameters, load_table, outputs, thermal_step
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--steps", type=int, default=200_000)

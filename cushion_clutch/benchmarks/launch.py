@@ -10,10 +10,10 @@ from pathlib import Path
 
 
 def main(argv=None) -> None:
-    from cushion_clutch.fmu_build import build_fmu
-    from cushion_clutch.launch import simulate_launches
-    from cushion_clutch.model import DEFAULT_TABLES, load_table
-    from cushion_clutch.scenario import DEFAULT_SCENARIO, load_scenario
+    from cushion_clutch.fmu.build import build_fmu
+    from cushion_clutch.launch.simulate import simulate_launches
+    from cushion_clutch.fmu.model import DEFAULT_TABLES, load_table
+    from cushion_clutch.launch.scenario import DEFAULT_SCENARIO, load_scenario
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--scenario", default=DEFAULT_SCENARIO)

@@ -31,9 +31,9 @@ def compare(coarse, fine) -> tuple[float, float]:
 
 
 def main(argv=None) -> None:
-    from cushion_clutch.params import load_params
-    from cushion_clutch.sweep import build_tables, run_sweep
-    from cushion_clutch.tables import read_tables
+    from cushion_clutch.fe.params import load_params
+    from cushion_clutch.fe.sweep import build_tables, run_sweep
+    from cushion_clutch.fe.tables import read_tables
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--sizes", type=float, nargs="+", default=[2e-3, 1e-3, 0.5e-3])

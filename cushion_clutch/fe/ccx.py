@@ -17,7 +17,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
-from .errors import CalculixError, CalculixNotFoundError, ConvergenceError
+from ..errors import CalculixError, CalculixNotFoundError, ConvergenceError
 
 log = logging.getLogger(__name__)
 

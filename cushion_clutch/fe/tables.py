@@ -26,8 +26,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import ResultError, TableError
-from .fmu_src.clutch_model import load_csv
+from ..errors import ResultError, TableError
+from ..fmu_src.clutch_model import load_csv
 from .results import CaseResult
 
 #: relative force decrease (of the case's largest force) treated as solver noise

@@ -24,10 +24,10 @@ from typing import Callable
 
 import numpy as np
 
-from . import __version__
+from .. import __version__
 from .ccx import RunStats, ccx_version, run_ccx
 from .deck import paddle_deck
-from .errors import SweepError
+from ..errors import SweepError
 from .geometry import half_pair_assembly, pair_assembly
 from .params import SpringParams
 from .results import CaseResult, parse_case

@@ -8,9 +8,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Iterable
 
-from .params import Checked, range_problem, build_checked, load_toml
+from ..config import Checked, build_checked, load_toml, range_problem
+from ..data import DEFAULT_SCENARIO
 
-DEFAULT_SCENARIO = Path(__file__).parent / "scenarios" / "default.toml"
 
 
 @dataclass(frozen=True)

@@ -27,7 +27,7 @@ from typing import Callable
 
 import numpy as np
 
-from .fmu_src.clutch_model import KELVIN, ClutchParameters, SpringTable, thermal_step, x_to_for_torque
+from ..fmu_src.clutch_model import KELVIN, ClutchParameters, SpringTable, thermal_step, x_to_for_torque
 from .scenario import Scenario
 
 G = 9.81

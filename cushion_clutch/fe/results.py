@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import ResultError
+from ..errors import ResultError
 
 _HEAD = re.compile(r"^\s*(displacements|forces)\s+\(\w+,\w+,\w+\)\s+for set\s+(\S+)\s+and time\s+(\S+)")
 MM = 1e-3  # mm -> m

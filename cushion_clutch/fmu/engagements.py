@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .fmu_src.clutch_model import KELVIN, ClutchParameters, SpringTable, outputs
+from ..fmu_src.clutch_model import KELVIN, ClutchParameters, SpringTable, outputs
 
 
 @dataclass(frozen=True)
@@ -109,7 +109,7 @@ def plot_engagements(res: np.ndarray, path: Path) -> Path:
     """theta_cm and theta_cs over repeated engagements (paper Fig. 10), and the torque."""
     import matplotlib.pyplot as plt
 
-    from .plots import finish_figure
+    from ..plotting import finish_figure
 
     fig, (a1, a2) = plt.subplots(2, 1, figsize=(9, 6), sharex=True)
     a1.plot(res["time"], res["theta_cm"] - KELVIN, label="facing θ_cm")
@@ -125,7 +125,7 @@ def plot_torque_characteristic(table: SpringTable, path: Path, p: ClutchParamete
     """T(x_to) at each table temperature (paper Fig. 12), from the shared model."""
     import matplotlib.pyplot as plt
 
-    from .plots import finish_figure
+    from ..plotting import finish_figure
 
     x = np.linspace(p.x_kiss_ref - 1.0e-3, p.x_kiss_ref + p.lever_ratio * 1.45e-3, 600)
     fig, ax = plt.subplots(figsize=(7, 4.5))
@@ -142,7 +142,7 @@ def plot_thermal_step(path: Path, p: ClutchParameters = ClutchParameters()) -> P
     import control
     import matplotlib.pyplot as plt
 
-    from .plots import finish_figure
+    from ..plotting import finish_figure
 
     from .model import thermal_system
 

@@ -7,8 +7,8 @@ from typing import Callable
 
 import numpy as np
 
-from .fmu_src.clutch_model import KELVIN, SpringTable
-from .launch import COLUMNS, LaunchResult, simulate_launches
+from ..fmu_src.clutch_model import KELVIN, SpringTable
+from .simulate import COLUMNS, LaunchResult, simulate_launches
 from .scenario import Scenario
 
 METRIC_COLUMNS = ("tcu", "launch", "theta_cs_start_degC", "torque_error_rms_Nm", "torque_error_max_Nm",
@@ -75,7 +75,7 @@ def plot_launches(results: dict[str, LaunchResult], out: Path) -> list[Path]:
     """Speeds, bearing, torque demanded vs delivered (last launch), temperatures over all launches."""
     import matplotlib.pyplot as plt
 
-    from .plots import finish_figure
+    from ..plotting import finish_figure
 
     nv, aw = results["naive"].series, results["aware"].series
     last = nv["launch"].max()

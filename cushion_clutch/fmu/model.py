@@ -1,8 +1,8 @@
-"""Python API of the clutch model, on the same module the FMU runs (``fmu_src/clutch_model.py``).
+"""Python API of the clutch model, on the same module the FMU runs (``cushion_clutch.fmu_src.clutch_model``).
 
 Examples
 --------
->>> from cushion_clutch.model import load_table, ClutchParameters, outputs, x_to_for_torque
+>>> from cushion_clutch.fmu.model import load_table, ClutchParameters, outputs, x_to_for_torque
 >>> table, p = load_table(), ClutchParameters()
 >>> out = outputs(x_to=0.0055, theta_cs=468.15, table=table, p=p)      # 195 degC
 >>> x = x_to_for_torque(out.torque, 468.15, table, p)                   # the TCU's inverse
@@ -11,10 +11,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .fmu_src.clutch_model import (KELVIN, ClutchParameters, Outputs, SpringTable, outputs,
+from ..data import DEFAULT_TABLES
+from ..fmu_src.clutch_model import (KELVIN, ClutchParameters, Outputs, SpringTable, outputs,
                                    thermal_step, x_to_for_torque)
-
-DEFAULT_TABLES = Path(__file__).resolve().parents[1] / "lookup_tables" / "default"
 
 __all__ = ["KELVIN", "ClutchParameters", "Outputs", "SpringTable", "outputs", "thermal_step",
            "x_to_for_torque", "load_table", "torque", "thermal_system", "DEFAULT_TABLES"]

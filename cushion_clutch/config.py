@@ -1,0 +1,111 @@
+"""Checked parameter files: frozen dataclasses loaded from TOML, problems collected.
+
+Shared by the spring parameters (:mod:`cushion_clutch.fe.params`) and the
+launch scenarios (:mod:`cushion_clutch.launch.scenario`). Every dataclass
+checks itself in ``__post_init__``; all problems of all sections are
+collected and raised at once as :class:`~cushion_clutch.errors.ParameterError`,
+each naming its key and the allowed range. Unknown keys are rejected.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+import tomllib
+from dataclasses import fields
+from pathlib import Path
+from typing import Any, Iterable
+
+from .errors import ParameterError
+
+
+def range_problem(key: str, value: Any, lo: float | None, hi: float | None,
+                  lo_open: bool = False, hi_open: bool = False) -> str | None:
+    """Return a message if ``value`` is not a finite number in the range, else None."""
+    lo_s = "-inf" if lo is None else f"{lo:g}"
+    hi_s = "inf" if hi is None else f"{hi:g}"
+    allowed = f"{'(' if lo_open or lo is None else '['}{lo_s}, {hi_s}{')' if hi_open or hi is None else ']'}"
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        return f"{key} = {value!r}: must be a finite number in {allowed}"
+    bad_lo = lo is not None and (value <= lo if lo_open else value < lo)
+    bad_hi = hi is not None and (value >= hi if hi_open else value > hi)
+    if bad_lo or bad_hi:
+        return f"{key} = {value!r}: out of range, allowed {allowed}"
+    return None
+
+
+class Checked:
+    """Mixin: run ``_problems`` after init and raise if there are any."""
+
+    _section = ""
+
+    def __post_init__(self) -> None:
+        problems = list(self._problems())
+        if problems:
+            raise ParameterError(problems)
+
+    def _key(self, name: str) -> str:
+        return f"{self._section}.{name}" if self._section else name
+
+    def _ranges(self, spec: dict[str, tuple]) -> Iterable[str]:
+        for name, bounds in spec.items():
+            msg = range_problem(self._key(name), getattr(self, name), *bounds)
+            if msg:
+                yield msg
+
+    def _integers(self, *names: str) -> Iterable[str]:
+        for name in names:
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int):
+                yield f"{self._key(name)} = {value!r}: must be an integer"
+
+    def _problems(self) -> Iterable[str]:  # pragma: no cover - overridden
+        return ()
+
+
+def build_checked(top_cls: type, data: dict[str, Any], source: str | None = None) -> Any:
+    """Build a checked dataclass of sections (``top_cls``) from nested dicts.
+
+    Sections are the fields whose default is a dataclass; other fields are
+    plain top-level keys. Unknown keys are rejected and all problems of all
+    sections are collected before one :class:`ParameterError` is raised.
+    """
+    sections = {f.name: type(f.default_factory()) for f in fields(top_cls)
+                if f.default_factory is not dataclasses.MISSING}
+    plain = {f.name for f in fields(top_cls)} - set(sections)
+    problems: list[str] = []
+    top: dict[str, Any] = {}
+    for key, value in data.items():
+        if key in sections:
+            cls = sections[key]
+            if not isinstance(value, dict):
+                problems.append(f"[{key}]: must be a table")
+                continue
+            allowed = {f.name for f in fields(cls)}
+            for k in sorted(set(value) - allowed):
+                problems.append(f"{key}.{k}: unknown key (allowed: {', '.join(sorted(allowed))})")
+            kwargs = {k: (tuple(v) if isinstance(v, list) else v)
+                      for k, v in value.items() if k in allowed}
+            try:
+                top[key] = cls(**kwargs)
+            except ParameterError as exc:
+                problems.extend(exc.problems)
+        elif key in plain:
+            top[key] = value
+        else:
+            problems.append(f"{key}: unknown key (allowed: {', '.join(sorted(plain | set(sections)))})")
+    try:
+        if not problems:
+            return top_cls(**top)
+        top_cls(**{k: v for k, v in top.items() if k in plain})   # complete the report
+    except ParameterError as exc:
+        problems.extend(exc.problems)
+    raise ParameterError(problems, source)
+
+
+def load_toml(path: str | Path) -> dict[str, Any]:
+    """Read a TOML file; a syntax error becomes a :class:`ParameterError`."""
+    path = Path(path)
+    try:
+        return tomllib.loads(path.read_text(encoding="utf-8"))
+    except tomllib.TOMLDecodeError as exc:
+        raise ParameterError([f"TOML syntax error: {exc}"], str(path)) from exc

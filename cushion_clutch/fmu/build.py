@@ -1,0 +1,147 @@
+"""Build the CushionClutch FMU from a table set: the front door for both backends.
+
+:func:`build_fmu` checks the tables and hands over to the native C backend
+(:mod:`cushion_clutch.fmu.native`, the default) or to pythonfmu. For the
+latter, pythonfmu writes the binaries and a bare modelDescription.xml; this module
+stages the slave, the shared model module and the tables, then completes the
+description: SI units on every variable (temperatures in K with degC as
+display unit) and the ``InitialUnknowns`` that FMI 2.0 requires for outputs.
+"""
+from __future__ import annotations
+
+import logging
+import shutil
+import tempfile
+import zipfile
+from pathlib import Path
+from xml.etree import ElementTree as ET
+
+from ..data import fmu_sources
+from ..errors import TableError
+from ..fmu_src.clutch_model import VARIABLES
+from ..fe.tables import read_tables
+
+log = logging.getLogger(__name__)
+
+FMU_SRC = fmu_sources()
+SLAVE = "CushionClutch"
+TABLE_FILES = ("force_deflection.csv", "kiss_point.csv", "metadata.json")
+
+#: unit of each variable (from the shared model module); temperatures get degC as display unit
+UNITS = {name: unit for name, _, unit, _ in VARIABLES}
+#: SI base-unit exponents of each unit
+BASE_UNITS = {
+    "m": {"m": "1"}, "K": {"K": "1"}, "N": {"kg": "1", "m": "1", "s": "-2"},
+    "N.m": {"kg": "1", "m": "2", "s": "-2"}, "W/K": {"kg": "1", "m": "2", "s": "-3", "K": "-1"},
+    "J/K": {"kg": "1", "m": "2", "s": "-2", "K": "-1"}, "1": {},
+}
+
+FMU_OPTIONS = dict(needsExecutionTool=False, canHandleVariableCommunicationStepSize=True,
+                   canInterpolateInputs=False, canBeInstantiatedOnlyOncePerProcess=False,
+                   canGetAndSetFMUstate=True, canSerializeFMUstate=True)
+
+
+def complete_model_description(xml_text: str) -> str:
+    """Add unit definitions, variable units and InitialUnknowns to pythonfmu's XML."""
+    root = ET.fromstring(xml_text)
+    units = ET.Element("UnitDefinitions")
+    for name, base in BASE_UNITS.items():
+        unit = ET.SubElement(units, "Unit", name=name)
+        ET.SubElement(unit, "BaseUnit", base)
+        if name == "K":
+            ET.SubElement(unit, "DisplayUnit", name="degC", offset="-273.15")
+    cosim = root.find("CoSimulation")
+    root.insert(list(root).index(cosim) + 1, units)
+    outputs = []
+    for index, var in enumerate(root.find("ModelVariables"), start=1):
+        real = var.find("Real")
+        name = var.get("name")
+        if real is None or name not in UNITS:
+            raise ValueError(f"variable {name!r} has no unit in fmu_build.UNITS")
+        real.set("unit", UNITS[name])
+        if UNITS[name] == "K":
+            real.set("displayUnit", "degC")
+        if var.get("causality") == "output":
+            outputs.append(index)
+    structure = root.find("ModelStructure")
+    for old in structure.findall("InitialUnknowns"):
+        structure.remove(old)
+    if outputs:
+        init = ET.SubElement(structure, "InitialUnknowns")
+        for index in outputs:
+            ET.SubElement(init, "Unknown", index=str(index))
+    ET.indent(root)
+    return '<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
+
+
+def build_fmu(tables: Path, output: Path, backend: str = "native") -> Path:
+    """Build ``output`` (.fmu) carrying the table set in ``tables``.
+
+    ``backend`` is ``"native"`` (C; loads in any FMI host) or ``"python"``
+    (pythonfmu; needs Python and numpy where it runs).
+
+    Raises
+    ------
+    TableError
+        If the table set is missing or malformed (checked before building).
+    """
+    from pythonfmu.builder import FmuBuilder
+
+    tables, output = Path(tables), Path(output)
+    read_tables(tables)                                 # fail early, with the file's name
+    for name in TABLE_FILES[:2]:
+        if not (tables / name).exists():
+            raise TableError(f"{tables / name} is missing")
+    output.parent.mkdir(parents=True, exist_ok=True)
+    if backend == "native":
+        from .native import build_native_fmu
+        return build_native_fmu(tables, output)
+    if backend != "python":
+        raise ValueError(f"backend = {backend!r}: allowed 'python' or 'native'")
+    with tempfile.TemporaryDirectory(prefix="cushion_fmu_") as tmp:
+        stage = Path(tmp)
+        shutil.copy(FMU_SRC / f"{SLAVE}.py", stage / f"{SLAVE}.py")
+        shutil.copy(FMU_SRC / "clutch_model.py", stage / "clutch_model.py")
+        (stage / "tables").mkdir()
+        for name in TABLE_FILES:
+            if (tables / name).exists():
+                shutil.copy(tables / name, stage / "tables" / name)
+        built = FmuBuilder.build_FMU(stage / f"{SLAVE}.py", dest=stage / "out",
+                                     project_files=[stage / "clutch_model.py", stage / "tables"],
+                                     **FMU_OPTIONS)
+        _rewrite_description(Path(built), output)
+    log.info("built %s from tables %s", output, tables)
+    return output
+
+
+def _rewrite_description(src: Path, dst: Path) -> None:
+    tmp = dst.with_suffix(".fmu.tmp")
+    with zipfile.ZipFile(src) as zin, zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as zout:
+        for item in zin.infolist():
+            data = zin.read(item.filename)
+            if item.filename == "modelDescription.xml":
+                data = complete_model_description(data.decode("utf-8")).encode("utf-8")
+            zout.writestr(item, data)
+    tmp.replace(dst)
+
+
+def add_backend(parser) -> None:
+    """The ``--backend`` option shared by every command that builds an FMU."""
+    parser.add_argument("--backend", choices=("native", "python"), default="native",
+                        help="native: C, loads in any FMI host (default); "
+                             "python: pythonfmu, needs Python + numpy where it runs")
+
+
+def add_build_arguments(parser) -> None:
+    """Options of ``cushion-clutch build-fmu`` and ``build_fmu.py`` (the same)."""
+    from ..data import DEFAULT_TABLES
+    parser.add_argument("--tables", type=Path, default=DEFAULT_TABLES,
+                        help="table folder (force_deflection.csv, kiss_point.csv, metadata.json)")
+    parser.add_argument("-o", "--output", type=Path, default=Path("CushionClutch.fmu"), help="FMU file")
+    add_backend(parser)
+
+
+def build_from_args(args) -> str:
+    """Build the FMU that parsed ``build-fmu`` options describe; return a one-line report."""
+    out = build_fmu(args.tables, args.output, backend=args.backend)
+    return f"built {out} ({args.backend}) from {args.tables}"

@@ -1,0 +1,1 @@
+"""FE pipeline: spring parameters -> paddle geometry -> CalculiX deck -> ccx run -> results -> tables -> sweep."""

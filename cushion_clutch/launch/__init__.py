@@ -1,0 +1,1 @@
+"""Launch simulations: scenario -> driveline and TCU around the clutch FMU -> metrics and report."""

@@ -9,7 +9,8 @@
  *   F       = PCHIP in u per table temperature, linear in theta, clamped;
  *   torque  = n_surfaces * mu * R_eq * F.
  *
- * Tables are read from <resources>/tables/{force_deflection,kiss_point}.csv at
+ * Tables are read from <resources>/tables/{force_deflection,kiss_point}.csv (and the optional
+ * friction.csv: mu(theta_cm, |omega_slip|), bilinear, clamped; else the parameter mu) at
  * instantiation, so one binary serves every table set. Value references follow
  * clutch_model.VARIABLES. No global state: any number of instances.
  */
@@ -24,30 +25,32 @@
 #define KELVIN 273.15
 #define X_TO_LIMIT 1.0
 #define THETA_CM_LIMIT 2000.0
-#define NVARS 17
+#define NVARS 18
+#define OMEGA_SLIP_LIMIT 1e4
+#define MU_LIMIT 2.0
 #define STATE_MAGIC 0x43434631u /* "CCF1" */
 
 enum {
     VR_X_TO, VR_THETA_CM, VR_TORQUE, VR_FORCE, VR_THETA_CS, VR_U_F, VR_X_KISS,
     VR_N_SURFACES, VR_MU, VR_R_EQ, VR_U, VR_H, VR_C, VR_THETA_A, VR_THETA_CS_START,
-    VR_X_KISS_REF, VR_LEVER_RATIO
+    VR_X_KISS_REF, VR_LEVER_RATIO, VR_OMEGA_SLIP
 };
 
 static const char *VAR_NAMES[NVARS] = {
     "x_to", "theta_cm", "torque", "force", "theta_cs", "u_f", "x_kiss", "n_surfaces", "mu",
-    "R_eq", "U", "H", "C", "theta_a", "theta_cs_start", "x_kiss_ref", "lever_ratio"};
+    "R_eq", "U", "H", "C", "theta_a", "theta_cs_start", "x_kiss_ref", "lever_ratio", "omega_slip"};
 
 /* defaults: inputs, outputs (start), parameters (clutch_model.ClutchParameters) */
 static const double DEFAULTS[NVARS] = {
     0.0, 293.15, 0.0, 0.0, 293.15, 0.0, 0.004, 2.0, 0.28, 0.089, 0.1, 0.04, 1.0, 293.15, 293.15,
-    0.004, 3.0};
+    0.004, 3.0, 0.0};
 
 /* allowed parameter ranges: low, high, low open, high open (clutch_model.RANGES) */
 static const double RANGES[NVARS][4] = {
     {0}, {0}, {0}, {0}, {0}, {0}, {0},
     {1.0, 16.0, 0, 0}, {0.0, 2.0, 0, 0}, {0.0, 1.0, 1, 0}, {0.0, 1e4, 0, 0}, {0.0, 1e4, 0, 0},
     {0.0, 1e6, 1, 0}, {0.0, 2000.0, 1, 0}, {0.0, 2000.0, 1, 0}, {-1.0, 1.0, 0, 0},
-    {0.0, 100.0, 1, 0}};
+    {0.0, 100.0, 1, 0}, {0}};
 
 typedef struct {
     int n;
@@ -59,6 +62,9 @@ typedef struct {
     double *theta; /* degC */
     double *delta; /* m */
     Curve *curves;
+    /* optional friction table mu(theta_cm degC, |omega_slip| rad/s), row-major [ntf][nw] */
+    int ntf, nw;
+    double *f_theta, *f_omega, *f_mu;
 } Table;
 
 typedef enum { ST_INSTANTIATED, ST_INIT, ST_STEP, ST_TERMINATED, ST_ERROR } Phase;
@@ -171,6 +177,48 @@ static double table_delta(const Table *tb, double theta) {
     return w == 0.0 ? tb->delta[i] : (1.0 - w) * tb->delta[i] + w * tb->delta[i + 1];
 }
 
+/* grid index and weight of v in g[0..n-1] (clamped) */
+static void grid_bracket(const double *g, int n, double v, int *i, double *w) {
+    int lo = 0, hi = n - 1;
+    if (n == 1 || v <= g[0]) { *i = 0; *w = 0.0; return; }
+    if (v >= g[n - 1]) { *i = n - 2; *w = 1.0; return; }
+    while (hi - lo > 1) {
+        int mid = (lo + hi) / 2;
+        if (g[mid] <= v) lo = mid; else hi = mid;
+    }
+    *i = lo;
+    *w = (v - g[lo]) / (g[lo + 1] - g[lo]);
+}
+
+/* mu(theta_cm degC, |omega|): bilinear on the friction grid, clamped (as friction.FrictionTable) */
+static double table_mu(const Table *tb, double theta, double omega) {
+    int i, j, i1, j1;
+    double wi, wj, lo, hi;
+    const double *m = tb->f_mu;
+    grid_bracket(tb->f_theta, tb->ntf, theta, &i, &wi);
+    grid_bracket(tb->f_omega, tb->nw, fabs(omega), &j, &wj);
+    i1 = i + 1 < tb->ntf ? i + 1 : tb->ntf - 1;
+    j1 = j + 1 < tb->nw ? j + 1 : tb->nw - 1;
+    lo = (1.0 - wj) * m[i * tb->nw + j] + wj * m[i * tb->nw + j1];
+    hi = (1.0 - wj) * m[i1 * tb->nw + j] + wj * m[i1 * tb->nw + j1];
+    return (1.0 - wi) * lo + wi * hi;
+}
+
+static int cmp_double(const void *a, const void *b) {
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* sorted unique values of column col of rows x ncol data; returns count */
+static int unique_sorted(const double *data, int rows, int ncol, int col, double *out) {
+    int k, n = 0;
+    for (k = 0; k < rows; ++k) out[k] = data[k * ncol + col];
+    qsort(out, rows, sizeof(double), cmp_double);
+    for (k = 0; k < rows; ++k)
+        if (n == 0 || out[k] != out[n - 1]) out[n++] = out[k];
+    return n;
+}
+
 static void table_free(Table *tb) {
     int k;
     if (tb->curves) {
@@ -179,6 +227,7 @@ static void table_free(Table *tb) {
         }
     }
     free(tb->curves); free(tb->theta); free(tb->delta);
+    free(tb->f_theta); free(tb->f_omega); free(tb->f_mu);
     memset(tb, 0, sizeof *tb);
 }
 
@@ -281,6 +330,44 @@ static int table_load(Table *tb, const char *dir, char *err, size_t errlen) {
         goto fail;
     }
     free(fd); free(kp);
+    fd = kp = NULL;
+    snprintf(path, sizeof path, "%s/tables/friction.csv", dir);
+    {
+        FILE *probe = fopen(path, "r");
+        if (probe) {
+            double *fr = NULL;
+            int nfr, r;
+            fclose(probe);
+            nfr = read_csv(path, "theta_degC,omega_slip_rad_s,mu", 3, &fr, err, errlen);
+            if (nfr < 0) goto fail;
+            tb->f_theta = (double *)malloc(sizeof(double) * (nfr + 1));
+            tb->f_omega = (double *)malloc(sizeof(double) * (nfr + 1));
+            if (!tb->f_theta || !tb->f_omega) { free(fr); snprintf(err, errlen, "out of memory"); goto fail; }
+            tb->ntf = nfr ? unique_sorted(fr, nfr, 3, 0, tb->f_theta) : 0;
+            tb->nw = nfr ? unique_sorted(fr, nfr, 3, 1, tb->f_omega) : 0;
+            if (nfr == 0 || tb->ntf * tb->nw != nfr || tb->f_omega[0] < 0.0) {
+                snprintf(err, errlen, "%s: rows must form a full grid of temperatures x slip speeds >= 0, "
+                         "each once", path);
+                free(fr); goto fail;
+            }
+            tb->f_mu = (double *)malloc(sizeof(double) * nfr);
+            if (!tb->f_mu) { free(fr); snprintf(err, errlen, "out of memory"); goto fail; }
+            for (r = 0; r < nfr; ++r) tb->f_mu[r] = -1.0;
+            for (r = 0; r < nfr; ++r) {
+                double *pt = (double *)bsearch(&fr[3 * r], tb->f_theta, tb->ntf, sizeof(double), cmp_double);
+                double *pw = (double *)bsearch(&fr[3 * r + 1], tb->f_omega, tb->nw, sizeof(double), cmp_double);
+                double mu = fr[3 * r + 2];
+                int at = (int)(pt - tb->f_theta) * tb->nw + (int)(pw - tb->f_omega);
+                if (!(mu >= 0.0 && mu <= MU_LIMIT) || tb->f_mu[at] >= 0.0) {
+                    snprintf(err, errlen, "%s data row %d: mu must be in [0, %g] and each grid point given once",
+                             path, r + 1, MU_LIMIT);
+                    free(fr); goto fail;
+                }
+                tb->f_mu[at] = mu;
+            }
+            free(fr);
+        }
+    }
     return 0;
 fail:
     free(fd); free(kp);
@@ -318,7 +405,8 @@ static void update_outputs(Comp *c) {
     double x_kiss = r[VR_X_KISS_REF] - r[VR_LEVER_RATIO] * table_delta(&c->table, theta_c);
     double u = (r[VR_X_TO] - x_kiss) / r[VR_LEVER_RATIO];
     double force = table_force(&c->table, u, theta_c);
-    r[VR_TORQUE] = r[VR_N_SURFACES] * r[VR_MU] * r[VR_R_EQ] * force;
+    double mu = c->table.f_mu ? table_mu(&c->table, r[VR_THETA_CM] - KELVIN, r[VR_OMEGA_SLIP]) : r[VR_MU];
+    r[VR_TORQUE] = r[VR_N_SURFACES] * mu * r[VR_R_EQ] * force;
     r[VR_FORCE] = force;
     r[VR_U_F] = u > 0.0 ? u : 0.0;
     r[VR_X_KISS] = x_kiss;
@@ -334,7 +422,7 @@ static void update_outputs(Comp *c) {
 
 static int check_parameters(Comp *c) {
     int k, ok = 1;
-    for (k = VR_N_SURFACES; k < NVARS; ++k) {
+    for (k = VR_N_SURFACES; k <= VR_LEVER_RATIO; ++k) {
         double v = c->r[k];
         const double *g = RANGES[k];
         int good = isfinite(v) && (g[2] ? v > g[0] : v >= g[0]) && (g[3] ? v < g[1] : v <= g[1]);
@@ -363,6 +451,12 @@ static int check_inputs(Comp *c, double t) {
         logf_(c, fmi2Error, "logStatusError",
               "t = %g s: input theta_cm = %g K is not finite or outside (0, %g) K; step refused", t, th,
               THETA_CM_LIMIT);
+        ok = 0;
+    }
+    if (!(isfinite(c->r[VR_OMEGA_SLIP]) && fabs(c->r[VR_OMEGA_SLIP]) <= OMEGA_SLIP_LIMIT)) {
+        logf_(c, fmi2Error, "logStatusError",
+              "t = %g s: input omega_slip = %g rad/s is not finite or |omega_slip| > %g rad/s; step refused", t,
+              c->r[VR_OMEGA_SLIP], OMEGA_SLIP_LIMIT);
         ok = 0;
     }
     return ok;
@@ -486,7 +580,7 @@ fmi2Status fmi2SetReal(fmi2Component comp, const fmi2ValueReference vr[], size_t
             logf_(c, fmi2Error, "logStatusError", "fmi2SetReal: value reference %u is not settable", vr[k]);
             return fmi2Error;
         }
-        if (vr[k] >= VR_N_SURFACES && c->phase == ST_STEP) {
+        if (vr[k] >= VR_N_SURFACES && vr[k] <= VR_LEVER_RATIO && c->phase == ST_STEP) {
             logf_(c, fmi2Error, "logStatusError",
                   "fmi2SetReal: parameter %s is fixed after initialization", VAR_NAMES[vr[k]]);
             return fmi2Error;

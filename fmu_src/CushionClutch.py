@@ -12,8 +12,8 @@ from pathlib import Path
 from pythonfmu import Fmi2Causality, Fmi2Slave, Fmi2Variability, Real
 from pythonfmu.enums import Fmi2Status
 
-from clutch_model import (THETA_CM_LIMIT, VARIABLES, X_TO_LIMIT, ClutchParameters, SpringTable,
-                          outputs, thermal_step)
+from clutch_model import (OMEGA_SLIP_LIMIT, OMEGA_SLIP_START, THETA_CM_LIMIT, VARIABLES, X_TO_LIMIT,
+                          ClutchParameters, SpringTable, outputs, thermal_step)
 
 CAUSALITY = {"input": (Fmi2Causality.input, Fmi2Variability.continuous),
              "output": (Fmi2Causality.output, Fmi2Variability.continuous),
@@ -34,6 +34,7 @@ class CushionClutch(Fmi2Slave):
         defaults = ClutchParameters()
         self.x_to = 0.0
         self.theta_cm = defaults.theta_a
+        self.omega_slip = OMEGA_SLIP_START
         for name in PARAMETERS:
             setattr(self, name, float(getattr(defaults, name)))
         self.theta_cs = defaults.theta_cs_start
@@ -95,10 +96,14 @@ class CushionClutch(Fmi2Slave):
         if not (isinstance(self.theta_cm, float) and math.isfinite(self.theta_cm)
                 and 0.0 < self.theta_cm < THETA_CM_LIMIT):
             out.append(f"input theta_cm = {self.theta_cm!r} K is not finite or outside (0, {THETA_CM_LIMIT:g}) K")
+        if not (isinstance(self.omega_slip, float) and math.isfinite(self.omega_slip)
+                and abs(self.omega_slip) <= OMEGA_SLIP_LIMIT):
+            out.append(f"input omega_slip = {self.omega_slip!r} rad/s is not finite or |omega_slip| > "
+                       f"{OMEGA_SLIP_LIMIT:g} rad/s")
         return out
 
     def _update_outputs(self) -> None:
-        out = outputs(self.x_to, self.theta_cs, self._table, self._params)
+        out = outputs(self.x_to, self.theta_cs, self._table, self._params, self.theta_cm, self.omega_slip)
         self.torque, self.force, self.u_f, self.x_kiss = out.torque, out.force, out.u_f, out.x_kiss
         if out.clamped and not self._range_warned:
             self._range_warned = True

@@ -25,7 +25,9 @@ log = logging.getLogger(__name__)
 
 FMU_SRC = fmu_sources()
 SLAVE = "CushionClutch"
-TABLE_FILES = ("force_deflection.csv", "kiss_point.csv", "metadata.json")
+#: the numpy-only model modules the pythonfmu slave imports (siblings inside the FMU)
+MODEL_MODULES = ("clutch_model.py", "spring_table.py", "friction.py")
+TABLE_FILES = ("force_deflection.csv", "kiss_point.csv", "metadata.json", "friction.csv")
 
 #: unit of each variable (from the shared model module); temperatures get degC as display unit
 UNITS = {name: unit for name, _, unit, _ in VARIABLES}
@@ -33,7 +35,7 @@ UNITS = {name: unit for name, _, unit, _ in VARIABLES}
 BASE_UNITS = {
     "m": {"m": "1"}, "K": {"K": "1"}, "N": {"kg": "1", "m": "1", "s": "-2"},
     "N.m": {"kg": "1", "m": "2", "s": "-2"}, "W/K": {"kg": "1", "m": "2", "s": "-3", "K": "-1"},
-    "J/K": {"kg": "1", "m": "2", "s": "-2", "K": "-1"}, "1": {},
+    "J/K": {"kg": "1", "m": "2", "s": "-2", "K": "-1"}, "1": {}, "rad/s": {"s": "-1", "rad": "1"},
 }
 
 FMU_OPTIONS = dict(needsExecutionTool=False, canHandleVariableCommunicationStepSize=True,
@@ -101,13 +103,14 @@ def build_fmu(tables: Path, output: Path, backend: str = "native") -> Path:
     with tempfile.TemporaryDirectory(prefix="cushion_fmu_") as tmp:
         stage = Path(tmp)
         shutil.copy(FMU_SRC / f"{SLAVE}.py", stage / f"{SLAVE}.py")
-        shutil.copy(FMU_SRC / "clutch_model.py", stage / "clutch_model.py")
+        for module in MODEL_MODULES:
+            shutil.copy(FMU_SRC / module, stage / module)
         (stage / "tables").mkdir()
         for name in TABLE_FILES:
             if (tables / name).exists():
                 shutil.copy(tables / name, stage / "tables" / name)
         built = FmuBuilder.build_FMU(stage / f"{SLAVE}.py", dest=stage / "out",
-                                     project_files=[stage / "clutch_model.py", stage / "tables"],
+                                     project_files=[*(stage / m for m in MODEL_MODULES), stage / "tables"],
                                      **FMU_OPTIONS)
         _rewrite_description(Path(built), output)
     log.info("built %s from tables %s", output, tables)

@@ -11,7 +11,7 @@ import zipfile
 from pathlib import Path
 from xml.etree import ElementTree as ET
 
-from ..fmu_src.clutch_model import VARIABLES, ClutchParameters
+from ..fmu_src.clutch_model import OMEGA_SLIP_START, VARIABLES, ClutchParameters
 from .build import FMU_SRC, SLAVE, TABLE_FILES, complete_model_description
 
 log = logging.getLogger(__name__)
@@ -53,7 +53,8 @@ def native_model_description(guid: str) -> str:
         var = ET.SubElement(variables, "ScalarVariable", attrs)
         real = ET.SubElement(var, "Real")
         if causality == "input":
-            real.set("start", repr({"x_to": 0.0, "theta_cm": defaults.theta_a}[name]))
+            real.set("start", repr({"x_to": 0.0, "theta_cm": defaults.theta_a,
+                                   "omega_slip": OMEGA_SLIP_START}[name]))
         elif causality == "parameter":
             real.set("start", repr(float(getattr(defaults, name))))
     structure = ET.SubElement(root, "ModelStructure")

@@ -8,10 +8,10 @@ from cushion_clutch.fe.params import Geometry
 def test_wave_is_one_minus_cos_between_its_angles():
     g = Geometry()
     phi = np.linspace(0, g.span_deg, 1001)
-    w = wave_height(phi, g)
+    w = wave_height(0.09, phi, g)
     assert w.max() == pytest.approx(g.wave_height_m, rel=1e-6)
     mid = 0.5 * (g.wave_start_deg + g.wave_end_deg)
-    assert wave_height(np.array([mid]), g)[0] == pytest.approx(g.wave_height_m)
+    assert wave_height(0.09, np.array([mid]), g)[0] == pytest.approx(g.wave_height_m)
     assert np.all(w[phi <= g.wave_start_deg] == 0)
 
 

@@ -89,9 +89,19 @@ class Assembly:
     paddles: int
 
 
-def wave_height(phi_deg: np.ndarray, geom: Geometry) -> np.ndarray:
-    """Wave offset w(phi) of the paddle's surface above its flat position, m."""
-    phi = np.asarray(phi_deg, dtype=float)
+def wave_height(r_m: np.ndarray, phi_deg: np.ndarray, geom: Geometry) -> np.ndarray:
+    """Wave offset w(r, phi) of the paddle's mid-surface above its flat position, m.
+
+    Parameters
+    ----------
+    r_m : array_like
+        Radius, m (broadcast against ``phi_deg``).
+    phi_deg : array_like
+        Angle from the paddle's clamped end, degrees.
+    geom : Geometry
+        Paddle shape.
+    """
+    phi = np.asarray(phi_deg, dtype=float) + 0.0 * np.asarray(r_m, dtype=float)
     s = (phi - geom.wave_start_deg) / (geom.wave_end_deg - geom.wave_start_deg)
     inside = (s >= 0.0) & (s <= 1.0)
     return np.where(inside, 0.5 * geom.wave_height_m * (1.0 - np.cos(2.0 * np.pi * s)), 0.0)
@@ -134,7 +144,7 @@ def paddle_mesh(geom: Geometry, element_size_m: float, mirror: bool = False) -> 
     nr, nphi = len(radii), len(phis)
     rr, pp = np.meshgrid(radii, phis, indexing="ij")          # (nr, nphi)
     sign = -1.0 if mirror else 1.0
-    z = sign * (0.5 * geom.thickness_m + geom.carrier_clearance_m + wave_height(pp, geom))
+    z = sign * (0.5 * geom.thickness_m + geom.carrier_clearance_m + wave_height(rr, pp, geom))
     rad = np.radians(pp)
     nodes = np.column_stack([(rr * np.cos(rad)).ravel(), (rr * np.sin(rad)).ravel(), z.ravel()])
 

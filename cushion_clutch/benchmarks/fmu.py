@@ -46,7 +46,7 @@ def compile_host(dest: Path) -> Path:
     from cushion_clutch.data import fmu_sources
     from cushion_clutch.fmu.native import fmi2_header_dir
     subprocess.run([shutil.which("gcc") or "cc", "-std=c99", "-D_POSIX_C_SOURCE=199309L", "-O2",
-                    f"-I{fmi2_header_dir()}", str(fmu_sources() / "fmi2_host.c"), "-o", str(dest), "-ldl"], check=True)
+                    f"-I{fmi2_header_dir()}", str(fmu_sources() / "hosts" / "fmi2_host.c"), "-o", str(dest), "-ldl"], check=True)
     return dest
 
 

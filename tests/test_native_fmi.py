@@ -344,3 +344,31 @@ def test_resource_uri_forms(tmp_path):
         cases = [c for c in URIS if c[0] == windows]
         out = subprocess.run([str(exe), str(windows), *[c[1] for c in cases]], capture_output=True, check=True)
         assert out.stdout.decode("utf-8").splitlines() == [c[2] for c in cases]
+
+
+def test_fmi3_and_fmi2_match_with_a_friction_table(tmp_path):
+    """omega_slip and friction.csv through both front ends (host binaries only)."""
+    from cushion_clutch.data import DEFAULT_TABLES
+    from cushion_clutch.fmu.native import build_native_fmu
+    tables = tmp_path / "fade"
+    shutil.copytree(DEFAULT_TABLES, tables)
+    (tables / "friction.csv").write_text("theta_degC,omega_slip_rad_s,mu\n20,0,0.30\n20,100,0.28\n"
+                                         "300,0,0.20\n300,100,0.18\n")
+    f2 = build_native_fmu(tables, tmp_path / "f2.fmu", 2, platforms=("linux64",))
+    f3 = build_native_fmu(tables, tmp_path / "f3.fmu", 3, platforms=("x86_64-linux",))
+    deps = {u.variable.name: sorted(d.name for d in u.dependencies)
+            for u in read_model_description(str(f3)).outputs}
+    assert deps["torque"] == ["omega_slip", "theta_cm", "theta_cs", "x_to"]
+    t = np.linspace(0.0, 10.0, 11)
+    sig = np.array([(tk, 0.007, 300.0 + 40.0 * tk, 100.0 - 10.0 * tk) for tk in t],
+                   dtype=[("time", float), ("x_to", float), ("theta_cm", float), ("omega_slip", float)])
+    runs = [simulate_fmu(str(f), input=sig, stop_time=10.0, output_interval=0.1, output=["torque", "theta_cs"])
+            for f in (f2, f3)]
+    assert np.max(np.abs(runs[0]["torque"] - runs[1]["torque"]) / runs[0]["torque"]) <= 1e-12
+    table, p = load_table(tables), ClutchParameters()
+    theta = p.theta_cs_start
+    for k in range(100):                                       # the Python model, inputs held per 0.1 s step
+        theta = thermal_step(theta, 300.0 + 40.0 * k * 0.1, 0.1, p)
+    assert runs[1]["theta_cs"][-1] == pytest.approx(theta, rel=1e-12)
+    ref = outputs(0.007, theta, table, p, theta_cm=300.0 + 40.0 * 9.9, omega_slip=100.0 - 10.0 * 9.9)
+    assert runs[1]["torque"][-1] == pytest.approx(ref.torque, rel=1e-12)

@@ -14,6 +14,7 @@ from fmpy import read_model_description
 
 from cushion_clutch.data import fmu_sources
 from cushion_clutch.fmu.model import ClutchParameters, load_table, outputs, thermal_step
+from cushion_clutch.fmu.descriptions import sources
 from cushion_clutch.fmu.native import fmi_header_dir
 from native_builds import native_fmus
 
@@ -89,11 +90,20 @@ def _model_final(steps, h):
     return [o.torque, o.force, theta, o.u_f, o.x_kiss]
 
 
-def test_win64_binary_runs_under_wine_with_windows_resource_uris(tmp_path, wine_env):
-    host = tmp_path / "fmi2_host.exe"
+def _windows_host(tmp_path, version):
+    host = tmp_path / f"fmi{version}_host.exe"
     subprocess.run([sys.executable, "-m", "ziglang", "cc", "-target", "x86_64-windows-gnu", "-std=c99", "-O2",
-                    f"-I{fmi_header_dir()}", str(fmu_sources() / "hosts" / "fmi2_host.c"), "-o", str(host)],
+                    f"-I{fmi_header_dir()}", str(fmu_sources() / "hosts" / f"fmi{version}_host.c"), "-o", str(host)],
                    check=True, capture_output=True)
+    return host
+
+
+def _final_outputs(stdout):
+    return [float(v) for v in stdout.splitlines()[0].split()[1:]]
+
+
+def test_win64_binary_runs_under_wine_with_windows_resource_uris(tmp_path, wine_env):
+    host = _windows_host(tmp_path, 2)
     fmu = native_fmus()[2]
     guid = read_model_description(str(fmu)).guid
     expected = _model_final(3000, 0.01)
@@ -107,6 +117,41 @@ def test_win64_binary_runs_under_wine_with_windows_resource_uris(tmp_path, wine_
         res = subprocess.run([str(WINE), str(host), "Z:" + str(dll).replace("/", "\\"), uri, guid, "3000", "0.01"],
                              env=wine_env, capture_output=True, text=True, timeout=120)
         assert res.returncode == 0, (uri, res.stdout, res.stderr[-2000:])
-        got = [float(v) for v in res.stdout.splitlines()[0].split()[1:]]
-        assert got == pytest.approx(expected, rel=1e-12, abs=1e-15), uri
+        assert _final_outputs(res.stdout) == pytest.approx(expected, rel=1e-12, abs=1e-15), uri
     assert "%C3%A9s%20dir" in (spaced / "resources").as_uri()
+
+
+def test_fmi3_windows_binary_runs_under_wine(tmp_path, wine_env):
+    host = _windows_host(tmp_path, 3)
+    fmu = native_fmus()[3]
+    unzip = tmp_path / "fmu3"
+    zipfile.ZipFile(fmu).extractall(unzip)
+    token = read_model_description(str(fmu)).guid
+    win = lambda p: "Z:" + str(p).replace("/", "\\")  # noqa: E731
+    res = subprocess.run([str(WINE), str(host), win(unzip / "binaries/x86_64-windows/CushionClutch.dll"),
+                          win(unzip / "resources") + "\\", token, "3000", "0.01"],
+                         env=wine_env, capture_output=True, text=True, timeout=120)
+    assert res.returncode == 0, (res.stdout, res.stderr[-2000:])
+    assert _final_outputs(res.stdout) == pytest.approx(_model_final(3000, 0.01), rel=1e-12, abs=1e-15)
+
+
+def test_fmi3_c_host_under_address_sanitizer_matches_the_model(tmp_path):
+    """Our FMI 3.0 C host on Linux, host and FMU library both built with ASan + UBSan."""
+    fmu = native_fmus()[3]
+    unzip = tmp_path / "fmu3"
+    zipfile.ZipFile(fmu).extractall(unzip)
+    flags = ["-fsanitize=address,undefined", "-fno-omit-frame-pointer", "-g", "-O1"]
+    cc, srcs = shutil.which("gcc"), unzip / "sources"
+    lib = tmp_path / "CushionClutch.so"
+    subprocess.run([cc, "-std=c99", "-fPIC", "-shared", *flags, f"-I{srcs}",
+                    *(str(srcs / f) for f in sources(3)), "-o", str(lib), "-lm"], check=True)
+    host = tmp_path / "fmi3_host"
+    subprocess.run([cc, "-std=c99", "-D_POSIX_C_SOURCE=199309L", *flags, f"-I{fmi_header_dir()}",
+                    str(fmu_sources() / "hosts" / "fmi3_host.c"), "-o", str(host), "-ldl"], check=True)
+    res = subprocess.run([str(host), str(lib), str(unzip / "resources") + "/", read_model_description(str(fmu)).guid,
+                          "3000", "0.01"], capture_output=True, text=True,
+                         env={"ASAN_OPTIONS": "detect_leaks=1", "UBSAN_OPTIONS": "halt_on_error=1",
+                              "PATH": "/usr/bin:/bin"})
+    assert res.returncode == 0, res.stderr[-3000:]
+    assert "runtime error" not in res.stderr
+    assert _final_outputs(res.stdout) == pytest.approx(_model_final(3000, 0.01), rel=1e-12, abs=1e-15)

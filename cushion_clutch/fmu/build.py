@@ -17,7 +17,7 @@ from pathlib import Path
 from xml.etree import ElementTree as ET
 
 from ..data import fmu_sources
-from ..errors import TableError
+from ..errors import ParameterError, TableError
 from ..fmu_src.clutch_model import VARIABLES
 from ..fe.tables import read_tables
 
@@ -95,7 +95,7 @@ def build_fmu(tables: Path, output: Path, backend: str = "native", fmi_version: 
         if not (tables / name).exists():
             raise TableError(f"{tables / name} is missing")
     if fmi_version not in (2, 3):
-        raise ValueError(f"fmi_version = {fmi_version!r}: allowed 2 or 3")
+        raise ParameterError([f"fmi_version = {fmi_version!r}: allowed 2 or 3"])
     output.parent.mkdir(parents=True, exist_ok=True)
     if backend == "native":
         from .native import build_native_fmu
@@ -103,7 +103,7 @@ def build_fmu(tables: Path, output: Path, backend: str = "native", fmi_version: 
     if backend != "python":
         raise ValueError(f"backend = {backend!r}: allowed 'python' or 'native'")
     if fmi_version != 2:
-        raise ValueError("fmi_version = 3 needs backend 'native' (the pythonfmu backend writes FMI 2.0)")
+        raise ParameterError(["fmi_version = 3 needs backend 'native' (the pythonfmu backend writes FMI 2.0)"])
     from pythonfmu.builder import FmuBuilder
     with tempfile.TemporaryDirectory(prefix="cushion_fmu_") as tmp:
         stage = Path(tmp)

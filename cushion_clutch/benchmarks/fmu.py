@@ -1,9 +1,11 @@
-"""Benchmark: time per step of the CushionClutch FMUs (pythonfmu and native C).
+"""Benchmark: time per step of the CushionClutch FMUs (pythonfmu and native C), and the native build time.
 
 Through fmpy (FMU2Slave: set 2 inputs, doStep, get 5 outputs), in our small C
-host (tests/c_host/fmi2_host.c, dlopen), and the Python model alone.
+host (fmu_src/hosts/fmi2_host.c, dlopen), and the Python model alone; the time
+to build the native FMU with the binaries of every platform (FMI 2.0: 3, FMI 3.0: 5),
+with zig's cache warm, and with ``--cold`` also from an empty zig cache.
 
-    python -m cushion_clutch.benchmarks.fmu [--steps 200000]
+    python -m cushion_clutch.benchmarks.fmu [--steps 200000] [--cold]
 """
 from __future__ import annotations
 
@@ -46,7 +48,7 @@ def compile_host(dest: Path) -> Path:
     from cushion_clutch.data import fmu_sources
     from cushion_clutch.fmu.native import fmi2_header_dir
     subprocess.run([shutil.which("gcc") or "cc", "-std=c99", "-D_POSIX_C_SOURCE=199309L", "-O2",
-                    f"-I{fmi2_header_dir()}", str(fmu_sources() / "fmi2_host.c"), "-o", str(dest), "-ldl"], check=True)
+                    f"-I{fmi2_header_dir()}", str(fmu_sources() / "hosts" / "fmi2_host.c"), "-o", str(dest), "-ldl"], check=True)
     return dest
 
 
@@ -71,16 +73,47 @@ def time_c_host(host: Path, fmu: Path, n: int, python: bool, workdir: Path) -> t
     return us, res.returncode, res.stderr.strip()[-200:]
 
 
+def time_builds(tmp: Path, cold: bool) -> None:
+    """Print the time to build the native FMU for all platforms, per FMI version (warm, optionally cold)."""
+    from cushion_clutch.fmu.build import build_fmu
+    from cushion_clutch.fmu.model import DEFAULT_TABLES
+
+    caches = [("warm zig cache", None)]
+    if cold:
+        caches.insert(0, ("cold zig cache", tmp / "zig-cache"))
+    for label, cache in caches:
+        env_before = os.environ.get("ZIG_GLOBAL_CACHE_DIR")
+        if cache is not None:
+            os.environ["ZIG_GLOBAL_CACHE_DIR"] = str(cache)
+        try:
+            for version in (2, 3):
+                build_fmu(DEFAULT_TABLES, tmp / f"warmup{version}.fmu", fmi_version=version) if label.startswith(
+                    "warm") else None
+                t0 = time.perf_counter()
+                out = build_fmu(DEFAULT_TABLES, tmp / f"build{version}.fmu", fmi_version=version)
+                dt = time.perf_counter() - t0
+                platforms = sum(1 for name in zipfile.ZipFile(out).namelist() if name.startswith("binaries/"))
+                print(f"native FMI {version}.0 FMU, all {platforms} platforms, {label}: {dt:6.1f} s")
+        finally:
+            if cache is not None:
+                if env_before is None:
+                    os.environ.pop("ZIG_GLOBAL_CACHE_DIR")
+                else:
+                    os.environ["ZIG_GLOBAL_CACHE_DIR"] = env_before
+
+
 def main(argv=None) -> None:
     from cushion_clutch.fmu.build import build_fmu
     from cushion_clutch.fmu.model import DEFAULT_TABLES, ClutchParameters, load_table, outputs, thermal_step
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--steps", type=int, default=200_000)
+    ap.add_argument("--cold", action="store_true", help="also time builds from an empty zig cache (minutes)")
     args = ap.parse_args(argv)
     n = args.steps
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
+        time_builds(tmp, args.cold)
         fmus = {b: build_fmu(DEFAULT_TABLES, tmp / f"{b}.fmu", backend=b) for b in ("python", "native")}
         host = compile_host(tmp / "host")
         print(f"steps: {n}, communication step 1 ms")

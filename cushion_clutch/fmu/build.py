@@ -17,7 +17,7 @@ from pathlib import Path
 from xml.etree import ElementTree as ET
 
 from ..data import fmu_sources
-from ..errors import TableError
+from ..errors import ParameterError, TableError
 from ..fmu_src.clutch_model import VARIABLES
 from ..fe.tables import read_tables
 
@@ -76,30 +76,35 @@ def complete_model_description(xml_text: str) -> str:
     return '<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
 
 
-def build_fmu(tables: Path, output: Path, backend: str = "native") -> Path:
+def build_fmu(tables: Path, output: Path, backend: str = "native", fmi_version: int = 2) -> Path:
     """Build ``output`` (.fmu) carrying the table set in ``tables``.
 
-    ``backend`` is ``"native"`` (C; loads in any FMI host) or ``"python"``
-    (pythonfmu; needs Python and numpy where it runs).
+    ``backend`` is ``"native"`` (C; loads in any FMI host; binaries for Windows,
+    Linux and macOS; Co-Simulation and Model Exchange) or ``"python"``
+    (pythonfmu; FMI 2.0 Co-Simulation; needs Python and numpy where it runs).
+    ``fmi_version`` is 2 (FMI 2.0) or 3 (FMI 3.0, native only).
 
     Raises
     ------
     TableError
         If the table set is missing or malformed (checked before building).
     """
-    from pythonfmu.builder import FmuBuilder
-
     tables, output = Path(tables), Path(output)
     read_tables(tables)                                 # fail early, with the file's name
     for name in TABLE_FILES[:2]:
         if not (tables / name).exists():
             raise TableError(f"{tables / name} is missing")
+    if fmi_version not in (2, 3):
+        raise ParameterError([f"fmi_version = {fmi_version!r}: allowed 2 or 3"])
     output.parent.mkdir(parents=True, exist_ok=True)
     if backend == "native":
         from .native import build_native_fmu
-        return build_native_fmu(tables, output)
+        return build_native_fmu(tables, output, fmi_version=fmi_version)
     if backend != "python":
         raise ValueError(f"backend = {backend!r}: allowed 'python' or 'native'")
+    if fmi_version != 2:
+        raise ParameterError(["fmi_version = 3 needs backend 'native' (the pythonfmu backend writes FMI 2.0)"])
+    from pythonfmu.builder import FmuBuilder
     with tempfile.TemporaryDirectory(prefix="cushion_fmu_") as tmp:
         stage = Path(tmp)
         shutil.copy(FMU_SRC / f"{SLAVE}.py", stage / f"{SLAVE}.py")
@@ -142,9 +147,13 @@ def add_build_arguments(parser) -> None:
                         help="table folder (force_deflection.csv, kiss_point.csv, metadata.json)")
     parser.add_argument("-o", "--output", type=Path, default=Path("CushionClutch.fmu"), help="FMU file")
     add_backend(parser)
+    parser.add_argument("--fmi-version", type=int, choices=(2, 3), default=2,
+                        help="FMI 2.0 (default) or 3.0 (native backend only); both carry Co-Simulation "
+                             "and Model Exchange")
 
 
 def build_from_args(args) -> str:
     """Build the FMU that parsed ``build-fmu`` options describe; return a one-line report."""
-    out = build_fmu(args.tables, args.output, backend=args.backend)
-    return f"built {out} ({args.backend}) from {args.tables}"
+    version = getattr(args, "fmi_version", 2)
+    out = build_fmu(args.tables, args.output, backend=args.backend, fmi_version=version)
+    return f"built {out} ({args.backend}, FMI {version}.0) from {args.tables}"

@@ -1,102 +1,90 @@
-"""The native C FMU: compile ``fmu_src/CushionClutch.c`` and pack it with its tables."""
+"""The native C FMU: the model core plus the FMI 2.0 or FMI 3.0 front end, built for every platform.
+
+The FMU carries ``binaries/<platform>/`` for Windows, Linux and macOS
+(:mod:`.crossbuild`), ``sources/`` (core, front end, generated ``cushion_guid.h``
+and the FMI headers; ``<SourceFiles>`` for FMI 2.0, ``buildDescription.xml``
+for FMI 3.0) and ``resources/tables``. The GUID (instantiationToken) hashes the
+tables, the C sources and the FMI version; the binaries check it at instantiation.
+"""
 from __future__ import annotations
 
 import hashlib
 import logging
 import shutil
-import subprocess
 import tempfile
 import uuid
 import zipfile
 from pathlib import Path
-from xml.etree import ElementTree as ET
 
-from ..fmu_src.clutch_model import OMEGA_SLIP_START, VARIABLES, ClutchParameters
-from .build import FMU_SRC, SLAVE, TABLE_FILES, complete_model_description
+from .build import FMU_SRC, SLAVE, TABLE_FILES
+from .crossbuild import build_binaries
+from .descriptions import (CORE_SOURCES, FRONT_ENDS, fmi2_description, fmi3_build_description,
+                           fmi3_description, sources)
 
 log = logging.getLogger(__name__)
 
+FMI_HEADERS = {2: ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h"),
+               3: ("fmi3Functions.h", "fmi3FunctionTypes.h", "fmi3PlatformTypes.h")}
+FMI2_HEADERS = FMI_HEADERS[2]
 
-FMI2_HEADERS = ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h")
 
-
-def fmi2_header_dir() -> Path:
-    """The FMI 2.0 standard headers shipped with FMPy."""
+def fmi_header_dir() -> Path:
+    """The FMI 2.0 and 3.0 standard headers shipped with FMPy."""
     import fmpy
     return Path(fmpy.__file__).parent / "c-code"
 
 
-def native_model_description(guid: str) -> str:
-    """modelDescription.xml of the native FMU: the variables of ``clutch_model.VARIABLES``."""
-    defaults = ClutchParameters()
-    root = ET.Element("fmiModelDescription", fmiVersion="2.0", modelName=SLAVE, guid=guid,
-                      description="Dry-clutch torque T = n*mu*R_eq*F(u_f(x_to, theta_cs), theta_cs) "
-                                  "with the cushion-spring thermal ODE; F from CalculiX tables (native C)",
-                      generationTool="cushion_clutch fmu_build (native)", variableNamingConvention="flat",
-                      numberOfEventIndicators="0")
-    cs = ET.SubElement(root, "CoSimulation", modelIdentifier=SLAVE, needsExecutionTool="false",
-                       canHandleVariableCommunicationStepSize="true", canInterpolateInputs="false",
-                       canBeInstantiatedOnlyOncePerProcess="false", canNotUseMemoryManagementFunctions="true",
-                       canGetAndSetFMUstate="true", canSerializeFMUstate="true")
-    files = ET.SubElement(cs, "SourceFiles")
-    ET.SubElement(files, "File", name=f"{SLAVE}.c")
-    cats = ET.SubElement(root, "LogCategories")
-    for name in ("logStatusWarning", "logStatusError"):
-        ET.SubElement(cats, "Category", name=name)
-    variables = ET.SubElement(root, "ModelVariables")
-    for vr, (name, causality, unit, desc) in enumerate(VARIABLES):
-        attrs = dict(name=name, valueReference=str(vr), description=f"{desc} [{unit}]", causality=causality)
-        if causality == "parameter":
-            attrs.update(variability="fixed", initial="exact")
-        else:
-            attrs["variability"] = "continuous"
-        var = ET.SubElement(variables, "ScalarVariable", attrs)
-        real = ET.SubElement(var, "Real")
-        if causality == "input":
-            real.set("start", repr({"x_to": 0.0, "theta_cm": defaults.theta_a,
-                                   "omega_slip": OMEGA_SLIP_START}[name]))
-        elif causality == "parameter":
-            real.set("start", repr(float(getattr(defaults, name))))
-    structure = ET.SubElement(root, "ModelStructure")
-    outputs = ET.SubElement(structure, "Outputs")
-    for vr, (_, causality, _, _) in enumerate(VARIABLES):
-        if causality == "output":
-            ET.SubElement(outputs, "Unknown", index=str(vr + 1))
-    return complete_model_description(ET.tostring(root, encoding="unicode"))
+fmi2_header_dir = fmi_header_dir
 
 
-def compile_native(dest: Path, extra_flags: tuple[str, ...] = ()) -> Path:
-    """Compile ``fmu_src/CushionClutch.c`` into the shared library ``dest`` with gcc."""
-    cc = shutil.which("gcc") or shutil.which("cc")
-    if cc is None:
-        raise RuntimeError("no C compiler: install gcc (apt-get install -y gcc)")
-    cmd = [cc, "-std=c99", "-O2", "-fPIC", "-shared", "-fvisibility=hidden", "-Wall", "-Wextra",
-           *extra_flags, f"-I{fmi2_header_dir()}", str(FMU_SRC / f"{SLAVE}.c"), "-o", str(dest), "-lm"]
-    out = subprocess.run(cmd, capture_output=True, text=True)
-    if out.returncode != 0:
-        raise RuntimeError(f"compiling the native FMU failed:\n{' '.join(cmd)}\n{out.stderr}")
-    return dest
+def model_guid(tables: Path, fmi_version: int) -> str:
+    """GUID / instantiationToken: a hash of the tables, the C sources and the FMI version."""
+    digest = hashlib.sha256(f"fmi{fmi_version}".encode())
+    for name in TABLE_FILES:
+        if (tables / name).exists():
+            digest.update(name.encode() + (tables / name).read_bytes())
+    for name in ("clutch_core.h", *CORE_SOURCES, FRONT_ENDS[fmi_version]):
+        digest.update((FMU_SRC / name).read_bytes())
+    return "{" + str(uuid.uuid5(uuid.NAMESPACE_URL, "cushion_clutch:" + digest.hexdigest())) + "}"
 
 
-def build_native_fmu(tables: Path, output: Path) -> Path:
-    """Build the native C FMU: binaries/linux64, sources/, resources/tables, modelDescription.xml."""
-    digest = hashlib.sha256()
-    for name in TABLE_FILES[:2]:
-        digest.update((tables / name).read_bytes())
-    digest.update((FMU_SRC / f"{SLAVE}.c").read_bytes())
-    guid = "{" + str(uuid.uuid5(uuid.NAMESPACE_URL, "cushion_clutch:" + digest.hexdigest())) + "}"
+def stage_sources(dest: Path, guid: str, fmi_version: int) -> list[str]:
+    """Copy the sources, the generated ``cushion_guid.h`` and the FMI headers to ``dest``; return the names."""
+    dest.mkdir(parents=True, exist_ok=True)
+    names = ["clutch_core.h", *sources(fmi_version)]
+    for name in names:
+        shutil.copy(FMU_SRC / name, dest / name)
+    (dest / "cushion_guid.h").write_text(f'/* generated by cushion_clutch.fmu.native */\n#define CC_GUID "{guid}"\n')
+    for header in FMI_HEADERS[fmi_version]:
+        shutil.copy(fmi_header_dir() / header, dest / header)
+    return [*names, "cushion_guid.h", *FMI_HEADERS[fmi_version]]
+
+
+def build_native_fmu(tables: Path, output: Path, fmi_version: int = 2,
+                     platforms: tuple[str, ...] | None = None) -> Path:
+    """Build the native FMU (FMI ``fmi_version`` 2 or 3) carrying the table set ``tables``."""
+    if fmi_version not in FRONT_ENDS:
+        raise ValueError(f"fmi_version = {fmi_version!r}: allowed 2 or 3")
+    tables, output = Path(tables), Path(output)
+    guid = model_guid(tables, fmi_version)
+    has_friction = (tables / "friction.csv").exists()
     with tempfile.TemporaryDirectory(prefix="cushion_native_") as tmp:
-        lib = compile_native(Path(tmp) / f"{SLAVE}.so")
+        src = Path(tmp) / "sources"
+        staged = stage_sources(src, guid, fmi_version)
+        libs = build_binaries(src, sources(fmi_version), fmi_version, Path(tmp) / "binaries", platforms)
         tmp_out = output.with_suffix(".fmu.tmp")
         with zipfile.ZipFile(tmp_out, "w", zipfile.ZIP_DEFLATED) as z:
-            z.writestr("modelDescription.xml", native_model_description(guid))
-            z.write(lib, f"binaries/linux64/{SLAVE}.so")
-            z.write(FMU_SRC / f"{SLAVE}.c", f"sources/{SLAVE}.c")
-            for header in FMI2_HEADERS:
-                z.write(fmi2_header_dir() / header, f"sources/{header}")
+            z.writestr("modelDescription.xml", fmi2_description(guid, has_friction) if fmi_version == 2
+                       else fmi3_description(guid, has_friction))
+            for platform, lib in sorted(libs.items()):
+                z.write(lib, f"binaries/{platform}/{lib.name}")
+            for name in staged:
+                z.write(src / name, f"sources/{name}")
+            if fmi_version == 3:
+                z.writestr("sources/buildDescription.xml", fmi3_build_description())
             for name in TABLE_FILES:
                 if (tables / name).exists():
                     z.write(tables / name, f"resources/tables/{name}")
         tmp_out.replace(output)
-    log.info("built native %s from tables %s", output, tables)
+    log.info("built native FMI %d.0 %s (%s) from tables %s", fmi_version, output, ", ".join(sorted(libs)), tables)
     return output

@@ -1,0 +1,96 @@
+"""Compile the native FMU's binaries for every platform on this machine with zig (``ziglang`` on PyPI).
+
+Each FMI version has its platform folders (FMI 2.0: ``linux64``, ``win64``,
+``darwin64``; FMI 3.0: ``x86_64-linux``, ``aarch64-linux``, ``x86_64-windows``,
+``x86_64-darwin``, ``aarch64-darwin``). ``zig cc`` cross-compiles them all (its
+cache makes later builds fast); without ziglang, gcc builds the host platform only.
+Only the FMI API is exported: ``-fvisibility=hidden`` plus the FMI headers'
+export macros (``__declspec(dllexport)`` on Windows).
+
+    python -m cushion_clutch.fmu.crossbuild    # warm zig's cache (CI install step)
+"""
+from __future__ import annotations
+
+import importlib.util
+import logging
+import shutil
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+log = logging.getLogger(__name__)
+
+#: platform folder -> (zig target, library suffix), per FMI version
+TARGETS = {
+    2: {"linux64": ("x86_64-linux-gnu.2.17", ".so"), "win64": ("x86_64-windows-gnu", ".dll"),
+        "darwin64": ("x86_64-macos.11.0", ".dylib")},
+    3: {"x86_64-linux": ("x86_64-linux-gnu.2.17", ".so"), "aarch64-linux": ("aarch64-linux-gnu.2.17", ".so"),
+        "x86_64-windows": ("x86_64-windows-gnu", ".dll"), "x86_64-darwin": ("x86_64-macos.11.0", ".dylib"),
+        "aarch64-darwin": ("aarch64-macos.11.0", ".dylib")},
+}
+#: the platform folder of this (Linux x86_64) machine, per FMI version
+HOST = {2: "linux64", 3: "x86_64-linux"}
+CFLAGS = ("-std=c99", "-O2", "-shared", "-fvisibility=hidden", "-Wall")
+
+
+def zig_available() -> bool:
+    """Whether ``python -m ziglang`` can be used."""
+    return importlib.util.find_spec("ziglang") is not None
+
+
+def compile_command(platform: str, fmi_version: int, src: Path, files: tuple[str, ...], out: Path) -> list[str]:
+    """The zig (or, for the host without ziglang, gcc) command building one platform's library."""
+    target, suffix = TARGETS[fmi_version][platform]
+    srcs = [str(src / f) for f in files]
+    libs = ["-lm"] if "linux" in target else []
+    pic = [] if "windows" in target else ["-fPIC"]
+    if zig_available():
+        return [sys.executable, "-m", "ziglang", "cc", "-target", target, *CFLAGS, *pic, f"-I{src}", *srcs,
+                "-o", str(out), *libs]
+    if platform != HOST[fmi_version]:
+        raise RuntimeError(f"cross-compiling for {platform} needs ziglang (pip install ziglang)")
+    cc = shutil.which("gcc") or shutil.which("cc")
+    if cc is None:
+        raise RuntimeError("no C compiler: pip install ziglang, or install gcc")
+    return [cc, *CFLAGS, *pic, f"-I{src}", *srcs, "-o", str(out), *libs]
+
+
+def build_binaries(src: Path, files: tuple[str, ...], fmi_version: int, out_dir: Path,
+                   platforms: tuple[str, ...] | None = None) -> dict[str, Path]:
+    """Compile ``files`` (in ``src``, with the headers) for ``platforms`` (default: all, or the host
+    without ziglang) in parallel; return platform -> library path."""
+    if platforms is None:
+        platforms = tuple(TARGETS[fmi_version]) if zig_available() else (HOST[fmi_version],)
+        if not zig_available():
+            log.warning("ziglang is not installed: building %s only (pip install ziglang for all platforms)",
+                        HOST[fmi_version])
+    jobs = {}
+    for platform in platforms:
+        _, suffix = TARGETS[fmi_version][platform]
+        out = out_dir / platform / f"CushionClutch{suffix}"
+        out.parent.mkdir(parents=True, exist_ok=True)
+        cmd = compile_command(platform, fmi_version, src, files, out)
+        jobs[platform] = (cmd, out, subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                                     text=True))
+    failed = []
+    for platform, (cmd, out, proc) in jobs.items():
+        _, err = proc.communicate()
+        if proc.returncode != 0 or not out.exists():
+            failed.append(f"{platform}: {' '.join(cmd)}\n{err}")
+    if failed:
+        raise RuntimeError("compiling the native FMU failed:\n" + "\n".join(failed))
+    return {p: out for p, (_, out, _) in jobs.items()}
+
+
+def warm_cache() -> None:
+    """Build the default FMUs once (both FMI versions) so that zig's cache holds every target's libc."""
+    from ..data import DEFAULT_TABLES
+    from .native import build_native_fmu
+    with tempfile.TemporaryDirectory() as tmp:
+        for version in (2, 3):
+            build_native_fmu(DEFAULT_TABLES, Path(tmp) / f"fmi{version}.fmu", fmi_version=version)
+
+
+if __name__ == "__main__":
+    warm_cache()

@@ -1,0 +1,167 @@
+"""modelDescription.xml (FMI 2.0 and 3.0) and buildDescription.xml of the native FMU.
+
+Both FMI versions carry Co-Simulation and Model Exchange. The variables are
+``clutch_model.VARIABLES`` (value reference = position) plus the state
+derivative ``der(theta_cs)`` [K/s] (value reference 18) and, in FMI 3.0, the
+independent variable ``time`` [s] (value reference 19). In Model Exchange
+``theta_cs`` is the continuous state; torque, force, u_f and x_kiss depend
+directly on the inputs (ModelStructure lists the dependencies).
+"""
+from __future__ import annotations
+
+from xml.etree import ElementTree as ET
+
+from ..fmu_src.clutch_model import OMEGA_SLIP_START, VARIABLES, ClutchParameters
+from .build import BASE_UNITS, SLAVE
+
+#: the model core (shared) and the front end of each FMI version, as shipped in sources/
+CORE_SOURCES = ("clutch_core.c", "clutch_tables.c")
+CORE_HEADERS = ("clutch_core.h", "cushion_guid.h")
+FRONT_ENDS = {2: "fmi2_frontend.c", 3: "fmi3_frontend.c"}
+#: value references beyond clutch_model.VARIABLES
+VR_DER = len(VARIABLES)
+VR_TIME = VR_DER + 1
+UNITS = dict(BASE_UNITS, **{"K/s": {"K": "1", "s": "-1"}, "s": {"s": "1"}})
+DESCRIPTION = ("Dry-clutch torque T = n*mu*R_eq*F(u_f(x_to, theta_cs), theta_cs) with the cushion-spring "
+               "thermal ODE C dtheta_cs/dt = U (theta_cm - theta_cs) + H (theta_a - theta_cs); F from "
+               "CalculiX tables (native C; Co-Simulation and Model Exchange)")
+
+
+def sources(fmi_version: int) -> tuple[str, ...]:
+    """C files compiled into the FMI ``fmi_version`` binary."""
+    return (*CORE_SOURCES, FRONT_ENDS[fmi_version])
+
+
+def _vr(name: str) -> int:
+    return [v[0] for v in VARIABLES].index(name)
+
+
+def dependencies(has_friction: bool) -> dict[int, list[int]]:
+    """Value references of the inputs and states each output and the derivative depend on."""
+    x_to, theta_cm, theta_cs, omega = _vr("x_to"), _vr("theta_cm"), _vr("theta_cs"), _vr("omega_slip")
+    torque = [x_to, theta_cs] + ([theta_cm, omega] if has_friction else [])
+    return {_vr("torque"): sorted(torque), _vr("force"): [x_to, theta_cs], theta_cs: [theta_cs],
+            _vr("u_f"): [x_to, theta_cs], _vr("x_kiss"): [theta_cs], VR_DER: [theta_cm, theta_cs]}
+
+
+def _variables():
+    """(vr, name, causality, unit, description, start) of every variable but time."""
+    defaults = ClutchParameters()
+    starts = {"x_to": 0.0, "theta_cm": defaults.theta_a, "omega_slip": OMEGA_SLIP_START}
+    for vr, (name, causality, unit, desc) in enumerate(VARIABLES):
+        start = starts.get(name) if causality == "input" else (
+            float(getattr(defaults, name)) if causality == "parameter" else None)
+        yield vr, name, causality, unit, desc, start
+    yield VR_DER, "der(theta_cs)", "local", "K/s", "rate of change of theta_cs (paper eq. 3)", None
+
+
+def _units(root: ET.Element) -> None:
+    units = ET.SubElement(root, "UnitDefinitions")
+    for name, base in UNITS.items():
+        unit = ET.SubElement(units, "Unit", name=name)
+        ET.SubElement(unit, "BaseUnit", base)
+        if name == "K":
+            ET.SubElement(unit, "DisplayUnit", name="degC", offset="-273.15")
+
+
+def _log_categories(root: ET.Element) -> None:
+    cats = ET.SubElement(root, "LogCategories")
+    for name in ("logStatusWarning", "logStatusDiscard", "logStatusError", "logAll"):
+        ET.SubElement(cats, "Category", name=name)
+
+
+def _finish(root: ET.Element) -> str:
+    ET.indent(root)
+    return '<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
+
+
+def fmi2_description(guid: str, has_friction: bool) -> str:
+    """FMI 2.0 modelDescription.xml: ME and CS, SourceFiles, ModelStructure with dependencies."""
+    root = ET.Element("fmiModelDescription", fmiVersion="2.0", modelName=SLAVE, guid=guid, description=DESCRIPTION,
+                      generationTool="cushion_clutch (native C)", variableNamingConvention="flat",
+                      numberOfEventIndicators="0")
+    common = dict(modelIdentifier=SLAVE, needsExecutionTool="false", canBeInstantiatedOnlyOncePerProcess="false",
+                  canNotUseMemoryManagementFunctions="true", canGetAndSetFMUstate="true",
+                  canSerializeFMUstate="true")
+    me = ET.SubElement(root, "ModelExchange", common, completedIntegratorStepNotNeeded="true")
+    cs = ET.SubElement(root, "CoSimulation", common, canHandleVariableCommunicationStepSize="true",
+                       canInterpolateInputs="false")
+    for element in (me, cs):
+        files = ET.SubElement(element, "SourceFiles")
+        for name in sources(2):
+            ET.SubElement(files, "File", name=name)
+    _units(root)
+    _log_categories(root)
+    variables = ET.SubElement(root, "ModelVariables")
+    for vr, name, causality, unit, desc, start in _variables():
+        attrs = dict(name=name, valueReference=str(vr), description=f"{desc} [{unit}]", causality=causality)
+        attrs.update(variability="fixed", initial="exact") if causality == "parameter" else attrs.update(
+            variability="continuous")
+        real = ET.SubElement(ET.SubElement(variables, "ScalarVariable", attrs), "Real", unit=unit)
+        if unit == "K":
+            real.set("displayUnit", "degC")
+        if vr == VR_DER:
+            real.set("derivative", str(_vr("theta_cs") + 1))
+        if start is not None:
+            real.set("start", repr(start))
+    deps = dependencies(has_friction)
+    index = lambda vrs: " ".join(str(v + 1) for v in vrs)  # noqa: E731
+    structure = ET.SubElement(root, "ModelStructure")
+    outputs = ET.SubElement(structure, "Outputs")
+    for vr, (_, causality, _, _) in enumerate(VARIABLES):
+        if causality == "output":
+            ET.SubElement(outputs, "Unknown", index=str(vr + 1), dependencies=index(deps[vr]))
+    ET.SubElement(ET.SubElement(structure, "Derivatives"), "Unknown", index=str(VR_DER + 1),
+                  dependencies=index(deps[VR_DER]))
+    init = ET.SubElement(structure, "InitialUnknowns")
+    for vr in sorted(deps):
+        ET.SubElement(init, "Unknown", index=str(vr + 1))
+    return _finish(root)
+
+
+def fmi3_description(token: str, has_friction: bool) -> str:
+    """FMI 3.0 modelDescription.xml: ME and CS, independent variable time, ModelStructure."""
+    root = ET.Element("fmiModelDescription", fmiVersion="3.0", modelName=SLAVE, instantiationToken=token,
+                      description=DESCRIPTION, generationTool="cushion_clutch (native C)",
+                      variableNamingConvention="flat")
+    common = dict(modelIdentifier=SLAVE, canGetAndSetFMUState="true", canSerializeFMUState="true")
+    ET.SubElement(root, "ModelExchange", common, needsCompletedIntegratorStep="false")
+    ET.SubElement(root, "CoSimulation", common, canHandleVariableCommunicationStepSize="true",
+                  hasEventMode="false")
+    _units(root)
+    _log_categories(root)
+    variables = ET.SubElement(root, "ModelVariables")
+    ET.SubElement(variables, "Float64", name="time", valueReference=str(VR_TIME), causality="independent",
+                  variability="continuous", unit="s", description="simulation time [s]")
+    for vr, name, causality, unit, desc, start in _variables():
+        attrs = dict(name=name, valueReference=str(vr), description=f"{desc} [{unit}]", causality=causality)
+        attrs.update(variability="fixed", initial="exact") if causality == "parameter" else attrs.update(
+            variability="continuous")
+        attrs["unit"] = unit
+        if unit == "K":
+            attrs["displayUnit"] = "degC"
+        if vr == VR_DER:
+            attrs["derivative"] = str(_vr("theta_cs"))
+        if start is not None:
+            attrs["start"] = repr(start)
+        ET.SubElement(variables, "Float64", attrs)
+    deps = dependencies(has_friction)
+    structure = ET.SubElement(root, "ModelStructure")
+    for vr, (_, causality, _, _) in enumerate(VARIABLES):
+        if causality == "output":
+            ET.SubElement(structure, "Output", valueReference=str(vr), dependencies=" ".join(map(str, deps[vr])))
+    ET.SubElement(structure, "ContinuousStateDerivative", valueReference=str(VR_DER),
+                  dependencies=" ".join(map(str, deps[VR_DER])))
+    for vr in sorted(deps):
+        ET.SubElement(structure, "InitialUnknown", valueReference=str(vr))
+    return _finish(root)
+
+
+def fmi3_build_description() -> str:
+    """sources/buildDescription.xml of the FMI 3.0 FMU."""
+    root = ET.Element("fmiBuildDescription", fmiVersion="3.0")
+    config = ET.SubElement(root, "BuildConfiguration", modelIdentifier=SLAVE)
+    files = ET.SubElement(config, "SourceFileSet", language="C99")
+    for name in sources(3):
+        ET.SubElement(files, "SourceFile", name=name)
+    return _finish(root)

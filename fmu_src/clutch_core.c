@@ -1,0 +1,365 @@
+/*
+ * CushionClutch model core, part 2: variables, parameter and input checks, outputs, the thermal
+ * step (Co-Simulation) and derivative (Model Exchange), the state machine checks shared by both
+ * FMI versions, and the saved state (versioned, checksummed, validated).
+ */
+#include "clutch_core.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define KELVIN 273.15
+#define X_TO_LIMIT 1.0
+#define THETA_CM_LIMIT 2000.0
+#define OMEGA_SLIP_LIMIT 1e4
+
+static const char *VAR_NAMES[CC_NVARS] = {
+    "x_to", "theta_cm", "torque", "force", "theta_cs", "u_f", "x_kiss", "n_surfaces", "mu",
+    "R_eq", "U", "H", "C", "theta_a", "theta_cs_start", "x_kiss_ref", "lever_ratio", "omega_slip",
+    "der(theta_cs)"};
+
+/* defaults: inputs, outputs (start), parameters (clutch_model.ClutchParameters) */
+static const double DEFAULTS[CC_NVARS] = {
+    0.0, 293.15, 0.0, 0.0, 293.15, 0.0, 0.004, 2.0, 0.28, 0.089, 0.1, 0.04, 1.0, 293.15, 293.15,
+    0.004, 3.0, 0.0, 0.0};
+
+/* allowed parameter ranges: low, high, low open, high open (clutch_model.ClutchParameters.RANGES) */
+static const double RANGES[CC_NVARS][4] = {
+    {0}, {0}, {0}, {0}, {0}, {0}, {0},
+    {1.0, 16.0, 0, 0}, {0.0, 2.0, 0, 0}, {0.0, 1.0, 1, 0}, {0.0, 1e4, 0, 0}, {0.0, 1e4, 0, 0},
+    {0.0, 1e6, 1, 0}, {0.0, 2000.0, 1, 0}, {0.0, 2000.0, 1, 0}, {-1.0, 1.0, 0, 0},
+    {0.0, 100.0, 1, 0}, {0}, {0}};
+
+static int is_input(unsigned int vr) { return vr == VR_X_TO || vr == VR_THETA_CM || vr == VR_OMEGA_SLIP; }
+static int is_parameter(unsigned int vr) { return vr >= VR_N_SURFACES && vr <= VR_LEVER_RATIO; }
+
+static const char *phase_name(int phase) {
+    switch (phase) {
+    case PH_INSTANTIATED: return "Instantiated";
+    case PH_INIT: return "Initialization Mode";
+    case PH_STEP: return "Step Mode";
+    case PH_EVENT: return "Event Mode";
+    case PH_CONT: return "Continuous-Time Mode";
+    case PH_TERMINATED: return "Terminated";
+    default: return "Error";
+    }
+}
+
+/* ------------------------------------------------------------------ logging */
+void cc_log(CcModel *m, int status, const char *fmt, ...) {
+    char msg[1200];
+    va_list ap;
+    const char *cat = status == CC_OK ? "logAll" : status == CC_WARNING ? "logStatusWarning"
+                    : status == CC_DISCARD ? "logStatusDiscard" : "logStatusError";
+    if (!m->logger) return;
+    if (!m->logging_on && status <= CC_WARNING) return; /* errors and discards: always */
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    m->logger(m->log_ctx, status, cat, msg);
+}
+
+int cc_allowed(CcModel *m, int mask, const char *fn) {
+    if (m->phase & mask) return 1;
+    cc_log(m, CC_ERROR, "%s is not allowed in %s", fn, phase_name(m->phase));
+    return 0;
+}
+
+/* ------------------------------------------------------------ instantiation */
+int cc_instantiate(CcModel *m, const char *dir, int me, CcLogger logger, void *ctx, int logging_on) {
+    memset(m, 0, sizeof *m);
+    m->logger = logger;
+    m->log_ctx = ctx;
+    m->logging_on = logging_on;
+    m->me = me;
+    memcpy(m->r, DEFAULTS, sizeof m->r);
+    m->phase = PH_INSTANTIATED;
+    m->dirty = 1;
+    m->table_ok = cc_table_load(&m->table, dir, m->table_error, sizeof m->table_error) == 0;
+    if (!m->table_ok) cc_log(m, CC_ERROR, "cannot load the F(u, theta) tables: %s", m->table_error);
+    return m->table_ok ? 0 : -1;
+}
+
+void cc_free(CcModel *m) { cc_table_free(&m->table); }
+
+void cc_reset(CcModel *m) {
+    memcpy(m->r, DEFAULTS, sizeof m->r);
+    m->range_warned = 0;
+    m->terminated = 0;
+    m->time = 0.0;
+    m->dirty = 1;
+    m->phase = PH_INSTANTIATED;
+}
+
+/* ------------------------------------------------------------------- checks */
+static int range_ok(int k, double v) {
+    const double *g = RANGES[k];
+    return isfinite(v) && (g[2] ? v > g[0] : v >= g[0]) && (g[3] ? v < g[1] : v <= g[1]);
+}
+
+/* every parameter problem is logged (prefix names the call); returns 1 if all are valid */
+static int check_parameters(CcModel *m, const double *r, const char *fn) {
+    int k, ok = 1;
+    for (k = VR_N_SURFACES; k <= VR_LEVER_RATIO; ++k) {
+        const double *g = RANGES[k];
+        if (!range_ok(k, r[k])) {
+            cc_log(m, CC_ERROR, "%s: parameter %s = %g is out of range %c%g, %g%c", fn, VAR_NAMES[k], r[k],
+                   g[2] ? '(' : '[', g[0], g[1], g[3] ? ')' : ']');
+            ok = 0;
+        }
+    }
+    if (range_ok(VR_N_SURFACES, r[VR_N_SURFACES]) && r[VR_N_SURFACES] != floor(r[VR_N_SURFACES])) {
+        cc_log(m, CC_ERROR, "%s: parameter n_surfaces = %g must be a whole number in [1, 16]", fn, r[VR_N_SURFACES]);
+        ok = 0;
+    }
+    if (ok && !(r[VR_U] + r[VR_H] > 0.0)) {
+        cc_log(m, CC_ERROR, "%s: U + H must be > 0 (the cushion spring needs a heat path)", fn);
+        ok = 0;
+    }
+    return ok;
+}
+
+static int inputs_ok(const double *r) {
+    return isfinite(r[VR_X_TO]) && fabs(r[VR_X_TO]) <= X_TO_LIMIT && isfinite(r[VR_THETA_CM]) &&
+           r[VR_THETA_CM] > 0.0 && r[VR_THETA_CM] < THETA_CM_LIMIT && isfinite(r[VR_OMEGA_SLIP]) &&
+           fabs(r[VR_OMEGA_SLIP]) <= OMEGA_SLIP_LIMIT;
+}
+
+static void log_inputs(CcModel *m, int status, double t, const char *what) {
+    double *r = m->r;
+    if (!(isfinite(r[VR_X_TO]) && fabs(r[VR_X_TO]) <= X_TO_LIMIT))
+        cc_log(m, status, "t = %g s: input x_to = %g m is not finite or |x_to| > %g m; %s", t, r[VR_X_TO],
+               X_TO_LIMIT, what);
+    if (!(isfinite(r[VR_THETA_CM]) && r[VR_THETA_CM] > 0.0 && r[VR_THETA_CM] < THETA_CM_LIMIT))
+        cc_log(m, status, "t = %g s: input theta_cm = %g K is not finite or outside (0, %g) K; %s", t,
+               r[VR_THETA_CM], THETA_CM_LIMIT, what);
+    if (!(isfinite(r[VR_OMEGA_SLIP]) && fabs(r[VR_OMEGA_SLIP]) <= OMEGA_SLIP_LIMIT))
+        cc_log(m, status, "t = %g s: input omega_slip = %g rad/s is not finite or |omega_slip| > %g rad/s; %s", t,
+               r[VR_OMEGA_SLIP], OMEGA_SLIP_LIMIT, what);
+}
+
+/* -------------------------------------------------------------------- model */
+static void update_outputs(CcModel *m) {
+    double *r = m->r;
+    const Table *tb = &m->table;
+    double theta_c = r[VR_THETA_CS] - KELVIN;
+    double x_kiss = r[VR_X_KISS_REF] - r[VR_LEVER_RATIO] * cc_table_delta(tb, theta_c);
+    double u = (r[VR_X_TO] - x_kiss) / r[VR_LEVER_RATIO];
+    double force = cc_table_force(tb, u, theta_c);
+    double mu = tb->f_mu ? cc_table_mu(tb, r[VR_THETA_CM] - KELVIN, r[VR_OMEGA_SLIP]) : r[VR_MU];
+    double g = r[VR_U] + r[VR_H];
+    r[VR_TORQUE] = r[VR_N_SURFACES] * mu * r[VR_R_EQ] * force;
+    r[VR_FORCE] = force;
+    r[VR_U_F] = u > 0.0 ? u : 0.0;
+    r[VR_X_KISS] = x_kiss;
+    r[CC_VR_DER_THETA_CS] = (r[VR_U] * r[VR_THETA_CM] + r[VR_H] * r[VR_THETA_A] - g * r[VR_THETA_CS]) / r[VR_C];
+    m->dirty = 0;
+    if (!(tb->theta[0] + KELVIN <= r[VR_THETA_CS] && r[VR_THETA_CS] <= tb->theta[tb->nt - 1] + KELVIN) &&
+        !m->range_warned) {
+        m->range_warned = 1;
+        cc_log(m, CC_WARNING, "theta_cs = %.2f K is outside the table range [%.2f, %.2f] K; F and the kiss point "
+               "are clamped to the nearest table temperature (warned once)", r[VR_THETA_CS],
+               tb->theta[0] + KELVIN, tb->theta[tb->nt - 1] + KELVIN);
+    }
+}
+
+/* outputs of the current inputs and state (in Initialization Mode: theta_cs = theta_cs_start);
+   with invalid inputs they keep their last values */
+static void refresh(CcModel *m) {
+    if (!m->dirty || !inputs_ok(m->r)) return;
+    if (m->phase == PH_INIT) {
+        if (!(m->r[VR_LEVER_RATIO] > 0.0 && m->r[VR_C] > 0.0)) return;
+        m->r[VR_THETA_CS] = m->r[VR_THETA_CS_START];
+    } else if (!(m->phase & (PH_STEP | PH_EVENT | PH_CONT | PH_TERMINATED))) {
+        return;
+    }
+    update_outputs(m);
+}
+
+int cc_set_real(CcModel *m, const unsigned int vr[], size_t n, const double v[], const char *fn) {
+    size_t k;
+    int after_init = (m->phase & (PH_STEP | PH_EVENT | PH_CONT)) != 0;
+    if (!cc_allowed(m, PH_INSTANTIATED | PH_INIT | PH_STEP | PH_EVENT | PH_CONT, fn)) return CC_ERROR;
+    if (n && (!vr || !v)) { cc_log(m, CC_ERROR, "%s: NULL value reference or value array", fn); return CC_ERROR; }
+    for (k = 0; k < n; ++k) { /* validate all first: a refused call changes nothing */
+        if (vr[k] >= CC_NVARS) {
+            cc_log(m, CC_ERROR, "%s: unknown value reference %u", fn, vr[k]);
+            return CC_ERROR;
+        }
+        if (!is_input(vr[k]) && !is_parameter(vr[k])) {
+            cc_log(m, CC_ERROR, "%s: %s (value reference %u) is not an input or parameter and cannot be set", fn,
+                   VAR_NAMES[vr[k]], vr[k]);
+            return CC_ERROR;
+        }
+        if (is_parameter(vr[k]) && after_init) {
+            cc_log(m, CC_ERROR, "%s: parameter %s is fixed after initialization", fn, VAR_NAMES[vr[k]]);
+            return CC_ERROR;
+        }
+    }
+    for (k = 0; k < n; ++k) m->r[vr[k]] = v[k];
+    if (n) m->dirty = 1;
+    return CC_OK;
+}
+
+int cc_get_real(CcModel *m, const unsigned int vr[], size_t n, double v[], const char *fn) {
+    size_t k;
+    if (!cc_allowed(m, PH_ANY & ~PH_INSTANTIATED, fn)) return CC_ERROR;
+    if (n && (!vr || !v)) { cc_log(m, CC_ERROR, "%s: NULL value reference or value array", fn); return CC_ERROR; }
+    for (k = 0; k < n; ++k)
+        if (vr[k] >= CC_NVARS) {
+            cc_log(m, CC_ERROR, "%s: unknown value reference %u", fn, vr[k]);
+            return CC_ERROR;
+        }
+    if (m->dirty) refresh(m);
+    for (k = 0; k < n; ++k) v[k] = m->r[vr[k]];
+    return CC_OK;
+}
+
+int cc_enter_init(CcModel *m, double start_time, const char *fn) {
+    if (!cc_allowed(m, PH_INSTANTIATED, fn)) return CC_ERROR;
+    if (!m->table_ok) {
+        cc_log(m, CC_ERROR, "%s: cannot load the F(u, theta) tables: %s", fn, m->table_error);
+        return CC_ERROR;
+    }
+    m->time = start_time;
+    m->phase = PH_INIT;
+    return CC_OK;
+}
+
+int cc_exit_init(CcModel *m, const char *fn) {
+    if (!cc_allowed(m, PH_INIT, fn)) return CC_ERROR;
+    if (!check_parameters(m, m->r, fn)) {
+        m->r[VR_TORQUE] = m->r[VR_FORCE] = m->r[VR_U_F] = 0.0;
+        m->phase = PH_ERROR;
+        return CC_ERROR;
+    }
+    m->r[VR_THETA_CS] = m->r[VR_THETA_CS_START];
+    m->phase = m->me ? PH_EVENT : PH_STEP;
+    m->dirty = 1;
+    refresh(m);
+    return CC_OK;
+}
+
+int cc_do_step(CcModel *m, double t, double h, const char *fn) {
+    double g, theta_inf, *r = m->r;
+    int status = CC_OK;
+    if (!cc_allowed(m, PH_STEP, fn)) return CC_ERROR;
+    if (!(isfinite(h) && h >= 0.0 && isfinite(t))) {
+        cc_log(m, CC_DISCARD, "%s: t = %g s: step size %g s must be finite and >= 0; step refused", fn, t, h);
+        m->terminated = 1;
+        return CC_DISCARD;
+    }
+    if (!inputs_ok(r)) {
+        log_inputs(m, CC_DISCARD, t, "step refused");
+        m->terminated = 1;
+        return CC_DISCARD;
+    }
+    if (fabs(t - m->time) > 1e-9 * (1.0 + fabs(t))) {
+        cc_log(m, CC_WARNING, "%s: currentCommunicationPoint = %.17g s does not follow the previous step "
+               "(expected %.17g s); accepted", fn, t, m->time);
+        status = CC_WARNING;
+    }
+    g = r[VR_U] + r[VR_H];
+    theta_inf = (r[VR_U] * r[VR_THETA_CM] + r[VR_H] * r[VR_THETA_A]) / g;
+    r[VR_THETA_CS] = theta_inf + (r[VR_THETA_CS] - theta_inf) * exp(-h * g / r[VR_C]);
+    update_outputs(m);
+    m->time = t + h;
+    m->terminated = 0;
+    return status;
+}
+
+int cc_derivative(CcModel *m, double *der, const char *fn) {
+    const double *r = m->r;
+    double theta;
+    if (!cc_allowed(m, PH_INIT | PH_EVENT | PH_CONT | PH_TERMINATED | PH_ERROR, fn)) return CC_ERROR;
+    if (!inputs_ok(r)) {
+        log_inputs(m, CC_ERROR, m->time, "no derivative");
+        return CC_ERROR;
+    }
+    theta = m->phase == PH_INIT ? r[VR_THETA_CS_START] : r[VR_THETA_CS];
+    *der = (r[VR_U] * r[VR_THETA_CM] + r[VR_H] * r[VR_THETA_A] - (r[VR_U] + r[VR_H]) * theta) / r[VR_C];
+    return CC_OK;
+}
+
+int cc_set_state_value(CcModel *m, double theta_cs, const char *fn) {
+    if (!cc_allowed(m, PH_CONT, fn)) return CC_ERROR;
+    if (!(isfinite(theta_cs) && theta_cs > 0.0 && theta_cs < THETA_CM_LIMIT)) {
+        cc_log(m, CC_ERROR, "%s: theta_cs = %g K is not finite or outside (0, %g) K", fn, theta_cs, THETA_CM_LIMIT);
+        return CC_ERROR;
+    }
+    m->r[VR_THETA_CS] = theta_cs;
+    m->dirty = 1;
+    return CC_OK;
+}
+
+/* -------------------------------------------------------------- saved state */
+static uint64_t fnv1a(const void *data, size_t n) {
+    const unsigned char *p = (const unsigned char *)data;
+    uint64_t h = 1469598103934665603ull;
+    size_t k;
+    for (k = 0; k < n; ++k) { h ^= p[k]; h *= 1099511628211ull; }
+    return h;
+}
+
+void cc_state_save(const CcModel *m, CcState *s) {
+    memset(s, 0, sizeof *s);
+    s->magic = CC_STATE_MAGIC;
+    s->version = CC_STATE_VERSION;
+    s->size = (uint32_t)sizeof *s;
+    s->phase = m->phase;
+    s->me = m->me;
+    s->range_warned = m->range_warned;
+    s->terminated = m->terminated;
+    s->time = m->time;
+    memcpy(s->r, m->r, sizeof s->r);
+    s->checksum = fnv1a(s, offsetof(CcState, checksum));
+}
+
+/* 1 if bytes hold a valid state for this instance; otherwise logs why and returns 0 */
+int cc_state_check(CcModel *m, const void *bytes, size_t size, const char *fn) {
+    CcState s;
+    int k, valid_phases = m->me ? (PH_ANY & ~PH_STEP) : (PH_ANY & ~PH_CONT);
+    if (!bytes || size != sizeof s) {
+        cc_log(m, CC_ERROR, "%s: not a CushionClutch state (%lu bytes, expected %lu)", fn, (unsigned long)size,
+               (unsigned long)sizeof s);
+        return 0;
+    }
+    memcpy(&s, bytes, sizeof s);
+    if (s.magic != CC_STATE_MAGIC || s.version != CC_STATE_VERSION || s.size != sizeof s) {
+        cc_log(m, CC_ERROR, "%s: not a CushionClutch state of version %u", fn, CC_STATE_VERSION);
+        return 0;
+    }
+    if (s.checksum != fnv1a(&s, offsetof(CcState, checksum))) {
+        cc_log(m, CC_ERROR, "%s: the state's checksum does not match: corrupted", fn);
+        return 0;
+    }
+    if (s.me != m->me || (s.phase & valid_phases) == 0 || (s.phase & (s.phase - 1)) != 0) {
+        cc_log(m, CC_ERROR, "%s: the state's phase %d is not valid for this %s instance", fn, s.phase,
+               m->me ? "Model Exchange" : "Co-Simulation");
+        return 0;
+    }
+    for (k = 0; k < CC_NVARS; ++k)
+        if (!isfinite(s.r[k])) {
+            cc_log(m, CC_ERROR, "%s: the state's %s = %g is not finite", fn, VAR_NAMES[k], s.r[k]);
+            return 0;
+        }
+    if (!isfinite(s.time) || !(s.r[VR_THETA_CS] > 0.0 && s.r[VR_THETA_CS] < THETA_CM_LIMIT) ||
+        !(s.range_warned == 0 || s.range_warned == 1) || !(s.terminated == 0 || s.terminated == 1)) {
+        cc_log(m, CC_ERROR, "%s: the state's time, theta_cs or flags are out of range", fn);
+        return 0;
+    }
+    if (s.phase != PH_INSTANTIATED && s.phase != PH_INIT && s.phase != PH_ERROR && !check_parameters(m, s.r, fn))
+        return 0;
+    return 1;
+}
+
+void cc_state_load(CcModel *m, const CcState *s) {
+    memcpy(m->r, s->r, sizeof m->r);
+    m->phase = s->phase;
+    m->range_warned = s->range_warned;
+    m->terminated = s->terminated;
+    m->time = s->time;
+    m->dirty = 1;
+}

@@ -1,0 +1,398 @@
+/*
+ * CushionClutch model core, part 1: the table set (force_deflection.csv, kiss_point.csv, optional
+ * friction.csv) read from the FMU's resources, its interpolation (as fmu_src/spring_table.py and
+ * friction.py, operation for operation), and the resource URI -> path conversion.
+ */
+#include "clutch_core.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#ifdef _WIN32
+#include <windows.h>
+#endif
+
+#define MU_LIMIT 2.0
+#define FORCE_LIMIT 1e12 /* N: n*mu*R_eq*F stays finite for every allowed parameter */
+
+/* ----------------------------------------------------------- interpolation */
+static double sign_(double v) { return (v > 0) - (v < 0); }
+
+static double end_slope(double h0, double h1, double m0, double m1) {
+    double d = ((2 * h0 + h1) * m0 - h0 * m1) / (h0 + h1);
+    if (sign_(d) != sign_(m0)) return 0.0;
+    if (sign_(m0) != sign_(m1) && fabs(d) > fabs(3 * m0)) return 3 * m0;
+    return d;
+}
+
+/* slopes of the monotone cubic Hermite interpolant (as spring_table.pchip_slopes) */
+static void pchip_slopes(const double *x, const double *y, double *d, int n) {
+    int k;
+    if (n == 2) {
+        d[0] = d[1] = (y[1] - y[0]) / (x[1] - x[0]);
+        return;
+    }
+    for (k = 1; k < n - 1; ++k) {
+        double h0 = x[k] - x[k - 1], h1 = x[k + 1] - x[k];
+        double m0 = (y[k] - y[k - 1]) / h0, m1 = (y[k + 1] - y[k]) / h1;
+        double w1 = 2 * h1 + h0, w2 = h1 + 2 * h0;
+        d[k] = (m0 * m1 > 0) ? (w1 + w2) / (w1 / m0 + w2 / m1) : 0.0;
+    }
+    d[0] = end_slope(x[1] - x[0], x[2] - x[1], (y[1] - y[0]) / (x[1] - x[0]), (y[2] - y[1]) / (x[2] - x[1]));
+    d[n - 1] = end_slope(x[n - 1] - x[n - 2], x[n - 2] - x[n - 3], (y[n - 1] - y[n - 2]) / (x[n - 1] - x[n - 2]),
+                         (y[n - 2] - y[n - 3]) / (x[n - 2] - x[n - 3]));
+}
+
+static double curve_eval(const Curve *c, double u) {
+    int lo = 0, hi = c->n - 1, i;
+    double h, t, t2, t3;
+    if (u <= c->x[0]) return c->y[0];
+    if (u >= c->x[c->n - 1]) return c->y[c->n - 1];
+    while (hi - lo > 1) { /* x[lo] <= u < x[hi] */
+        int mid = (lo + hi) / 2;
+        if (c->x[mid] <= u) lo = mid; else hi = mid;
+    }
+    i = lo;
+    h = c->x[i + 1] - c->x[i];
+    t = (u - c->x[i]) / h;
+    t2 = t * t;
+    t3 = t * t * t;
+    return (2 * t3 - 3 * t2 + 1) * c->y[i] + (t3 - 2 * t2 + t) * h * c->d[i] + (-2 * t3 + 3 * t2) * c->y[i + 1] +
+           (t3 - t2) * h * c->d[i + 1];
+}
+
+/* grid index and weight of v in g[0..n-1] (clamped) */
+static void grid_bracket(const double *g, int n, double v, int *i, double *w) {
+    int lo = 0, hi = n - 1;
+    if (n == 1 || v <= g[0]) { *i = 0; *w = 0.0; return; }
+    if (v >= g[n - 1]) { *i = n - 2; *w = 1.0; return; }
+    while (hi - lo > 1) {
+        int mid = (lo + hi) / 2;
+        if (g[mid] <= v) lo = mid; else hi = mid;
+    }
+    *i = lo;
+    *w = (v - g[lo]) / (g[lo + 1] - g[lo]);
+}
+
+double cc_table_force(const Table *tb, double u, double theta) {
+    int i; double w, f0;
+    grid_bracket(tb->theta, tb->nt, theta, &i, &w);
+    f0 = curve_eval(&tb->curves[i], u);
+    return w == 0.0 ? f0 : (1.0 - w) * f0 + w * curve_eval(&tb->curves[i + 1], u);
+}
+
+double cc_table_delta(const Table *tb, double theta) {
+    int i; double w;
+    grid_bracket(tb->theta, tb->nt, theta, &i, &w);
+    return w == 0.0 ? tb->delta[i] : (1.0 - w) * tb->delta[i] + w * tb->delta[i + 1];
+}
+
+/* mu(theta_cm degC, |omega|): bilinear on the friction grid, clamped (as friction.FrictionTable) */
+double cc_table_mu(const Table *tb, double theta, double omega) {
+    int i, j, i1, j1;
+    double wi, wj, lo, hi;
+    const double *m = tb->f_mu;
+    grid_bracket(tb->f_theta, tb->ntf, theta, &i, &wi);
+    grid_bracket(tb->f_omega, tb->nw, fabs(omega), &j, &wj);
+    i1 = i + 1 < tb->ntf ? i + 1 : tb->ntf - 1;
+    j1 = j + 1 < tb->nw ? j + 1 : tb->nw - 1;
+    lo = (1.0 - wj) * m[i * tb->nw + j] + wj * m[i * tb->nw + j1];
+    hi = (1.0 - wj) * m[i1 * tb->nw + j] + wj * m[i1 * tb->nw + j1];
+    return (1.0 - wi) * lo + wi * hi;
+}
+
+/* ------------------------------------------------------------------ reading */
+static int cmp_double(const void *a, const void *b) {
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* sorted unique values of column col of rows x ncol data into out; returns count */
+static int unique_sorted(const double *data, int rows, int ncol, int col, double *out) {
+    int k, n = 0;
+    for (k = 0; k < rows; ++k) out[k] = data[k * ncol + col];
+    qsort(out, rows, sizeof(double), cmp_double);
+    for (k = 0; k < rows; ++k)
+        if (n == 0 || out[k] != out[n - 1]) out[n++] = out[k];
+    return n;
+}
+
+void cc_table_free(Table *tb) {
+    int k;
+    if (tb->curves)
+        for (k = 0; k < tb->nt; ++k) { free(tb->curves[k].x); free(tb->curves[k].y); free(tb->curves[k].d); }
+    free(tb->curves); free(tb->theta); free(tb->delta);
+    free(tb->f_theta); free(tb->f_omega); free(tb->f_mu);
+    memset(tb, 0, sizeof *tb);
+}
+
+FILE *cc_fopen(const char *path, const char *mode) {
+#ifdef _WIN32
+    wchar_t wpath[4096], wmode[8];
+    if (!MultiByteToWideChar(CP_UTF8, MB_ERR_INVALID_CHARS, path, -1, wpath, 4096) ||
+        !MultiByteToWideChar(CP_UTF8, 0, mode, -1, wmode, 8))
+        return NULL;
+    return _wfopen(wpath, wmode);
+#else
+    return fopen(path, mode);
+#endif
+}
+
+/* Read a CSV with a fixed header into rows of ncol finite doubles; lines[r] is the file line of row r.
+   Returns the number of rows or -1 (message in err, naming the file and line). */
+static int read_csv(const char *path, const char *header, int ncol, double **out, int **lines, char *err,
+                    size_t errlen) {
+    FILE *f = cc_fopen(path, "r");
+    char line[4096];
+    int rows = 0, cap = 256, lineno = 1;
+    double *data;
+    int *where;
+    if (!f) { snprintf(err, errlen, "cannot open %s", path); return -1; }
+    if (!fgets(line, sizeof line, f)) { snprintf(err, errlen, "%s is empty", path); fclose(f); return -1; }
+    line[strcspn(line, "\r\n")] = 0;
+    if (strcmp(line, header) != 0) {
+        snprintf(err, errlen, "%s line 1: header must be %s", path, header); fclose(f); return -1;
+    }
+    data = (double *)malloc(sizeof(double) * cap * ncol);
+    where = (int *)malloc(sizeof(int) * cap);
+    if (!data || !where) { free(data); free(where); snprintf(err, errlen, "out of memory"); fclose(f); return -1; }
+    while (fgets(line, sizeof line, f)) {
+        char *p = line, *end;
+        int k;
+        ++lineno;
+        if (strspn(line, " \t\r\n") == strlen(line)) continue;
+        if (rows == cap) {
+            double *grown = (double *)realloc(data, sizeof(double) * (size_t)(cap * 2) * ncol);
+            int *wgrown = grown ? (int *)realloc(where, sizeof(int) * (size_t)(cap * 2)) : NULL;
+            if (grown) data = grown;
+            if (!grown || !wgrown) {
+                free(data); free(where); snprintf(err, errlen, "out of memory"); fclose(f); return -1;
+            }
+            where = wgrown;
+            cap *= 2;
+        }
+        for (k = 0; k < ncol; ++k) {
+            double v = strtod(p, &end);
+            if (end == p || !isfinite(v) || (k < ncol - 1 && *end != ',') ||
+                (k == ncol - 1 && strspn(end, " \t\r\n") != strlen(end))) {
+                snprintf(err, errlen, "%s line %d: expected %d finite numbers", path, lineno, ncol);
+                free(data); free(where); fclose(f); return -1;
+            }
+            data[rows * ncol + k] = v;
+            p = end + 1;
+        }
+        where[rows++] = lineno;
+    }
+    fclose(f);
+    *out = data;
+    *lines = where;
+    return rows;
+}
+
+static int load_friction(Table *tb, const char *path, char *err, size_t errlen) {
+    double *fr = NULL;
+    int *ln = NULL, nfr, r;
+    nfr = read_csv(path, "theta_degC,omega_slip_rad_s,mu", 3, &fr, &ln, err, errlen);
+    if (nfr < 0) return -1;
+    tb->f_theta = (double *)malloc(sizeof(double) * (nfr + 1));
+    tb->f_omega = (double *)malloc(sizeof(double) * (nfr + 1));
+    tb->f_mu = (double *)malloc(sizeof(double) * (nfr + 1));
+    if (!tb->f_theta || !tb->f_omega || !tb->f_mu) { snprintf(err, errlen, "out of memory"); goto fail; }
+    tb->ntf = nfr ? unique_sorted(fr, nfr, 3, 0, tb->f_theta) : 0;
+    tb->nw = nfr ? unique_sorted(fr, nfr, 3, 1, tb->f_omega) : 0;
+    if (nfr == 0 || tb->ntf * tb->nw != nfr || tb->f_omega[0] < 0.0) {
+        snprintf(err, errlen, "%s: rows must form a full grid of temperatures x slip speeds >= 0, each once", path);
+        goto fail;
+    }
+    for (r = 0; r < nfr; ++r) tb->f_mu[r] = -1.0;
+    for (r = 0; r < nfr; ++r) {
+        double *pt = (double *)bsearch(&fr[3 * r], tb->f_theta, tb->ntf, sizeof(double), cmp_double);
+        double *pw = (double *)bsearch(&fr[3 * r + 1], tb->f_omega, tb->nw, sizeof(double), cmp_double);
+        double mu = fr[3 * r + 2];
+        int at = (int)(pt - tb->f_theta) * tb->nw + (int)(pw - tb->f_omega);
+        if (!(mu >= 0.0 && mu <= MU_LIMIT) || tb->f_mu[at] >= 0.0) {
+            snprintf(err, errlen, "%s line %d: mu must be in [0, %g] and each grid point given once", path, ln[r],
+                     MU_LIMIT);
+            goto fail;
+        }
+        tb->f_mu[at] = mu;
+    }
+    free(fr); free(ln);
+    return 0;
+fail:
+    free(fr); free(ln);
+    return -1;
+}
+
+/* One F(u) curve per temperature; the groups may come in any order, rows keep their file order
+   within a group (as SpringTable.from_dir). kiss_point.csv rows may come in any order too. */
+int cc_table_load(Table *tb, const char *dir, char *err, size_t errlen) {
+    char path[4200], kpath[4200];
+    double *fd = NULL, *kp = NULL, *uniq = NULL;
+    int *fdl = NULL, *kpl = NULL, nfd, nkp, k, t, nt;
+    FILE *probe;
+    memset(tb, 0, sizeof *tb);
+    if (strlen(dir) > 4000) { snprintf(err, errlen, "resource path too long"); return -1; }
+    snprintf(path, sizeof path, "%s/tables/force_deflection.csv", dir);
+    snprintf(kpath, sizeof kpath, "%s/tables/kiss_point.csv", dir);
+    nfd = read_csv(path, "theta_degC,u_m,force_N", 3, &fd, &fdl, err, errlen);
+    if (nfd < 0) return -1;
+    nkp = read_csv(kpath, "theta_degC,delta_kiss_m", 2, &kp, &kpl, err, errlen);
+    if (nkp < 0) goto fail;
+    for (k = 0; k < nfd; ++k)
+        if (!(fabs(fd[3 * k + 2]) <= FORCE_LIMIT)) {
+            snprintf(err, errlen, "%s line %d: force_N = %g is outside [-%g, %g] N (the torque would overflow)",
+                     path, fdl[k], fd[3 * k + 2], FORCE_LIMIT, FORCE_LIMIT);
+            goto fail;
+        }
+    uniq = (double *)malloc(sizeof(double) * (nfd + nkp + 1));
+    if (!uniq) { snprintf(err, errlen, "out of memory"); goto fail; }
+    nt = nfd ? unique_sorted(fd, nfd, 3, 0, uniq) : 0;
+    if (nt < 1) { snprintf(err, errlen, "%s has no rows", path); goto fail; }
+    tb->nt = nt;
+    tb->theta = uniq;
+    uniq = NULL;
+    tb->delta = (double *)calloc(nt, sizeof(double));
+    tb->curves = (Curve *)calloc(nt, sizeof(Curve));
+    if (!tb->delta || !tb->curves) { snprintf(err, errlen, "out of memory"); goto fail; }
+    /* kiss_point.csv: exactly the temperatures of force_deflection.csv, each once */
+    for (t = 0; t < nt; ++t) tb->delta[t] = NAN;
+    for (k = 0; k < nkp; ++k) {
+        double *at = (double *)bsearch(&kp[2 * k], tb->theta, nt, sizeof(double), cmp_double);
+        if (!at || !isnan(tb->delta[at - tb->theta])) {
+            snprintf(err, errlen, "%s line %d: temperature %g degC is %s", kpath, kpl[k], kp[2 * k],
+                     at ? "given twice" : "not in force_deflection.csv");
+            goto fail;
+        }
+        tb->delta[at - tb->theta] = kp[2 * k + 1];
+    }
+    for (t = 0; t < nt; ++t)
+        if (isnan(tb->delta[t])) {
+            snprintf(err, errlen, "%s: temperature %g degC of force_deflection.csv is missing", kpath, tb->theta[t]);
+            goto fail;
+        }
+    for (t = 0; t < nt; ++t) {
+        Curve *c = &tb->curves[t];
+        int n = 0, j;
+        for (k = 0; k < nfd; ++k) n += fd[3 * k] == tb->theta[t];
+        c->x = (double *)malloc(sizeof(double) * n);
+        c->y = (double *)malloc(sizeof(double) * n);
+        c->d = (double *)malloc(sizeof(double) * n);
+        if (!c->x || !c->y || !c->d) { snprintf(err, errlen, "out of memory"); goto fail; }
+        for (k = 0, j = 0; k < nfd; ++k) {
+            if (fd[3 * k] != tb->theta[t]) continue;
+            c->x[j] = fd[3 * k + 1];
+            c->y[j] = fd[3 * k + 2];
+            if (j > 0 && (!(c->x[j] > c->x[j - 1]) || c->y[j] < c->y[j - 1])) {
+                snprintf(err, errlen, "%s line %d: curve at %g degC: u must increase and force must not decrease",
+                         path, fdl[k], tb->theta[t]);
+                c->n = j;
+                goto fail;
+            }
+            ++j;
+        }
+        c->n = n;
+        if (n < 2) {
+            snprintf(err, errlen, "%s: curve at %g degC needs at least 2 rows, has %d", path, tb->theta[t], n);
+            goto fail;
+        }
+        pchip_slopes(c->x, c->y, c->d, n);
+    }
+    free(fd); free(kp); free(fdl); free(kpl);
+    fd = kp = NULL;
+    fdl = kpl = NULL;
+    snprintf(path, sizeof path, "%s/tables/friction.csv", dir);
+    probe = cc_fopen(path, "r");
+    if (probe) {
+        fclose(probe);
+        if (load_friction(tb, path, err, errlen) != 0) goto fail;
+    }
+    return 0;
+fail:
+    free(fd); free(kp); free(fdl); free(kpl); free(uniq);
+    cc_table_free(tb);
+    return -1;
+}
+
+/* --------------------------------------------------------------- URI -> path */
+static int hexval(char ch) {
+    if (ch >= '0' && ch <= '9') return ch - '0';
+    if (ch >= 'a' && ch <= 'f') return ch - 'a' + 10;
+    if (ch >= 'A' && ch <= 'F') return ch - 'A' + 10;
+    return -1;
+}
+
+static int is_drive(const char *p) {
+    return ((p[0] >= 'A' && p[0] <= 'Z') || (p[0] >= 'a' && p[0] <= 'z')) && (p[1] == ':' || p[1] == '|') &&
+           (p[2] == '/' || p[2] == '\\' || p[2] == 0);
+}
+
+/* file:///C:/a%20b -> C:\a b (windows) ; file:///a/b -> /a/b ; file://localhost/a -> /a ;
+   file:/C:/a, file://C:/a -> C:\a ; file://server/share/x -> \\server\share\x (windows; refused on POSIX).
+   A string without the file: scheme is taken as a path as it is. Trailing separators are dropped. */
+int cc_uri_to_path(const char *uri, int windows, char *out, size_t len, char *err, size_t errlen) {
+    const char *p = uri, *host = NULL;
+    size_t o = 0, hostlen = 0;
+    if (!uri || !*uri) { snprintf(err, errlen, "empty resource location"); return -1; }
+    if (strncmp(p, "file:", 5) != 0) {
+        if (strlen(p) + 1 > len) { snprintf(err, errlen, "resource path too long"); return -1; }
+        strcpy(out, p);
+        o = strlen(out);
+        goto trim;
+    }
+    p += 5;
+    if (p[0] == '/' && p[1] == '/') { /* authority */
+        const char *a = p + 2, *slash = a;
+        while (*slash && *slash != '/') ++slash;
+        if (windows && is_drive(a)) { /* file://C:/x (non-standard, seen in the wild) */
+            p = a;
+        } else {
+            host = a;
+            hostlen = (size_t)(slash - a);
+            p = slash;
+            if (hostlen == 0 || (hostlen == 9 && strncmp(host, "localhost", 9) == 0)) host = NULL;
+        }
+    }
+    if (host) {
+        if (!windows) {
+            snprintf(err, errlen, "file URI names the host '%.*s': only local files can be read", (int)hostlen,
+                     host);
+            return -1;
+        }
+        if (hostlen + 3 > len) { snprintf(err, errlen, "resource path too long"); return -1; }
+        out[o++] = '/'; out[o++] = '/';
+        memcpy(out + o, host, hostlen);
+        o += hostlen;
+    } else if (windows && p[0] == '/' && is_drive(p + 1)) {
+        ++p; /* /C:/x -> C:/x */
+    }
+    for (; *p; ++p) {
+        char ch = *p;
+        if (ch == '?' || ch == '#') break;
+        if (ch == '%') {
+            int hi = hexval(p[1]), lo = hi < 0 ? -1 : hexval(p[2]);
+            if (hi < 0 || lo < 0) {
+                snprintf(err, errlen, "bad percent-encoding in resource location %s", uri);
+                return -1;
+            }
+            ch = (char)(hi * 16 + lo);
+            if (ch == 0) { snprintf(err, errlen, "%%00 in resource location %s", uri); return -1; }
+            p += 2;
+        }
+        if (o + 2 > len) { snprintf(err, errlen, "resource path too long"); return -1; }
+        out[o++] = ch;
+    }
+    if (windows && o >= 2 && out[1] == '|') out[1] = ':';
+trim:
+    while (o > 1 && (out[o - 1] == '/' || (windows && out[o - 1] == '\\'))) {
+        if (windows && o == 3 && out[1] == ':') break; /* keep C:/ */
+        --o;
+    }
+    out[o] = 0;
+    if (windows) {
+        size_t k;
+        for (k = 0; k < o; ++k)
+            if (out[k] == '/') out[k] = '\\';
+    }
+    return 0;
+}

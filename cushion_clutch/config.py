@@ -102,10 +102,28 @@ def build_checked(top_cls: type, data: dict[str, Any], source: str | None = None
     raise ParameterError(problems, source)
 
 
-def load_toml(path: str | Path) -> dict[str, Any]:
-    """Read a TOML file; a syntax error becomes a :class:`ParameterError`."""
+def load_toml(path: str | Path, required: tuple[str, ...] = ()) -> dict[str, Any]:
+    """Read a TOML file that must not be empty and must hold the ``required`` top-level keys.
+
+    Raises
+    ------
+    ParameterError
+        Naming the file: missing or unreadable, not UTF-8 text, a TOML syntax
+        error, an empty document, or a required key absent.
+    """
     path = Path(path)
     try:
-        return tomllib.loads(path.read_text(encoding="utf-8"))
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError as exc:
+        raise ParameterError(["file does not exist"], str(path)) from exc
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ParameterError([f"cannot read the file: {exc}"], str(path)) from exc
     except tomllib.TOMLDecodeError as exc:
         raise ParameterError([f"TOML syntax error: {exc}"], str(path)) from exc
+    if not data:
+        raise ParameterError(["the file is empty: it must set at least "
+                              + (", ".join(required) if required else "one key")], str(path))
+    missing = [f"{key}: required key missing" for key in required if key not in data]
+    if missing:
+        raise ParameterError(missing, str(path))
+    return data

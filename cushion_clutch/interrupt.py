@@ -131,7 +131,7 @@ def handle_signals() -> Iterator[None]:
         first = not _cancelled.is_set()
         cancel(signum)
         if first:
-            log.warning("signal %d: cancelling queued cases and ending running solver processes", signum)
+            log.info("signal %d: cancelling queued cases and ending running solver processes", signum)
             raise RunInterrupted(signum)
 
     old = {s: signal.signal(s, handler) for s in (signal.SIGINT, signal.SIGTERM)}

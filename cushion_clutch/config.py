@@ -62,6 +62,29 @@ class Checked:
         return ()
 
 
+def _type_problems(cls: type, section: str, values: dict[str, Any]) -> Iterable[str]:
+    """Values whose type does not match the field's default: lists, strings and booleans.
+
+    Numbers are left to the range checks (which name the allowed range).
+    """
+    for f in fields(cls):
+        if f.name not in values or f.default is dataclasses.MISSING:
+            continue
+        v, default = values[f.name], f.default
+        key = f"{section}.{f.name}"
+        if isinstance(default, tuple):
+            if not isinstance(v, tuple):
+                yield f"{key} = {v!r}: must be a list"
+            elif default and all(isinstance(d, (int, float)) and not isinstance(d, bool) for d in default) and \
+                    not all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in v):
+                yield f"{key} = {list(v)!r}: must be a list of numbers"
+        elif isinstance(default, bool):
+            if not isinstance(v, bool):
+                yield f"{key} = {v!r}: must be true or false"
+        elif isinstance(default, str) and not isinstance(v, str):
+            yield f"{key} = {v!r}: must be a string"
+
+
 def build_checked(top_cls: type, data: dict[str, Any], source: str | None = None) -> Any:
     """Build a checked dataclass of sections (``top_cls``) from nested dicts.
 
@@ -85,11 +108,21 @@ def build_checked(top_cls: type, data: dict[str, Any], source: str | None = None
                 problems.append(f"{key}.{k}: unknown key (allowed: {', '.join(sorted(allowed))})")
             kwargs = {k: (tuple(v) if isinstance(v, list) else v)
                       for k, v in value.items() if k in allowed}
+            shape = list(_type_problems(cls, key, kwargs))
+            if shape:
+                problems.extend(shape)
+                continue
             try:
                 top[key] = cls(**kwargs)
             except ParameterError as exc:
                 problems.extend(exc.problems)
+            except (TypeError, ValueError, ArithmeticError) as exc:   # a check the types above missed
+                problems.append(f"[{key}]: invalid values ({exc})")
         elif key in plain:
+            default = next(f.default for f in fields(top_cls) if f.name == key)
+            if isinstance(default, str) and not isinstance(value, str):
+                problems.append(f"{key} = {value!r}: must be a string")
+                continue
             top[key] = value
         else:
             problems.append(f"{key}: unknown key (allowed: {', '.join(sorted(plain | set(sections)))})")

@@ -119,8 +119,10 @@ class OutputSet:
 
     def __enter__(self) -> Path:
         check_writable(self.folder)
-        if self.stage.exists():
-            shutil.rmtree(self.stage)
+        for old in self.folder.glob(f".{self.name}.staging-*"):    # left by a killed run
+            pid = old.name.rsplit("-", 1)[-1]
+            if old == self.stage or not (pid.isdigit() and Path(f"/proc/{pid}").exists()):
+                shutil.rmtree(old, ignore_errors=True)
         self.stage.mkdir()
         return self.stage
 

@@ -18,16 +18,16 @@ as the wrapper allows:
   strings, so every ``%`` is doubled here.
 - The wrapper drops every message when ``loggingOn`` is false; errors are
   therefore also written to the process's standard error.
-- Serialized states carry a format tag and a SHA-256 checksum; a state is
+- Serialized states carry a format tag and a CRC-32 checksum; a state is
   checked (tag, checksum, every variable finite, phase, parameter ranges)
   before it is applied, and never raises.
 """
 from __future__ import annotations
 
-import hashlib
 import json
 import math
 import sys
+import zlib
 from dataclasses import fields
 from pathlib import Path
 
@@ -49,6 +49,12 @@ PHASES = ("instantiated", "initialization", "stepping", "terminated")
 def _escape(msg: str) -> str:
     """The message as a printf format that prints it verbatim (the wrapper formats it)."""
     return str(msg).replace("%", "%%")
+
+
+def _crc(text: str) -> str:
+    """CRC-32 of a serialized state body (zlib: hashlib would load OpenSSL, whose exit
+    handlers turn the wrapper's teardown use-after-free into an abort in C hosts)."""
+    return format(zlib.crc32(text.encode("utf-8")), "08x")
 
 
 def _tidy_sys_path(resources) -> None:
@@ -330,8 +336,7 @@ class CushionClutch(Fmi2Slave):
     @staticmethod
     def _fmu_state_to_bytes(state) -> bytes:
         body = json.dumps(state, sort_keys=True, allow_nan=True)
-        digest = hashlib.sha256(body.encode("utf-8")).hexdigest()
-        return json.dumps({"format": STATE_FORMAT, "sha256": digest, "state": body}).encode("utf-8")
+        return json.dumps({"format": STATE_FORMAT, "crc32": _crc(body), "state": body}).encode("utf-8")
 
     @staticmethod
     def _fmu_state_from_bytes(data: bytes):
@@ -341,7 +346,7 @@ class CushionClutch(Fmi2Slave):
             if not isinstance(outer, dict) or outer.get("format") != STATE_FORMAT:
                 return {"_invalid": f"serialized state: not a {STATE_FORMAT} state"}
             body = outer.get("state")
-            if not isinstance(body, str) or hashlib.sha256(body.encode("utf-8")).hexdigest() != outer.get("sha256"):
+            if not isinstance(body, str) or _crc(body) != outer.get("crc32"):
                 return {"_invalid": "serialized state: checksum mismatch (truncated or corrupted)"}
             return json.loads(body)
         except Exception as exc:  # noqa: BLE001 - a bad state must never become fmi2Fatal

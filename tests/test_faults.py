@@ -139,8 +139,10 @@ CATALOGUE = [
      E({0}, None, {"torque_ok": True}), E({0}, None, {"torque_ok": True})),
     ("fifty_instances", "50 instances alive at once, identical results",
      E({0}, None, {"identical": True}), E({0}, None, {"identical": True})),
-    ("cycles_1000", "1000 instantiate/step/free cycles: RSS growth < 4 MB",
-     E({0}, None, {"rss_growth_MB": lambda v: v < 4.0}), E({0}, None, {"rss_growth_MB": lambda v: v < 4.0})),
+    # pythonfmu: the wrapper itself leaks ~4.5 kB per instance (findClass's MRO lists and repr
+    # strings, the class they keep); our former slave leaked ~22 kB more (a class per instance)
+    ("cycles_1000", "1000 instantiate/step/free cycles: RSS growth < 2 MB native, < 8 MB pythonfmu",
+     E({0}, None, {"rss_growth_MB": lambda v: v < 2.0}), E({0}, None, {"rss_growth_MB": lambda v: v < 8.0})),
     ("threads_8", "one instance per thread in 8 threads, 2000 steps each, equal to serial",
      E({0}, None, {"identical": True}), E({0}, None, {"identical": True})),
 ]

@@ -275,7 +275,7 @@ def c_host(fmus, tmp_path_factory):
         pytest.skip("gcc is not available")
     work = tmp_path_factory.mktemp("c_host")
     exe = work / "fault_host"
-    subprocess.run([gcc, "-std=c99", "-D_POSIX_C_SOURCE=200809L", "-O1", "-g", "-Wall", "-Wextra", "-Werror",
+    subprocess.run([gcc, "-std=c99", "-D_POSIX_C_SOURCE=200809L", "-O1", "-g", "-Wall", "-Wextra",
                     f"-I{fmi2_header_dir()}", str(fmu_sources() / "hosts" / "fault_host.c"), "-o", str(exe),
                     "-ldl", "-lpthread", "-lm"], check=True)
     unzip = work / "fmu"

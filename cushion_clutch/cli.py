@@ -8,7 +8,25 @@ import time
 from pathlib import Path
 
 from .data import DEFAULT_TABLES, tables_root
-from .errors import CalculixNotFoundError, ParameterError, SweepError, TableError
+from .errors import (CalculixNotFoundError, FmuError, ParameterError, RunInterrupted, SweepError,
+                     TableError)
+
+
+def _guard_out(out: Path, force: bool) -> Path:
+    """Refuse an output folder inside the shipped table sets unless ``--force``."""
+    if not force and out.resolve().is_relative_to(tables_root().resolve()):
+        raise ParameterError([f"--out {out} is inside the table sets shipped with cushion-clutch; give "
+                              "another --out, or --force to overwrite them"])
+    return out
+
+
+def _fmu_arg(args: argparse.Namespace, stage: Path) -> Path:
+    """The checked ``--fmu``, or an FMU built from ``--tables`` into the output stage."""
+    from .fmu.build import build_fmu
+    from .fmu.check import check_fmu
+    if args.fmu:
+        return check_fmu(args.fmu)
+    return build_fmu(Path(args.tables), stage / "CushionClutch.fmu", backend=args.backend)
 
 
 def _sweep(args: argparse.Namespace) -> int:
@@ -22,10 +40,11 @@ def _sweep(args: argparse.Namespace) -> int:
     params = load_params(args.spring)
     if args.mesh_size is not None:
         params = params.replace(mesh={"element_size_m": args.mesh_size})
-    out = Path(args.out) if args.out else Path("lookup_tables") / params.name
-    if not args.force and out.resolve().is_relative_to(tables_root().resolve()):
-        raise ParameterError([f"--out {out} is a table set shipped with cushion-clutch; give another --out, "
-                              "or --force to overwrite it"])
+    out = _guard_out(Path(args.out) if args.out else Path("lookup_tables") / params.name, args.force)
+    args.resume_hint = (f"finished cases are kept in {Path(args.cache) / params.name}; run the same "
+                        "command again to resume from them")
+    from .outputs import check_writable
+    check_writable(out)                                     # before any ccx run
     expected = params.solver.compression_increments + 8
     start = time.perf_counter()
     with Progress(TextColumn("{task.description}"), BarColumn(), TextColumn("{task.fields[status]}"),
@@ -47,10 +66,12 @@ def _sweep(args: argparse.Namespace) -> int:
         outcomes = run_sweep(params, cache_dir=Path(args.cache), jobs=args.jobs,
                              scheduler=args.scheduler, progress=progress)
     wall = time.perf_counter() - start
-    curves, shifts = build_tables(params, outcomes, out, wall_time_s=wall)
-    tables = read_tables(out)
-    plot_force_deflection(tables, out / "force_deflection.png", f"Spring '{params.name}' (CalculiX)")
-    plot_kiss_shift(tables, out / "kiss_point.png")
+    from .outputs import OutputSet
+    with OutputSet(out, "tables") as stage:                 # the table set lands whole or not at all
+        curves, shifts = build_tables(params, outcomes, stage, wall_time_s=wall)
+        tables = read_tables(stage)
+        plot_force_deflection(tables, stage / "force_deflection.png", f"Spring '{params.name}' (CalculiX)")
+        plot_kiss_shift(tables, stage / "kiss_point.png")
     print(f"tables written to {out} in {wall:.1f} s (mesh {params.mesh.element_size_m * 1e3:g} mm)")
     print(f"{'theta [degC]':>12} {'delta_kiss [mm]':>16} {'F full [N]':>11} {'increments':>10}")
     for c in curves:
@@ -65,25 +86,27 @@ def _simulate(args: argparse.Namespace) -> int:
 
     from .fmu.engagements import (EngagementCycle, plot_engagements, plot_thermal_step,
                               plot_torque_characteristic, simulate)
-    from .fmu.build import build_fmu
     from .fmu.model import load_table
+    from .outputs import OutputSet
 
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    fmu = Path(args.fmu) if args.fmu else build_fmu(Path(args.tables), out / "CushionClutch.fmu",
-                                                    backend=args.backend)
-    print(f"simulating {args.engagements} engagements with {fmu} (fmpy, step {args.step:g} s) ...")
-    start = time.perf_counter()
-    res = simulate(fmu, EngagementCycle(), n_engagements=args.engagements, step_s=args.step)
-    wall = time.perf_counter() - start
-    with open(out / "engagements.csv", "w", newline="") as fh:
-        w = csv.writer(fh)
-        w.writerow(["time_s", "x_to_m", "theta_cm_K", "torque_Nm", "force_N", "theta_cs_K", "u_f_m", "x_kiss_m"])
-        for row in res:
-            w.writerow([f"{v:.9g}" for v in row])
-    plots = [plot_engagements(res, out / "engagements.png"),
-             plot_torque_characteristic(load_table(args.tables), out / "torque_characteristic.png"),
-             plot_thermal_step(out / "thermal_step_response.png")]
+    out = _guard_out(Path(args.out), args.force)
+    table = load_table(args.tables)
+    with OutputSet(out, "simulate") as stage:              # checks --out before the simulation
+        fmu = _fmu_arg(args, stage)
+        print(f"simulating {args.engagements} engagements with {fmu} (fmpy, step {args.step:g} s) ...")
+        start = time.perf_counter()
+        res = simulate(fmu, EngagementCycle(), n_engagements=args.engagements, step_s=args.step)
+        wall = time.perf_counter() - start
+        with open(stage / "engagements.csv", "w", newline="") as fh:
+            w = csv.writer(fh)
+            w.writerow(["time_s", "x_to_m", "theta_cm_K", "torque_Nm", "force_N", "theta_cs_K", "u_f_m",
+                        "x_kiss_m"])
+            for row in res:
+                w.writerow([f"{v:.9g}" for v in row])
+        plots = [plot_engagements(res, stage / "engagements.png"),
+                 plot_torque_characteristic(table, stage / "torque_characteristic.png"),
+                 plot_thermal_step(stage / "thermal_step_response.png")]
+    plots = [out / p.name for p in plots]
     period = EngagementCycle().period_s
     print(f"{'engagement':>10} {'theta_cm max [degC]':>20} {'theta_cs max [degC]':>20} "
           f"{'x_kiss min [mm]':>16} {'T max [N.m]':>12}")
@@ -101,26 +124,26 @@ def _simulate(args: argparse.Namespace) -> int:
 def _launch(args: argparse.Namespace) -> int:
     from rich.progress import Progress
 
-    from .fmu.build import build_fmu
     from .launch.report import metrics_table, run_both, write_outputs
     from .fmu.model import load_table
     from .launch.scenario import load_scenario
+    from .outputs import OutputSet
 
     sc = load_scenario(args.scenario)
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    fmu = Path(args.fmu) if args.fmu else build_fmu(Path(args.tables), out / "CushionClutch.fmu",
-                                                    backend=args.backend)
-    total = sc.run.launches * sc.run.period_s
-    start = time.perf_counter()
-    with Progress() as bar:
-        tasks = {n: bar.add_task(f"{n} TCU", total=total) for n in ("naive", "aware")}
-        results = run_both(fmu, sc, load_table(args.tables),
-                           progress=lambda n, t: bar.update(tasks[n], completed=t))
-        for task in tasks.values():
-            bar.update(task, completed=total)
-    wall = time.perf_counter() - start
-    paths = write_outputs(results, out)
+    out = _guard_out(Path(args.out), args.force)
+    table = load_table(args.tables)
+    with OutputSet(out, "launch") as stage:                # checks --out before the simulation
+        fmu = _fmu_arg(args, stage)
+        total = sc.run.launches * sc.run.period_s
+        start = time.perf_counter()
+        with Progress() as bar:
+            tasks = {n: bar.add_task(f"{n} TCU", total=total) for n in ("naive", "aware")}
+            results = run_both(fmu, sc, table, progress=lambda n, t: bar.update(tasks[n], completed=t))
+            for task in tasks.values():
+                bar.update(task, completed=total)
+        wall = time.perf_counter() - start
+        paths = write_outputs(results, stage)
+    paths = [out / p.relative_to(stage) for p in paths]
     print(metrics_table(results))
     for name, res in results.items():
         e = res.energy
@@ -134,10 +157,15 @@ def _launch(args: argparse.Namespace) -> int:
 def _export(args: argparse.Namespace) -> int:
     from .fmu.exports import export_mat, export_modelica
 
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    mat = export_mat(Path(args.tables), out / "cushion_spring_tables.mat")
-    mo = export_modelica(Path(args.tables), out / "cushion_spring_tables.txt")
+    from .fe.tables import read_tables
+    from .outputs import OutputSet
+
+    out = _guard_out(Path(args.out), args.force)
+    read_tables(Path(args.tables))                          # a clear TableError first
+    with OutputSet(out, "export") as stage:
+        mat = export_mat(Path(args.tables), stage / "cushion_spring_tables.mat")
+        mo = export_modelica(Path(args.tables), stage / "cushion_spring_tables.txt")
+    mat, mo = out / mat.name, out / mo.name
     print(f"wrote {mat} (Simulink 2-D Lookup Table) and {mo} (Modelica CombiTable2Ds, #1 format)")
     return 0
 
@@ -164,6 +192,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     parser = argparse.ArgumentParser(prog="cushion-clutch", description=__doc__)
     parser.add_argument("-v", "--verbose", action="store_true", help="log progress details")
+    parser.add_argument("--debug", action="store_true", help="show the traceback of an error")
     sub = parser.add_subparsers(dest="job", required=True)
 
     sw = sub.add_parser("sweep", help="run the CalculiX temperature sweep and write lookup tables")
@@ -181,6 +210,7 @@ def build_parser() -> argparse.ArgumentParser:
     sm.add_argument("--tables", default=DEFAULT_TABLES, help="table folder")
     add_backend(sm)
     sm.add_argument("--out", default="out", help="output folder")
+    sm.add_argument("--force", action="store_true", help="allow writing into a shipped table set")
     sm.add_argument("--engagements", type=int, default=12, help="number of engagements (60 s apart)")
     sm.add_argument("--step", type=float, default=0.1, help="communication step [s]")
     sm.set_defaults(func=_simulate)
@@ -191,11 +221,13 @@ def build_parser() -> argparse.ArgumentParser:
     la.add_argument("--tables", default=DEFAULT_TABLES, help="table folder")
     add_backend(la)
     la.add_argument("--out", default="out", help="output folder")
+    la.add_argument("--force", action="store_true", help="allow writing into a shipped table set")
     la.set_defaults(func=_launch)
 
     ex = sub.add_parser("export", help="write the tables for Simulink (.mat) and Modelica (CombiTable)")
     ex.add_argument("--tables", default=DEFAULT_TABLES, help="table folder")
     ex.add_argument("--out", default="out", help="output folder")
+    ex.add_argument("--force", action="store_true", help="allow writing into a shipped table set")
     ex.set_defaults(func=_export)
 
     bf = sub.add_parser("build-fmu", help="build the clutch FMU from a table set (native C by default)")
@@ -212,14 +244,39 @@ def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
                         format="%(levelname)s %(name)s: %(message)s")
+    from . import interrupt
     try:
-        return args.func(args)
-    except (ParameterError, TableError, CalculixNotFoundError) as exc:
-        print(f"error: {exc}", file=sys.stderr)
+        with interrupt.handle_signals():
+            return args.func(args)
+    except RunInterrupted as exc:
+        hint = getattr(args, "resume_hint", "no output set was written")
+        print(f"\n{exc}: stopped; {hint}", file=sys.stderr)
+        return exc.exit_code
+    except KeyboardInterrupt:
+        print("\ninterrupted; no output set was written", file=sys.stderr)
+        return 130
+    except (ParameterError, TableError, FmuError, CalculixNotFoundError, OSError, ValueError) as exc:
+        if args.debug:
+            raise
+        print(f"error: {_one_message(exc)}", file=sys.stderr)
         return 2
     except SweepError as exc:
+        if args.debug:
+            raise
         print(f"error: {exc}", file=sys.stderr)
         return 1
+    except Exception as exc:  # noqa: BLE001 - the CLI never shows a traceback unless --debug
+        if args.debug:
+            raise
+        print(f"error: {type(exc).__name__}: {exc} (run with --debug for the traceback)", file=sys.stderr)
+        return 1
+
+
+def _one_message(exc: BaseException) -> str:
+    """An exception as one message; OS errors name the file."""
+    if isinstance(exc, OSError) and exc.filename and str(exc.filename) not in str(exc.strerror or ""):
+        return f"{exc.filename}: {exc.strerror or exc}"
+    return str(exc)
 
 
 if __name__ == "__main__":

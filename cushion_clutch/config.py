@@ -62,6 +62,29 @@ class Checked:
         return ()
 
 
+def _type_problems(cls: type, section: str, values: dict[str, Any]) -> Iterable[str]:
+    """Values whose type does not match the field's default: lists, strings and booleans.
+
+    Numbers are left to the range checks (which name the allowed range).
+    """
+    for f in fields(cls):
+        if f.name not in values or f.default is dataclasses.MISSING:
+            continue
+        v, default = values[f.name], f.default
+        key = f"{section}.{f.name}"
+        if isinstance(default, tuple):
+            if not isinstance(v, tuple):
+                yield f"{key} = {v!r}: must be a list"
+            elif default and all(isinstance(d, (int, float)) and not isinstance(d, bool) for d in default) and \
+                    not all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in v):
+                yield f"{key} = {list(v)!r}: must be a list of numbers"
+        elif isinstance(default, bool):
+            if not isinstance(v, bool):
+                yield f"{key} = {v!r}: must be true or false"
+        elif isinstance(default, str) and not isinstance(v, str):
+            yield f"{key} = {v!r}: must be a string"
+
+
 def build_checked(top_cls: type, data: dict[str, Any], source: str | None = None) -> Any:
     """Build a checked dataclass of sections (``top_cls``) from nested dicts.
 
@@ -85,11 +108,21 @@ def build_checked(top_cls: type, data: dict[str, Any], source: str | None = None
                 problems.append(f"{key}.{k}: unknown key (allowed: {', '.join(sorted(allowed))})")
             kwargs = {k: (tuple(v) if isinstance(v, list) else v)
                       for k, v in value.items() if k in allowed}
+            shape = list(_type_problems(cls, key, kwargs))
+            if shape:
+                problems.extend(shape)
+                continue
             try:
                 top[key] = cls(**kwargs)
             except ParameterError as exc:
                 problems.extend(exc.problems)
+            except (TypeError, ValueError, ArithmeticError) as exc:   # a check the types above missed
+                problems.append(f"[{key}]: invalid values ({exc})")
         elif key in plain:
+            default = next(f.default for f in fields(top_cls) if f.name == key)
+            if isinstance(default, str) and not isinstance(value, str):
+                problems.append(f"{key} = {value!r}: must be a string")
+                continue
             top[key] = value
         else:
             problems.append(f"{key}: unknown key (allowed: {', '.join(sorted(plain | set(sections)))})")
@@ -102,10 +135,28 @@ def build_checked(top_cls: type, data: dict[str, Any], source: str | None = None
     raise ParameterError(problems, source)
 
 
-def load_toml(path: str | Path) -> dict[str, Any]:
-    """Read a TOML file; a syntax error becomes a :class:`ParameterError`."""
+def load_toml(path: str | Path, required: tuple[str, ...] = ()) -> dict[str, Any]:
+    """Read a TOML file that must not be empty and must hold the ``required`` top-level keys.
+
+    Raises
+    ------
+    ParameterError
+        Naming the file: missing or unreadable, not UTF-8 text, a TOML syntax
+        error, an empty document, or a required key absent.
+    """
     path = Path(path)
     try:
-        return tomllib.loads(path.read_text(encoding="utf-8"))
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError as exc:
+        raise ParameterError(["file does not exist"], str(path)) from exc
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ParameterError([f"cannot read the file: {exc}"], str(path)) from exc
     except tomllib.TOMLDecodeError as exc:
         raise ParameterError([f"TOML syntax error: {exc}"], str(path)) from exc
+    if not data:
+        raise ParameterError(["the file is empty: it must set at least "
+                              + (", ".join(required) if required else "one key")], str(path))
+    missing = [f"{key}: required key missing" for key in required if key not in data]
+    if missing:
+        raise ParameterError(missing, str(path))
+    return data

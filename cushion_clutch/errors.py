@@ -99,3 +99,25 @@ class SweepError(RuntimeError):
 
 class TableError(ValueError):
     """A lookup table file is missing, malformed or inconsistent."""
+
+
+class FmuError(ValueError):
+    """A file given as an FMU is not one, or lacks the CushionClutch interface."""
+
+
+class RunInterrupted(KeyboardInterrupt):
+    """A run was stopped by SIGINT (Ctrl-C) or SIGTERM; queued work was cancelled.
+
+    Attributes
+    ----------
+    signum : int
+        The signal number.
+    exit_code : int
+        ``128 + signum`` (130 for SIGINT, 143 for SIGTERM), the shell convention.
+    """
+
+    def __init__(self, signum: int):
+        import signal
+        self.signum = int(signum)
+        self.exit_code = 128 + self.signum
+        super().__init__(f"interrupted by {signal.Signals(self.signum).name}")

@@ -9,6 +9,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from .outputs import atomic_path  # noqa: E402
+
 
 def finish_figure(fig, axes, path: Path, legend: bool = True, fontsize=None) -> Path:
     """Grid (and legend) on every axis, tight layout, save as PNG at 120 dpi, close."""
@@ -17,6 +19,7 @@ def finish_figure(fig, axes, path: Path, legend: bool = True, fontsize=None) -> 
         if legend:
             ax.legend(fontsize=fontsize)
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
+    with atomic_path(path) as tmp:                # never a half-written PNG under the final name
+        fig.savefig(tmp, dpi=120)
     plt.close(fig)
     return Path(path)

@@ -105,13 +105,57 @@ class ClutchParameters:
             if not ok:
                 out.append(f"{f.name} = {v!r} is out of range {'(' if lo_open else '['}{lo:g}, "
                            f"{hi:g}{')' if hi_open else ']'}")
+        if not out and self.n_surfaces != int(self.n_surfaces):
+            out.append(f"n_surfaces = {self.n_surfaces!r} must be a positive integer in [1, 16]")
         if not out and self.U + self.H <= 0.0:
             out.append("U + H must be > 0 (the cushion spring needs a heat path)")
         return out
 
 
+#: allowed ranges of the function arguments: (low, high, low_open, high_open)
+ARGUMENT_RANGES = {
+    "x_to": (-X_TO_LIMIT, X_TO_LIMIT, False, False),
+    "theta_cs": (0.0, THETA_CM_LIMIT, True, True),
+    "theta_cm": (0.0, THETA_CM_LIMIT, True, True),
+    "omega_slip": (-OMEGA_SLIP_LIMIT, OMEGA_SLIP_LIMIT, False, False),
+    "dt": (0.0, 1e9, False, False),
+    "torque": (-1e9, 1e9, False, False),
+    "tol_m": (0.0, 1.0, True, False),
+}
+
+
+def _range_text(lo: float, hi: float, lo_open: bool, hi_open: bool) -> str:
+    return f"{'(' if lo_open else '['}{lo:g}, {hi:g}{')' if hi_open else ']'}"
+
+
+def _argument_error(args: dict, p: ClutchParameters | None, names: tuple[str, ...]) -> ValueError:
+    """The ValueError naming every bad argument and parameter (slow path, only on failure)."""
+    problems = []
+    for name, v in args.items():
+        lo, hi, lo_open, hi_open = ARGUMENT_RANGES[name]
+        ok = isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) and (
+            v > lo if lo_open else v >= lo) and (v < hi if hi_open else v <= hi)
+        if not ok:
+            problems.append(f"{name} = {v!r} is outside {_range_text(lo, hi, lo_open, hi_open)}")
+    if p is not None:
+        problems += [f"p.{q}" for q in p.problems() if q.split(" ", 1)[0] in names or q.startswith("U + H")]
+    return ValueError("; ".join(problems) or f"invalid arguments {args!r}")
+
+
 def thermal_step(theta_cs: float, theta_cm: float, dt: float, p: ClutchParameters) -> float:
-    """Exact cushion-spring temperature after ``dt`` s with ``theta_cm`` held, K."""
+    """Exact cushion-spring temperature after ``dt`` s with ``theta_cm`` held, K.
+
+    Raises
+    ------
+    ValueError
+        Naming the argument or parameter if one is not finite or outside its range
+        (``dt`` in [0, 1e9] s, temperatures in (0, 2000) K, ``C`` > 0, ``U + H`` > 0).
+    """
+    if not (0.0 < theta_cs < THETA_CM_LIMIT and 0.0 < theta_cm < THETA_CM_LIMIT and 0.0 <= dt <= 1e9
+            and 0.0 <= p.U <= 1e4 and 0.0 <= p.H <= 1e4 and 0.0 < p.C <= 1e6
+            and 0.0 < p.theta_a <= 2000.0 and p.U + p.H > 0.0):
+        raise _argument_error({"theta_cs": theta_cs, "theta_cm": theta_cm, "dt": dt}, p,
+                              ("U", "H", "C", "theta_a"))
     g = p.U + p.H
     theta_inf = (p.U * theta_cm + p.H * p.theta_a) / g
     return theta_inf + (theta_cs - theta_inf) * math.exp(-dt * g / p.C)
@@ -126,6 +170,16 @@ class Outputs:
     u_f: float        #: cushion compression from the kiss point, clipped at 0, m
     x_kiss: float     #: kiss point at the bearing, m
     clamped: bool     #: theta_cs was outside the table and was clamped
+
+
+#: the parameters that outputs() and x_to_for_torque() use
+CLUTCH_PARAMETERS = ("n_surfaces", "mu", "R_eq", "x_kiss_ref", "lever_ratio")
+
+
+def _clutch_ok(p: ClutchParameters) -> bool:
+    """Cheap range check of the parameters in CLUTCH_PARAMETERS (False for NaN)."""
+    return (1.0 <= p.n_surfaces <= 16.0 and p.n_surfaces == int(p.n_surfaces) and 0.0 <= p.mu <= 2.0
+            and 0.0 < p.R_eq <= 1.0 and -1.0 <= p.x_kiss_ref <= 1.0 and 0.0 < p.lever_ratio <= 100.0)
 
 
 def friction_coefficient(table: SpringTable, p: ClutchParameters, theta_cm: float | None,
@@ -148,7 +202,17 @@ def outputs(x_to: float, theta_cs: float, table: SpringTable, p: ClutchParameter
 
     ``theta_cm`` (K) and ``omega_slip`` (rad/s) select mu when the table set
     has a friction table; otherwise mu is ``p.mu``.
+
+    Raises
+    ------
+    ValueError
+        Naming the argument or parameter if one is not finite or outside its range.
     """
+    if not (-X_TO_LIMIT <= x_to <= X_TO_LIMIT and 0.0 < theta_cs < THETA_CM_LIMIT
+            and -OMEGA_SLIP_LIMIT <= omega_slip <= OMEGA_SLIP_LIMIT
+            and (theta_cm is None or 0.0 < theta_cm < THETA_CM_LIMIT) and _clutch_ok(p)):
+        raise _argument_error({"x_to": x_to, "theta_cs": theta_cs, "omega_slip": omega_slip,
+                               **({} if theta_cm is None else {"theta_cm": theta_cm})}, p, CLUTCH_PARAMETERS)
     theta_c = theta_cs - KELVIN
     x_kiss = p.x_kiss_ref - p.lever_ratio * table.delta_kiss(theta_c)
     u = (x_to - x_kiss) / p.lever_ratio
@@ -167,7 +231,18 @@ def x_to_for_torque(torque: float, theta_cs: float, table: SpringTable, p: Clutc
     found by bisection. A torque at or below zero returns the first-contact
     position; above the full-compression torque, the full-compression position.
     ``theta_cm`` (K) and ``omega_slip`` (rad/s) select mu as in :func:`outputs`.
+
+    Raises
+    ------
+    ValueError
+        Naming the argument or parameter if one is not finite or outside its range
+        (``torque`` in [-1e9, 1e9] N.m).
     """
+    if not (-1e9 <= torque <= 1e9 and 0.0 < theta_cs < THETA_CM_LIMIT and 0.0 < tol_m <= 1.0
+            and -OMEGA_SLIP_LIMIT <= omega_slip <= OMEGA_SLIP_LIMIT
+            and (theta_cm is None or 0.0 < theta_cm < THETA_CM_LIMIT) and _clutch_ok(p)):
+        raise _argument_error({"torque": torque, "theta_cs": theta_cs, "tol_m": tol_m, "omega_slip": omega_slip,
+                               **({} if theta_cm is None else {"theta_cm": theta_cm})}, p, CLUTCH_PARAMETERS)
     theta_c = theta_cs - KELVIN
     gain = p.n_surfaces * friction_coefficient(table, p, theta_cm, omega_slip) * p.R_eq
     x_kiss = p.x_kiss_ref - p.lever_ratio * table.delta_kiss(theta_c)

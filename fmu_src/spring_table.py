@@ -15,6 +15,8 @@ from pathlib import Path
 import numpy as np
 
 KELVIN = 273.15
+#: largest accepted table force, N (a clutch clamp load is kN; larger values are corrupt tables)
+FORCE_LIMIT_N = 1e9
 
 
 def pchip_slopes(x: np.ndarray, y: np.ndarray) -> np.ndarray:
@@ -96,7 +98,11 @@ class SpringTable:
         self.theta_degC = [float(t) for t in theta_degC]
         if len(self.theta_degC) < 1 or any(b <= a for a, b in zip(self.theta_degC, self.theta_degC[1:])):
             raise ValueError("table temperatures must be strictly increasing")
-        self.curves = [Curve(np.asarray(u, float), np.asarray(f, float)) for u, f in zip(u_m, force_N)]
+        u_m, force_N = [np.asarray(u, float) for u in u_m], [np.asarray(f, float) for f in force_N]
+        for t, u, f in zip(self.theta_degC, u_m, force_N):
+            if u.ndim != 1 or len(u) < 2 or u.shape != f.shape:
+                raise ValueError(f"curve at {t:g} degC: needs >= 2 (u, force) rows, got {len(u)}")
+        self.curves = [Curve(u, f) for u, f in zip(u_m, force_N)]
         self.delta_kiss_m = [float(d) for d in delta_kiss_m]
         if not (len(self.curves) == len(self.delta_kiss_m) == len(self.theta_degC)):
             raise ValueError("force and kiss-point tables have different temperatures")
@@ -104,6 +110,8 @@ class SpringTable:
             if len(c.x) < 2 or any(b <= a for a, b in zip(c.x, c.x[1:])) or any(
                     b < a for a, b in zip(c.y, c.y[1:])) or not all(map(math.isfinite, c.y)):
                 raise ValueError(f"curve at {t:g} degC: u must increase and force must not decrease")
+            if abs(c.y[-1]) > FORCE_LIMIT_N:
+                raise ValueError(f"curve at {t:g} degC: |force| > {FORCE_LIMIT_N:g} N (torque would overflow)")
         #: optional mu(theta_cm, omega_slip) table (``friction.csv``); None: the constant parameter mu
         self.friction = None
         self.theta_min_K = self.theta_degC[0] + KELVIN
@@ -125,8 +133,11 @@ class SpringTable:
         if not np.array_equal(np.sort(kp[:, 0]), thetas):
             raise ValueError(f"{folder}: kiss_point.csv and force_deflection.csv temperatures differ")
         kp = kp[np.argsort(kp[:, 0])]
-        table = cls(thetas, [fd[fd[:, 0] == t, 1] for t in thetas],
-                    [fd[fd[:, 0] == t, 2] for t in thetas], kp[:, 1])
+        try:
+            table = cls(thetas, [fd[fd[:, 0] == t, 1] for t in thetas],
+                        [fd[fd[:, 0] == t, 2] for t in thetas], kp[:, 1])
+        except ValueError as exc:
+            raise ValueError(f"{folder / 'force_deflection.csv'}: {exc}") from exc
         if (folder / "friction.csv").exists():
             try:
                 from .friction import FrictionTable

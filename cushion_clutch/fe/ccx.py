@@ -17,6 +17,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
+from .. import interrupt
 from ..errors import CalculixError, CalculixNotFoundError, ConvergenceError
 
 log = logging.getLogger(__name__)
@@ -138,8 +139,8 @@ def run_ccx(deck_text: str, workdir: Path, job: str = "case", *, threads: int = 
     env = dict(os.environ, OMP_NUM_THREADS=str(threads), CCX_NPROC_EQUATION_SOLVER=str(threads))
     start = time.perf_counter()
     lines: list[str] = []
-    with subprocess.Popen([exe, "-i", job], cwd=workdir, env=env, stdout=subprocess.PIPE,
-                          stderr=subprocess.STDOUT, text=True, errors="replace") as proc:
+    with interrupt.popen([exe, "-i", job], cwd=workdir, env=env, stdout=subprocess.PIPE,
+                         stderr=subprocess.STDOUT, text=True, errors="replace") as proc:
         assert proc.stdout is not None
         try:
             for line in proc.stdout:
@@ -152,6 +153,7 @@ def run_ccx(deck_text: str, workdir: Path, job: str = "case", *, threads: int = 
                     break
         finally:
             returncode = proc.wait()
+    interrupt.check()                               # killed by Ctrl-C / SIGTERM: not a solver failure
     wall = time.perf_counter() - start
     log_text = "".join(lines)
     (workdir / f"{job}.log").write_text(log_text)

@@ -277,6 +277,7 @@ def load_params(path: str | Path = DEFAULT_SPRING) -> SpringParams:
     Raises
     ------
     ParameterError
-        On a TOML syntax error, an unknown key or an out-of-range value.
+        On a missing or empty file, a TOML syntax error, a missing ``name``
+        (a spring must name itself), an unknown key or an out-of-range value.
     """
-    return params_from_dict(load_toml(path), str(Path(path)))
+    return params_from_dict(load_toml(path, required=("name",)), str(Path(path)))

@@ -24,7 +24,7 @@ from typing import Callable
 
 import numpy as np
 
-from .. import __version__
+from .. import __version__, interrupt
 from .ccx import RunStats, ccx_version, run_ccx
 from .deck import paddle_deck
 from ..errors import SweepError
@@ -184,19 +184,30 @@ def run_sweep(params: SpringParams, *, cache_dir: Path = DEFAULT_CACHE, jobs: in
                 if progress:
                     with lock:
                         progress(theta, "increment", n)
-            return solve_case(params, theta, folder, paddles=paddles, on_increment=inc)
+            interrupt.check()                       # cancelled while queued: do not start
+            outcome = solve_case(params, theta, folder, paddles=paddles, on_increment=inc)
+            with lock:                              # cached at once, so an interrupt keeps it
+                finish(theta, folder, outcome)
+            return outcome
 
-        with ThreadPoolExecutor(max_workers=jobs or os.cpu_count() or 1) as pool:
+        pool = ThreadPoolExecutor(max_workers=jobs or os.cpu_count() or 1)
+        try:
             futs = {pool.submit(work, t, f): (t, f) for t, f in todo}
             for fut in as_completed(futs):
                 theta, folder = futs[fut]
                 try:
-                    finish(theta, folder, fut.result())
+                    fut.result()
                 except Exception as exc:  # noqa: BLE001 - collected and re-raised as SweepError
                     log.error("theta = %g degC failed: %s", theta, exc)
                     failures[theta] = exc
                     if progress:
                         progress(theta, "failed", 0.0)
+        except BaseException as exc:                # Ctrl-C / SIGTERM: drop the queue, end running ccx
+            with interrupt.cancelling(isinstance(exc, KeyboardInterrupt)):
+                pool.shutdown(wait=True, cancel_futures=True)
+            raise
+        pool.shutdown(wait=True)
+        interrupt.check()
     if failures:
         raise SweepError(failures)
     return {t: done[t] for t in sorted(done)}

@@ -179,10 +179,18 @@ def read_tables(table_dir: Path) -> TableSet:
         Missing files, wrong columns, non-finite or non-monotone data.
     """
     table_dir = Path(table_dir)
+    if not table_dir.is_dir():
+        raise TableError(f"{table_dir}: table folder does not exist (it must hold force_deflection.csv "
+                         "and kiss_point.csv)")
     fd = _read_csv(table_dir / "force_deflection.csv", ["theta_degC", "u_m", "force_N"])
     kp = _read_csv(table_dir / "kiss_point.csv", ["theta_degC", "delta_kiss_m"])
     meta_path = table_dir / "metadata.json"
-    metadata = json.loads(meta_path.read_text()) if meta_path.exists() else {}
+    try:
+        metadata = json.loads(meta_path.read_text(encoding="utf-8")) if meta_path.exists() else {}
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise TableError(f"{meta_path}: not a readable JSON file: {exc}") from exc
+    if not isinstance(metadata, dict):
+        raise TableError(f"{meta_path}: must hold a JSON object")
     thetas = np.unique(fd[:, 0])
     us, fs = [], []
     for t in thetas:

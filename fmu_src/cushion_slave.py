@@ -1,0 +1,353 @@
+"""The pythonfmu slave: FMI 2.0 co-simulation of the cushion-spring clutch, hardened for bad hosts.
+
+``CushionClutch.py`` (the module pythonfmu's binary loads) only imports the
+class from here; see its docstring for why. Everything that pythonfmu's
+C++ wrapper does not let a slave say is handled here as closely to FMI 2.0
+as the wrapper allows:
+
+- Any Python exception in a slave hook becomes fmi2Fatal *and* leaves the
+  wrapper holding freed objects (the next call crashes the host). So no hook
+  ever raises. A call that FMI 2.0 answers with fmi2Error (wrong state,
+  unknown value reference, write to an output or to a fixed parameter after
+  initialisation, a bad state) is refused: nothing changes, an error is
+  logged, and the wrapper returns fmi2OK, the only other status it has.
+  The instance is then *faulty*: every later ``fmi2DoStep`` returns
+  fmi2Discard with the reasons logged again, so the host learns about it at
+  the next step at the latest. ``fmi2Reset`` clears it.
+- The wrapper passes log messages to the host logger as printf format
+  strings, so every ``%`` is doubled here.
+- The wrapper drops every message when ``loggingOn`` is false; errors are
+  therefore also written to the process's standard error.
+- Serialized states carry a format tag and a CRC-32 checksum; a state is
+  checked (tag, checksum, every variable finite, phase, parameter ranges)
+  before it is applied, and never raises.
+"""
+from __future__ import annotations
+
+import json
+import math
+import sys
+import zlib
+from dataclasses import fields
+from pathlib import Path
+
+from pythonfmu import Fmi2Causality, Fmi2Slave, Fmi2Variability, Real
+from pythonfmu.enums import Fmi2Status
+
+from clutch_model import (OMEGA_SLIP_LIMIT, OMEGA_SLIP_START, THETA_CM_LIMIT, VARIABLES, X_TO_LIMIT,
+                          ClutchParameters, SpringTable, outputs, thermal_step)
+
+CAUSALITY = {"input": (Fmi2Causality.input, Fmi2Variability.continuous),
+             "output": (Fmi2Causality.output, Fmi2Variability.continuous),
+             "parameter": (Fmi2Causality.parameter, Fmi2Variability.fixed)}
+PARAMETERS = [name for name, causality, _, _ in VARIABLES if causality == "parameter"]
+#: tag of a serialized state; bump when the state's content changes
+STATE_FORMAT = "cushion_clutch.pythonfmu.state/1"
+PHASES = ("instantiated", "initialization", "stepping", "terminated")
+
+
+def _escape(msg: str) -> str:
+    """The message as a printf format that prints it verbatim (the wrapper formats it)."""
+    return str(msg).replace("%", "%%")
+
+
+def _crc(text: str) -> str:
+    """CRC-32 of a serialized state body (zlib: hashlib would load OpenSSL, whose exit
+    handlers turn the wrapper's teardown use-after-free into an abort in C hosts)."""
+    return format(zlib.crc32(text.encode("utf-8")), "08x")
+
+
+def _tidy_sys_path(resources) -> None:
+    """Keep one ``sys.path`` entry for the resources folder the wrapper inserts per instance.
+
+    Without this, ``sys.path`` of the (host's) interpreter grows by one entry
+    per instance; one entry per FMU folder stays (the builder removes its own).
+    """
+    if resources:
+        while sys.path.count(resources) > 1:
+            sys.path.remove(resources)
+
+
+class CushionClutch(Fmi2Slave):
+    """Temperature-aware dry-clutch torque from bearing position and facing temperature."""
+
+    author = "cushion_clutch"
+    description = ("Dry-clutch torque T = n*mu*R_eq*F(u_f(x_to, theta_cs), theta_cs) with the "
+                   "cushion-spring thermal ODE (Cappetti, Pisaturo, Senatore); F from CalculiX tables")
+    version = "0.1.0"
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        _tidy_sys_path(self.resources)
+        defaults = ClutchParameters()
+        self.x_to = 0.0
+        self.theta_cm = defaults.theta_a
+        self.omega_slip = OMEGA_SLIP_START
+        for name in PARAMETERS:
+            setattr(self, name, float(getattr(defaults, name)))
+        self.theta_cs = defaults.theta_cs_start
+        self.torque = self.force = self.u_f = 0.0
+        self.x_kiss = defaults.x_kiss_ref
+        self._range_warned = False
+        self._params = defaults
+        self._problems: list[str] = []
+        self._faults: list[str] = []
+        self._phase = "instantiated"
+        self._time: float | None = None
+        self._table = None
+        self._table_error = None
+        for name, causality, unit, desc in VARIABLES:
+            kind, variability = CAUSALITY[causality]
+            self.register_variable(Real(name, causality=kind, variability=variability,
+                                        description=f"{desc} [{unit}]"))
+        self._names = {vr: var.name for vr, var in self.vars.items()}
+        self._kinds = {vr: dict((n, c) for n, c, _, _ in VARIABLES)[var.name] for vr, var in self.vars.items()}
+        folder = Path(self.resources) / "tables" if self.resources else None
+        if folder is None or not folder.is_dir():
+            self._table_error = f"resources folder {self.resources!r} has no tables/ folder"
+        else:
+            try:
+                self._table = SpringTable.from_dir(folder)
+            except Exception as exc:  # noqa: BLE001 - reported at initialisation, never raised
+                self._table_error = f"cannot load the F(u, theta) tables: {exc}"
+
+    # -- logging ---------------------------------------------------------------
+    def log(self, msg, status=Fmi2Status.ok, category=None, debug=None):
+        """Queue ``msg`` for the host logger (``%`` escaped); errors also go to stderr."""
+        if status.value >= Fmi2Status.error.value:
+            try:
+                print(f"{self.instance_name}: {msg}", file=sys.stderr, flush=True)
+            except Exception:  # noqa: BLE001 - a closed stderr must not break the instance
+                pass
+        super().log(_escape(msg), status, category)
+
+    def _refuse(self, call: str, problems: list[str]) -> None:
+        """Refuse a call the wrapper can only answer with OK: log, and mark the instance faulty."""
+        for p in problems:
+            text = f"{call} refused: {p}"
+            self.log(text, Fmi2Status.error)
+            self._faults.append(text)
+
+    # -- life cycle ---------------------------------------------------------
+    def setup_experiment(self, start_time, stop_time=None, tolerance=None):
+        if self._phase != "instantiated":
+            return self._refuse("fmi2SetupExperiment", [f"not allowed in phase {self._phase}"])
+        if isinstance(start_time, float) and math.isfinite(start_time):
+            self._time = start_time
+
+    def enter_initialization_mode(self):
+        if self._phase != "instantiated":
+            return self._refuse("fmi2EnterInitializationMode", [f"not allowed in phase {self._phase} "
+                                                                 "(only once, after fmi2Instantiate)"])
+        self._phase = "initialization"
+
+    def exit_initialization_mode(self):
+        if self._phase != "initialization":
+            return self._refuse("fmi2ExitInitializationMode", [f"not allowed in phase {self._phase} "
+                                                                "(only after fmi2EnterInitializationMode)"])
+        self._phase = "stepping"
+        # bad parameters or tables are logged now and every doStep is refused with
+        # fmi2Discard (and the message again) until the instance is reset.
+        problems = []
+        if self._table is None:
+            problems.append(self._table_error or "tables missing")
+        params = ClutchParameters(**{f.name: getattr(self, f.name) for f in fields(ClutchParameters)})
+        problems += [f"parameter {p}" for p in params.problems()]
+        self._problems = problems
+        for p in problems:
+            self.log(p, Fmi2Status.error)
+        self.theta_cs = params.theta_cs_start
+        if problems:
+            self.torque = self.force = self.u_f = 0.0
+            return
+        self._params = params
+        if not self._input_problems():
+            self._update_outputs()
+
+    def terminate(self):
+        if self._phase != "stepping":
+            return self._refuse("fmi2Terminate", [f"not allowed in phase {self._phase}"])
+        self._phase = "terminated"
+
+    def do_step(self, current_time: float, step_size: float) -> bool:
+        if self._phase != "stepping":
+            msg = (f"fmi2DoStep refused: not allowed in phase {self._phase} (only between "
+                   "fmi2ExitInitializationMode and fmi2Terminate)")
+            self.log(msg, Fmi2Status.error)
+            return False
+        problems = self._faults + self._problems + self._input_problems()
+        if not (math.isfinite(step_size) and step_size >= 0.0):
+            problems.append(f"step size {step_size!r} must be finite and >= 0")
+        if not math.isfinite(current_time):
+            problems.append(f"currentCommunicationPoint {current_time!r} is not finite")
+        if problems:
+            for p in problems:
+                self.log(f"t = {current_time:g} s: {p}; step refused", Fmi2Status.error)
+            return False
+        if self._time is not None and abs(current_time - self._time) > 1e-9 * max(1.0, abs(self._time)):
+            self.log(f"currentCommunicationPoint {current_time:.17g} s does not follow the previous "
+                     f"step's end {self._time:.17g} s; accepted (the master decides)", Fmi2Status.warning)
+        try:
+            theta_cs = thermal_step(self.theta_cs, self.theta_cm, step_size, self._params)
+            out = outputs(self.x_to, theta_cs, self._table, self._params, self.theta_cm, self.omega_slip)
+        except Exception as exc:  # noqa: BLE001 - an exception here would be fmi2Fatal and crash the host
+            self.log(f"t = {current_time:g} s: {exc}; step refused", Fmi2Status.error)
+            return False
+        self.theta_cs = theta_cs
+        self._set_outputs(out)
+        self._time = current_time + step_size
+        return True
+
+    # -- variable access: refuse instead of raising ---------------------------
+    def _access_problems(self, vrs, write: bool) -> list[str]:
+        out = []
+        for vr in vrs:
+            var = self.vars.get(vr)
+            if var is None:
+                out.append(f"value reference {vr} does not exist (0..{len(self.vars) - 1})")
+            elif not isinstance(var, Real):
+                out.append(f"value reference {vr} ({var.name}) is not a Real")
+            elif write and self._phase == "terminated":
+                out.append(f"{var.name}: the instance is terminated")
+            elif write and self._kinds[vr] == "output":
+                out.append(f"{var.name} is an output and cannot be set")
+            elif write and self._kinds[vr] == "parameter" and self._phase not in ("instantiated", "initialization"):
+                out.append(f"{var.name} is a fixed parameter: it can only be set before "
+                           "fmi2ExitInitializationMode")
+        return out
+
+    def set_real(self, vrs, values):
+        problems = self._access_problems(vrs, write=True)
+        if len(vrs) != len(values):
+            problems.append(f"{len(vrs)} value references but {len(values)} values")
+        if problems:                       # all or nothing: a refused set changes nothing
+            return self._refuse("fmi2SetReal", problems)
+        for vr, value in zip(vrs, values):
+            setattr(self, self._names[vr], float(value))
+
+    def get_real(self, vrs):
+        problems = self._access_problems(vrs, write=False)
+        if problems:
+            self._refuse("fmi2GetReal", problems)
+            return [math.nan] * len(vrs)
+        return [float(getattr(self, self._names[vr])) for vr in vrs]
+
+    def _no_such_type(self, call: str, vrs) -> None:
+        self._refuse(call, [f"value reference {vr}: this FMU has Real variables only" for vr in vrs]
+                     or ["this FMU has Real variables only"])
+
+    def set_integer(self, vrs, values):
+        self._no_such_type("fmi2SetInteger", vrs)
+
+    def set_boolean(self, vrs, values):
+        self._no_such_type("fmi2SetBoolean", vrs)
+
+    def set_string(self, vrs, values):
+        self._no_such_type("fmi2SetString", vrs)
+
+    def get_integer(self, vrs):
+        self._no_such_type("fmi2GetInteger", vrs)
+        return [0] * len(vrs)
+
+    def get_boolean(self, vrs):
+        self._no_such_type("fmi2GetBoolean", vrs)
+        return [False] * len(vrs)
+
+    def get_string(self, vrs):
+        self._no_such_type("fmi2GetString", vrs)
+        return [""] * len(vrs)
+
+    # -- helpers -------------------------------------------------------------
+    def _input_problems(self) -> list[str]:
+        out = []
+        if not (isinstance(self.x_to, float) and math.isfinite(self.x_to) and abs(self.x_to) <= X_TO_LIMIT):
+            out.append(f"input x_to = {self.x_to!r} m is not finite or |x_to| > {X_TO_LIMIT:g} m")
+        if not (isinstance(self.theta_cm, float) and math.isfinite(self.theta_cm)
+                and 0.0 < self.theta_cm < THETA_CM_LIMIT):
+            out.append(f"input theta_cm = {self.theta_cm!r} K is not finite or outside (0, {THETA_CM_LIMIT:g}) K")
+        if not (isinstance(self.omega_slip, float) and math.isfinite(self.omega_slip)
+                and abs(self.omega_slip) <= OMEGA_SLIP_LIMIT):
+            out.append(f"input omega_slip = {self.omega_slip!r} rad/s is not finite or |omega_slip| > "
+                       f"{OMEGA_SLIP_LIMIT:g} rad/s")
+        return out
+
+    def _update_outputs(self) -> None:
+        try:
+            out = outputs(self.x_to, self.theta_cs, self._table, self._params, self.theta_cm, self.omega_slip)
+        except Exception as exc:  # noqa: BLE001 - logged; refused again at the first step
+            self._problems.append(str(exc))
+            self.log(str(exc), Fmi2Status.error)
+            return
+        self._set_outputs(out)
+
+    def _set_outputs(self, out) -> None:
+        self.torque, self.force, self.u_f, self.x_kiss = out.torque, out.force, out.u_f, out.x_kiss
+        if out.clamped and not self._range_warned:
+            self._range_warned = True
+            self.log(f"theta_cs = {self.theta_cs:.2f} K is outside the table range "
+                     f"[{self._table.theta_min_K:.2f}, {self._table.theta_max_K:.2f}] K; "
+                     "F and the kiss point are clamped to the nearest table temperature "
+                     "(warned once)", Fmi2Status.warning)
+
+    # -- state -------------------------------------------------------------------
+    def _get_fmu_state(self):
+        state = {name: float(getattr(self, name)) for name, _, _, _ in VARIABLES}
+        state.update(_phase=self._phase, _time=self._time, _range_warned=self._range_warned,
+                     _problems=list(self._problems), _faults=list(self._faults))
+        return state
+
+    def _state_problems(self, state) -> list[str]:
+        if not isinstance(state, dict):
+            return ["not a state of this FMU"]
+        if "_invalid" in state:
+            return [str(state["_invalid"])]
+        out = []
+        for name, _, _, _ in VARIABLES:
+            v = state.get(name)
+            if not (isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)):
+                out.append(f"{name} = {v!r} is missing or not finite")
+        if state.get("_phase") not in PHASES:
+            out.append(f"phase {state.get('_phase')!r} is not one of {', '.join(PHASES)}")
+        t = state.get("_time")
+        if t is not None and not (isinstance(t, (int, float)) and math.isfinite(t)):
+            out.append(f"time {t!r} is not finite")
+        if not out and state["_phase"] in ("stepping", "terminated"):
+            params = ClutchParameters(**{p: float(state[p]) for p in PARAMETERS})
+            out += [f"parameter {p}" for p in params.problems()]
+            if not 0.0 < state["theta_cs"] < THETA_CM_LIMIT:
+                out.append(f"theta_cs = {state['theta_cs']!r} K is outside (0, {THETA_CM_LIMIT:g}) K")
+        for key in ("_problems", "_faults"):
+            if not (isinstance(state.get(key), list) and all(isinstance(s, str) for s in state[key])):
+                out.append(f"{key} is not a list of messages")
+        return out
+
+    def _set_fmu_state(self, state):
+        problems = self._state_problems(state)
+        if problems:                       # the instance stays as it was
+            return self._refuse("fmi2SetFMUstate", problems)
+        for name, _, _, _ in VARIABLES:
+            setattr(self, name, float(state[name]))
+        self._phase, self._time = state["_phase"], state["_time"]
+        self._range_warned = bool(state.get("_range_warned"))
+        self._problems, self._faults = list(state["_problems"]), list(state["_faults"])
+        if self._phase in ("stepping", "terminated"):
+            self._params = ClutchParameters(**{p: float(state[p]) for p in PARAMETERS})
+
+    @staticmethod
+    def _fmu_state_to_bytes(state) -> bytes:
+        body = json.dumps(state, sort_keys=True, allow_nan=True)
+        return json.dumps({"format": STATE_FORMAT, "crc32": _crc(body), "state": body}).encode("utf-8")
+
+    @staticmethod
+    def _fmu_state_from_bytes(data: bytes):
+        """The state in ``data``, or ``{"_invalid": reason}`` (refused at fmi2SetFMUstate; never raises)."""
+        try:
+            outer = json.loads(bytes(data).decode("utf-8"))
+            if not isinstance(outer, dict) or outer.get("format") != STATE_FORMAT:
+                return {"_invalid": f"serialized state: not a {STATE_FORMAT} state"}
+            body = outer.get("state")
+            if not isinstance(body, str) or _crc(body) != outer.get("crc32"):
+                return {"_invalid": "serialized state: checksum mismatch (truncated or corrupted)"}
+            return json.loads(body)
+        except Exception as exc:  # noqa: BLE001 - a bad state must never become fmi2Fatal
+            return {"_invalid": f"serialized state: cannot be decoded ({type(exc).__name__})"}

@@ -1,0 +1,135 @@
+"""Property test of the TOML loaders (issue 12, item 8): any document gives an object or a ParameterError.
+
+Documents are the shipped spring and scenario files mutated at random (keys
+dropped, values replaced by other types, NaN, inf, huge numbers, unknown
+keys and sections added), plus arbitrary text. Each must load to a valid,
+frozen object or raise :class:`ParameterError` whose every problem names a
+key (or is a TOML syntax error / an empty-file message); never any other
+exception.
+"""
+from __future__ import annotations
+
+import math
+import tomllib
+
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from cushion_clutch.data import DEFAULT_SCENARIO, DEFAULT_SPRING
+from cushion_clutch.errors import ParameterError
+from cushion_clutch.fe.params import SpringParams, load_params
+from cushion_clutch.launch.scenario import Scenario, load_scenario
+
+BASE = {"spring": tomllib.loads(DEFAULT_SPRING.read_text()),
+        "scenario": tomllib.loads(DEFAULT_SCENARIO.read_text())}
+LOADERS = {"spring": (load_params, SpringParams), "scenario": (load_scenario, Scenario)}
+
+
+def _toml_value(v) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, int):
+        return str(v)
+    if isinstance(v, float):
+        return "nan" if math.isnan(v) else ("inf" if v == math.inf else "-inf" if v == -math.inf else repr(v))
+    if isinstance(v, str):
+        return '"' + v.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n") + '"'
+    if isinstance(v, list):
+        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
+    if isinstance(v, dict):
+        return "{" + ", ".join(f'"{k}" = {_toml_value(x)}' for k, x in v.items()) + "}"
+    raise TypeError(type(v))
+
+
+def to_toml(doc: dict) -> str:
+    """A small TOML writer for the documents this test makes (no dependency needed)."""
+    plain = [f'"{k}" = {_toml_value(v)}' for k, v in doc.items() if not isinstance(v, dict)]
+    tables = [f'["{k}"]\n' + "\n".join(f'"{kk}" = {_toml_value(vv)}' for kk, vv in v.items())
+              for k, v in doc.items() if isinstance(v, dict)]
+    return "\n".join(plain) + "\n\n" + "\n\n".join(tables) + "\n"
+
+
+scalars = st.one_of(
+    st.booleans(), st.integers(-10**6, 10**6), st.floats(allow_nan=True, allow_infinity=True),
+    st.sampled_from([0, -1, 1e308, -1e-300, 2.5, 1e-12]), st.text(max_size=8))
+values = st.one_of(scalars, st.lists(scalars, max_size=4), st.dictionaries(st.text(max_size=5), scalars, max_size=2))
+keys = st.text(st.characters(min_codepoint=97, max_codepoint=122), min_size=1, max_size=8)
+
+
+@st.composite
+def documents(draw, kind: str):
+    doc = {k: (dict(v) if isinstance(v, dict) else v) for k, v in BASE[kind].items()}
+    for _ in range(draw(st.integers(0, 4))):
+        op = draw(st.sampled_from(["drop", "replace", "add", "replace_section", "add_section"]))
+        section = draw(st.sampled_from(sorted(doc))) if doc else None
+        if op == "drop" and section is not None:
+            if isinstance(doc[section], dict) and doc[section] and draw(st.booleans()):
+                doc[section].pop(draw(st.sampled_from(sorted(doc[section]))))
+            else:
+                doc.pop(section)
+        elif op == "replace" and section is not None:
+            if isinstance(doc[section], dict) and doc[section]:
+                doc[section][draw(st.sampled_from(sorted(doc[section])))] = draw(values)
+            else:
+                doc[section] = draw(values)
+        elif op == "add":
+            target = doc[section] if section is not None and isinstance(doc[section], dict) else doc
+            target[draw(keys)] = draw(values)
+        elif op == "replace_section" and section is not None:
+            doc[section] = draw(values)
+        elif op == "add_section":
+            doc[draw(keys)] = draw(st.dictionaries(keys, values, max_size=3))
+    return doc
+
+
+def _key_names(doc) -> set[str]:
+    names = set()
+    for k, v in (doc or {}).items():
+        names.add(str(k))
+        if isinstance(v, dict):
+            names.update(f"{k}.{kk}" for kk in v)
+    return names
+
+
+def _check(kind: str, text: str, tmp_path, doc: dict | None = None) -> None:
+    path = tmp_path / f"{kind}.toml"
+    path.write_text(text, encoding="utf-8")
+    loader, cls = LOADERS[kind]
+    try:
+        obj = loader(path)
+    except ParameterError as exc:
+        assert exc.problems, "a ParameterError must list its problems"
+        names = _key_names(doc) | _key_names(BASE[kind])
+        for p in exc.problems:
+            assert (p.startswith(("TOML syntax error", "the file is empty", "cannot read the file"))
+                    or any(n and n in p for n in names)), f"problem names no key: {p!r}"
+        return
+    assert isinstance(obj, cls)
+
+
+SETTINGS = settings(max_examples=300, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.function_scoped_fixture])
+
+
+@pytest.mark.parametrize("kind", ["spring", "scenario"])
+def test_shipped_documents_load(kind, tmp_path):
+    _check(kind, to_toml(BASE[kind]), tmp_path)
+    assert isinstance(LOADERS[kind][0](tmp_path / f"{kind}.toml"), LOADERS[kind][1])
+
+
+@SETTINGS
+@given(doc=documents("spring"))
+def test_random_spring_documents(doc, tmp_path):
+    _check("spring", to_toml(doc), tmp_path, doc)
+
+
+@SETTINGS
+@given(doc=documents("scenario"))
+def test_random_scenario_documents(doc, tmp_path):
+    _check("scenario", to_toml(doc), tmp_path, doc)
+
+
+@settings(max_examples=100, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(text=st.text(max_size=200), kind=st.sampled_from(["spring", "scenario"]))
+def test_arbitrary_text(text, kind, tmp_path):
+    _check(kind, text, tmp_path)

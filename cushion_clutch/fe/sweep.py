@@ -84,7 +84,7 @@ def solve_case(params: SpringParams, theta_degC: float, workdir: Path, *, paddle
     """
     size = params.mesh.element_size_m
     build = half_pair_assembly if paddles == 1 else pair_assembly
-    assembly = build(params.geometry, size, params.solver.initial_gap_m)
+    assembly = build(params.geometry, size, params.solver.initial_gap_m, params.mesh.element_type)
     deck, _ = paddle_deck(assembly, params, theta_degC)
     count = [0]
 
@@ -224,7 +224,7 @@ def build_tables(params: SpringParams, outcomes: dict[float, CaseOutcome], out_d
         "spring": params.to_dict(),
         "model": "half pair: paddle A against the carrier plane, composed in series "
                  "(pair travel = 2 x paddle travel)" if any_case.result.paddles == 1 else "full pair",
-        "mesh": {"element_size_m": params.mesh.element_size_m, "element_type": "S4",
+        "mesh": {"element_size_m": params.mesh.element_size_m, "element_type": params.mesh.element_type,
                  "nodes": any_case.n_nodes, "elements": any_case.n_elements},
         "units": {"theta_degC": "degC", "u_m": "m", "force_N": "N", "delta_kiss_m": "m"},
         "definitions": {

@@ -205,3 +205,33 @@ def _read_csv(path: Path, columns: list[str]) -> np.ndarray:
         return load_csv(path, tuple(columns))
     except ValueError as exc:
         raise TableError(str(exc)) from exc
+
+
+#: travel fractions (kiss point to full compression) at which progressivity is reported
+PROGRESSIVITY_FRACTIONS = (0.2, 0.5, 0.9)
+
+
+def tangent_stiffness(u_m: np.ndarray, force_N: np.ndarray, fractions=PROGRESSIVITY_FRACTIONS,
+                      window: float = 0.05) -> dict[float, float]:
+    """Tangent stiffness dF/du (N/m) at fractions of the travel from the kiss point to full compression.
+
+    The slope is a secant over ``window`` of that travel centred on each
+    point (clipped to the curve's ends), so that increment noise does not
+    dominate it.
+    """
+    u = np.asarray(u_m, dtype=float)
+    f = np.asarray(force_N, dtype=float)
+    u_full = float(u[-1])
+    out = {}
+    for x in fractions:
+        lo = max(0.0, (x - 0.5 * window) * u_full)
+        hi = min(u_full, (x + 0.5 * window) * u_full)
+        out[x] = float((np.interp(hi, u, f) - np.interp(lo, u, f)) / (hi - lo))
+    return out
+
+
+def progressivity(u_m: np.ndarray, force_N: np.ndarray) -> dict[str, float]:
+    """k(20 %), k(50 %), k(90 %) in N/m and the ratio k(90 %)/k(20 %) of one curve."""
+    k = tangent_stiffness(u_m, force_N)
+    return {"k20_N_per_m": k[0.2], "k50_N_per_m": k[0.5], "k90_N_per_m": k[0.9],
+            "k90_over_k20": k[0.9] / k[0.2]}

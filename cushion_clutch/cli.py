@@ -52,11 +52,15 @@ def _sweep(args: argparse.Namespace) -> int:
     plot_force_deflection(tables, out / "force_deflection.png", f"Spring '{params.name}' (CalculiX)")
     plot_kiss_shift(tables, out / "kiss_point.png")
     print(f"tables written to {out} in {wall:.1f} s (mesh {params.mesh.element_size_m * 1e3:g} mm)")
-    print(f"{'theta [degC]':>12} {'delta_kiss [mm]':>16} {'F full [N]':>11} {'increments':>10}")
+    prog, crest = tables.metadata["progressivity"], tables.metadata["kiss_point"]
+    print(f"{'theta [degC]':>12} {'delta_kiss [mm]':>16} {'crest growth [mm]':>18} {'F full [N]':>11} "
+          f"{'k20/k50/k90 [kN/mm]':>20} {'k90/k20':>8} {'increments':>10}")
     for c in curves:
-        o = outcomes[c.theta_degC]
-        print(f"{c.theta_degC:>12g} {shifts[c.theta_degC] * 1e3:>16.4f} {c.force_N[-1]:>11.0f} "
-              f"{o.stats.increments:>10d}")
+        o, k = outcomes[c.theta_degC], prog[f"{c.theta_degC:g}"]
+        ks = "/".join(f"{k[n] / 1e6:.2f}" for n in ("k20_N_per_m", "k50_N_per_m", "k90_N_per_m"))
+        print(f"{c.theta_degC:>12g} {shifts[c.theta_degC] * 1e3:>16.4f} "
+              f"{crest[f'{c.theta_degC:g}']['crest_growth_m'] * 1e3:>18.4f} {c.force_N[-1]:>11.0f} "
+              f"{ks:>20} {k['k90_over_k20']:>8.2f} {o.stats.increments:>10d}")
     return 0
 
 

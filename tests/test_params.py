@@ -73,3 +73,19 @@ def test_replace_rechecks():
     assert p.replace(mesh={"element_size_m": 2e-3}).mesh.element_size_m == 2e-3
     with pytest.raises(ParameterError, match="mesh.element_size_m"):
         p.replace(mesh={"element_size_m": -1.0})
+
+
+def test_default_is_progressive_by_its_far_zone_and_states_alpha():
+    p = load_params(DEFAULT_SPRING)
+    assert p.geometry.far_zone_support == "carrier" and p.geometry.far_end == "elastic"
+    text = DEFAULT_SPRING.read_text()
+    assert "1.12e-6" in text and "11-13 um/(m K)" in text
+
+
+def test_old_penalty_key_is_rejected_and_new_ones_checked():
+    with pytest.raises(ParameterError, match=r"solver\.penalty_stiffness_N_per_m: unknown key"):
+        params_from_dict({"solver": {"penalty_stiffness_N_per_m": 1e8}})
+    with pytest.raises(ParameterError, match=r"solver\.surface_penalty_Pa_per_m = 10: out of range"):
+        params_from_dict({"solver": {"surface_penalty_Pa_per_m": 10}})
+    with pytest.raises(ParameterError, match=r"mesh\.element_type = 'S3': allowed"):
+        params_from_dict({"mesh": {"element_type": "S3"}})

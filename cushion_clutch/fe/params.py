@@ -277,7 +277,7 @@ class Solver(Checked):
 
     contact: str = "node_to_surface"
     node_penalty_N_per_m: float = 1e8
-    surface_penalty_Pa_per_m: float = 1e12
+    surface_penalty_Pa_per_m: float = 1e14
     tension_N: float = 0.01
     initial_gap_m: float = 0.15e-3
     compression_increments: int = 60
@@ -291,7 +291,7 @@ class Solver(Checked):
     def _problems(self) -> Iterable[str]:
         yield from self._ranges({
             "node_penalty_N_per_m": (1e5, 1e12),
-            "surface_penalty_Pa_per_m": (1e8, 1e16),
+            "surface_penalty_Pa_per_m": (1e9, 1e18),
             "tension_N": (0.0, 10.0),
             "initial_gap_m": (0.0, 2e-3, True),
             "compression_increments": (30, 1000),

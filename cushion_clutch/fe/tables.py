@@ -11,8 +11,14 @@ Table files (all SI):
     ``theta_degC,delta_kiss_m``: growth of the spring's free height relative
     to the reference temperature, i.e. how far the kiss point moves towards
     the open side (m).
+``crest_growth.csv``
+    ``theta_degC,crest_growth_m``: growth of the pair's free height at the
+    wave crest (mean radius) from heating alone, relative to the reference
+    temperature (m). Unlike ``delta_kiss_m`` (where the 10 N point moves) it
+    holds no stiffness change; the two differ by how much softer the hot
+    spring is at first touch.
 ``metadata.json``
-    Parameters, mesh, solver, statistics, date and code version.
+    Parameters, mesh, solver, statistics, progressivity, date and code version.
 """
 from __future__ import annotations
 
@@ -111,8 +117,10 @@ def kiss_shift(curves: list[Curve], reference_degC: float) -> dict[float, float]
 
 
 def write_tables(out_dir: Path, curves: list[Curve], reference_degC: float,
-                 metadata: dict) -> Path:
+                 metadata: dict, crest_growth_m: dict[float, float] | None = None) -> Path:
     """Write a table set atomically: all files appear together or not at all.
+
+    ``crest_growth_m`` (theta to m), if given, goes to ``crest_growth.csv``.
 
     The set is built in a temporary sibling folder and renamed into place;
     an existing set is replaced only after the new one is complete.
@@ -133,6 +141,12 @@ def write_tables(out_dir: Path, curves: list[Curve], reference_degC: float,
             w.writerow(["theta_degC", "delta_kiss_m"])
             for t in sorted(shifts):
                 w.writerow([f"{t:g}", f"{shifts[t]:.9e}"])
+        if crest_growth_m is not None:
+            with open(tmp / "crest_growth.csv", "w", newline="") as fh:
+                w = csv.writer(fh)
+                w.writerow(["theta_degC", "crest_growth_m"])
+                for t in sorted(crest_growth_m):
+                    w.writerow([f"{t:g}", f"{crest_growth_m[t]:.9e}"])
         (tmp / "metadata.json").write_text(json.dumps(metadata, indent=2, default=_jsonable) + "\n")
         backup = None
         if out_dir.exists():

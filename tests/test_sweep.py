@@ -32,8 +32,8 @@ def test_tables_have_the_paper_properties(coarse_tables):
         assert np.interp(0.0, u, f) == pytest.approx(80.0)
         # full compression of a passenger-car spring: 3-8 kN
         assert 3e3 <= f[-1] <= 8e3
-        # about 2 x 0.7 mm of travel from the kiss point to full compression
-        assert 1.0e-3 < u[-1] < 1.5e-3
+        # up to 2 x 0.97 x 1.0 mm (the outer edge's wave) from the kiss point to full compression
+        assert 1.0e-3 < u[-1] < 2.0e-3
     # paper: about 0.1 mm axial kiss-point shift at 195 degC
     assert t.delta_kiss_m[0] == 0.0
     assert 0.07e-3 <= t.delta_kiss_m[1] <= 0.14e-3
@@ -58,7 +58,7 @@ def test_metadata_records_provenance(coarse_tables):
     m = coarse_tables.metadata
     assert m["solver"]["name"] == "CalculiX ccx" and m["solver"]["version"] != "unknown"
     assert m["mesh"]["nodes"] > 0 and m["mesh"]["elements"] > 0
-    assert m["spring"]["geometry"]["thickness_m"] == pytest.approx(0.4e-3)
+    assert m["spring"]["geometry"]["thickness_m"] == pytest.approx(0.42e-3)
     for case in m["cases"].values():
         assert case["increments"] > 30 and case["iterations"] > 0 and case["wall_time_s"] > 0
 
@@ -137,11 +137,12 @@ QUICK = {"mesh": {"element_size_m": 4e-3}, "solver": {"compression_increments": 
 
 
 @pytest.mark.parametrize("geometry, mesh", [
-    ({"wave_tilt_m": 0.4e-3}, {}),
-    ({"waves": 2, "wave_profile": "flat_top", "crest_flat_fraction": 0.4}, {"element_type": "S4R"}),
+    ({"wave_tilt_m": 0.4e-3, "far_zone_support": "carrier"}, {}),
+    ({"waves": 2, "wave_profile": "flat_top", "crest_flat_fraction": 0.4, "wave_tilt_m": 0.0},
+     {"element_type": "S4R"}),
     ({"wave_profile": "table", "profile_s": (0.0, 0.3, 0.7, 1.0), "profile_z": (0.0, 1.0, 1.0, 0.0),
-      "far_zone_support": "slot"}, {"element_type": "S8R"}),
-], ids=["tilted", "two-flat-top-S4R", "table-slot-S8R"])
+      "wave_tilt_m": 0.0}, {"element_type": "S8R"}),
+], ids=["tilted-resting", "two-flat-top-S4R", "table-S8R"])
 def test_every_new_shape_builds_meshes_and_solves(coarse, tmp_path, geometry, mesh):
     p = coarse.replace(geometry=geometry, **{**QUICK, "mesh": {**QUICK["mesh"], **mesh}})
     out = solve_case(p, 195.0, tmp_path)
@@ -153,7 +154,7 @@ def test_every_new_shape_builds_meshes_and_solves(coarse, tmp_path, geometry, me
 def test_tilted_wave_is_more_progressive_than_plain_cosine(coarse, case_cache):
     """Same mean height 0.7 mm: the tilted wave touches at one edge first and stiffens later."""
     ratios = {}
-    for name, tilt in (("cosine", 0.0), ("tilted", 0.5e-3)):
+    for name, tilt in (("cosine", 0.0), ("tilted", coarse.geometry.wave_tilt_m)):
         p = coarse.replace(geometry={"wave_tilt_m": tilt}, sweep={"temperatures_degC": (20.0,)})
         case = run_sweep(p, cache_dir=case_cache)[20.0]
         c = curve_from_case(case.result, p.n_pairs, p.sweep.kiss_force_N)

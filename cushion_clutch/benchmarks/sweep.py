@@ -40,9 +40,10 @@ def compare(coarse, fine) -> tuple[float, float]:
     return full, point
 
 
-def _model(text: str) -> tuple[float, str]:
-    size, _, kind = text.partition(":")
-    return float(size), kind or "S4"
+def _model(text: str) -> tuple[float, str, int | None]:
+    """``SIZE_M[:TYPE[:INCREMENTS]]``, e.g. ``1e-3:S4:30``."""
+    size, kind, inc = (text.split(":") + ["", ""])[:3]
+    return float(size), kind or "S4", int(inc) if inc else None
 
 
 def _sweep(params, cache, jobs):
@@ -61,7 +62,7 @@ def main(argv=None) -> None:
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--models", nargs="*", default=["0.5e-3:S4", "1e-3:S4", "2e-3:S8R", "2e-3:S4"],
-                    help="SIZE_M:TYPE, the first is the reference")
+                    help="SIZE_M[:TYPE[:INCREMENTS]], the first is the reference")
     ap.add_argument("--temps", help="comma-separated temperatures (default: the spring's)")
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--cache", type=Path, default=None,
@@ -75,15 +76,16 @@ def main(argv=None) -> None:
     cache = args.cache or Path(tempfile.mkdtemp(prefix="bench_cache_"))
     tables = {}
     for text in args.models:
-        size, kind = _model(text)
-        p = base.replace(mesh={"element_size_m": size, "element_type": kind})
+        size, kind, inc = _model(text)
+        p = base.replace(mesh={"element_size_m": size, "element_type": kind},
+                         solver={"compression_increments": inc or base.solver.compression_increments})
         t, outcomes, wall = _sweep(p, cache, args.jobs)
         tables[text] = t
         o = next(iter(outcomes.values()))
         cpu = sum(v.stats.wall_time_s for v in outcomes.values())
         prog = t.metadata["progressivity"]
         k = prog[f"{t.theta_degC[0]:g}"]["k90_over_k20"]
-        print(f"{size * 1e3:4.2f} mm {kind:4s}: {o.n_elements:5d} elements, {len(outcomes)} temperatures, "
+        print(f"{size * 1e3:4.2f} mm {kind:4s} {p.solver.compression_increments:3d} inc: {o.n_elements:5d} elements, {len(outcomes)} temperatures, "
               f"sweep wall {wall:7.1f} s (sum of ccx case times {cpu:7.1f} s), "
               f"F_full({t.theta_degC[0]:g} C) = {t.force_N[0][-1]:.0f} N, k90/k20 = {k:.2f}", flush=True)
     ref = args.models[0]
@@ -97,7 +99,7 @@ def main(argv=None) -> None:
 
 def sensitivity(base, model, cache, jobs) -> None:
     """Print delta_kiss(195 C) and crest growth with kappa and tab stiffness at 50/100/150 %."""
-    size, kind = model
+    size, kind, _ = model
     base = base.replace(mesh={"element_size_m": size, "element_type": kind},
                         sweep={"temperatures_degC": (20.0, 195.0)})
     kap, tab = base.carrier.temperature_ratio, base.carrier.far_end_stiffness_N_per_m

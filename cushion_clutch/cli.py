@@ -73,11 +73,39 @@ def _sweep(args: argparse.Namespace) -> int:
         plot_force_deflection(tables, stage / "force_deflection.png", f"Spring '{params.name}' (CalculiX)")
         plot_kiss_shift(tables, stage / "kiss_point.png")
     print(f"tables written to {out} in {wall:.1f} s (mesh {params.mesh.element_size_m * 1e3:g} mm)")
-    print(f"{'theta [degC]':>12} {'delta_kiss [mm]':>16} {'F full [N]':>11} {'increments':>10}")
+    prog, crest = tables.metadata["progressivity"], tables.metadata["kiss_point"]
+    print(f"{'theta [degC]':>12} {'delta_kiss [mm]':>16} {'crest growth [mm]':>18} {'F full [N]':>11} "
+          f"{'k20/k50/k90 [kN/mm]':>20} {'k90/k20':>8} {'increments':>10}")
     for c in curves:
-        o = outcomes[c.theta_degC]
-        print(f"{c.theta_degC:>12g} {shifts[c.theta_degC] * 1e3:>16.4f} {c.force_N[-1]:>11.0f} "
-              f"{o.stats.increments:>10d}")
+        o, k = outcomes[c.theta_degC], prog[f"{c.theta_degC:g}"]
+        ks = "/".join(f"{k[n] / 1e6:.2f}" for n in ("k20_N_per_m", "k50_N_per_m", "k90_N_per_m"))
+        print(f"{c.theta_degC:>12g} {shifts[c.theta_degC] * 1e3:>16.4f} "
+              f"{crest[f'{c.theta_degC:g}']['crest_growth_m'] * 1e3:>18.4f} {c.force_N[-1]:>11.0f} "
+              f"{ks:>20} {k['k90_over_k20']:>8.2f} {o.stats.increments:>10d}")
+    return 0
+
+
+def _calibrate(args: argparse.Namespace) -> int:
+    from .fe.calibrate import calibrate, parse_bounds, read_measured
+    from .fe.calibration_report import params_toml, plot_calibration, report_text
+    from .fe.params import load_params
+
+    params = load_params(args.spring)
+    if args.mesh_size is not None:
+        params = params.replace(mesh={"element_size_m": args.mesh_size})
+    measured = read_measured(args.measured, args.basis)
+    out = Path(args.out)
+    cal = calibrate(params, measured, [n.strip() for n in args.fit.split(",") if n.strip()],
+                    parse_bounds(args.bounds), cache_dir=Path(args.cache), jobs=args.jobs,
+                    scheduler=args.scheduler,
+                    on_case=lambda n: print(f"FE case {n} done", file=sys.stderr, flush=True))
+    report = report_text(cal)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text(params_toml(cal.params, f"calibrated by cushion-clutch calibrate to {args.measured}\n"
+                               + report), encoding="utf-8")
+    out.with_suffix(".txt").write_text(report, encoding="utf-8")
+    png = plot_calibration(cal, out.with_suffix(".png"), f"Spring '{params.name}': FE against {Path(args.measured).name}")
+    print(report + f"wrote {out}, {out.with_suffix('.txt')} and {png}")
     return 0
 
 
@@ -204,6 +232,20 @@ def build_parser() -> argparse.ArgumentParser:
     sw.add_argument("--scheduler", help="Dask scheduler address, e.g. tcp://host:8786")
     sw.add_argument("--cache", default=DEFAULT_CACHE, help="case cache folder")
     sw.set_defaults(func=_sweep)
+
+    ca = sub.add_parser("calibrate", help="fit spring parameters to a measured load-deflection curve")
+    ca.add_argument("--measured", required=True, help="CSV u_m,force_N from the kiss point (room temperature)")
+    ca.add_argument("--basis", choices=("pair", "spring"), default="pair",
+                    help="the measured force is of one paddle pair (default) or the whole spring")
+    ca.add_argument("--spring", default=DEFAULT_SPRING, help="start parameter TOML")
+    ca.add_argument("--fit", required=True, help="comma-separated keys, e.g. wave_height_m,thickness_m")
+    ca.add_argument("--bounds", help="NAME=LOWER:UPPER,... (default: start value +-30 %%)")
+    ca.add_argument("--out", required=True, help="calibrated TOML (report .txt and .png beside it)")
+    ca.add_argument("--mesh-size", type=float, help="override mesh.element_size_m [m]")
+    ca.add_argument("--jobs", type=int, default=2, help="parallel ccx jobs")
+    ca.add_argument("--scheduler", help="Dask scheduler address, e.g. tcp://host:8786")
+    ca.add_argument("--cache", default=DEFAULT_CACHE, help="case cache folder")
+    ca.set_defaults(func=_calibrate)
 
     sm = sub.add_parser("simulate", help="repeated engagements through the FMU with fmpy, with plots")
     sm.add_argument("--fmu", help="FMU to simulate (default: build one from --tables into --out)")

@@ -9,7 +9,7 @@ from cushion_clutch.fe.params import DEFAULT_SPRING, SpringParams, load_params, 
 def test_default_file_loads_and_matches_paper():
     p = load_params(DEFAULT_SPRING)
     assert p.n_pairs == 8
-    assert p.geometry.thickness_m == pytest.approx(0.4e-3)
+    assert p.geometry.thickness_m == pytest.approx(0.42e-3)     # 0.4 mm in the paper, see the TOML
     assert p.geometry.wave_height_m == pytest.approx(0.7e-3)
     assert p.material.youngs_modulus_Pa == (206e9, 202e9, 196e9, 186e9)
     assert p.material.temperatures_degC == (20.0, 80.0, 200.0, 350.0)
@@ -33,7 +33,7 @@ def test_unknown_key_is_named(tmp_path):
 
 def test_out_of_range_names_key_and_range(tmp_path):
     f = tmp_path / "s.toml"
-    text = DEFAULT_SPRING.read_text().replace("thickness_m = 0.4e-3", "thickness_m = 0.04")
+    text = DEFAULT_SPRING.read_text().replace("thickness_m = 0.42e-3", "thickness_m = 0.04")
     text = text.replace("poisson_ratio = 0.3", "poisson_ratio = 0.7")
     f.write_text(text)
     with pytest.raises(ParameterError) as info:
@@ -73,3 +73,21 @@ def test_replace_rechecks():
     assert p.replace(mesh={"element_size_m": 2e-3}).mesh.element_size_m == 2e-3
     with pytest.raises(ParameterError, match="mesh.element_size_m"):
         p.replace(mesh={"element_size_m": -1.0})
+
+
+def test_default_is_progressive_by_its_tilt_and_states_alpha():
+    p = load_params(DEFAULT_SPRING)
+    assert p.geometry.wave_tilt_m == pytest.approx(0.6e-3)
+    assert p.geometry.edge_heights_m() == pytest.approx((0.4e-3, 1.0e-3))
+    assert p.geometry.far_zone_support == "slot" and p.geometry.far_end == "elastic"
+    text = DEFAULT_SPRING.read_text()
+    assert "1.12e-6" in text and "11-13 um/(m K)" in text
+
+
+def test_old_penalty_key_is_rejected_and_new_ones_checked():
+    with pytest.raises(ParameterError, match=r"solver\.penalty_stiffness_N_per_m: unknown key"):
+        params_from_dict({"solver": {"penalty_stiffness_N_per_m": 1e8}})
+    with pytest.raises(ParameterError, match=r"solver\.surface_penalty_Pa_per_m = 10: out of range"):
+        params_from_dict({"solver": {"surface_penalty_Pa_per_m": 10}})
+    with pytest.raises(ParameterError, match=r"mesh\.element_type = 'S3': allowed"):
+        params_from_dict({"mesh": {"element_type": "S3"}})

@@ -1,10 +1,17 @@
-"""Benchmark: wall time of the default 5-temperature sweep at several meshes.
+"""Benchmark: FE cost at fine-mesh accuracy, and how certain the kiss-point shift is.
 
-Prints the wall time per mesh and the largest relative force difference of
-each mesh against the finest, over u between the kiss point and 90 % of the
-full compression (the stiff end is reported separately).
+Part 1 (``--models``) solves the default spring's sweep with several models
+(element size and type, e.g. ``1e-3:S4 2e-3:S8R``) and prints each one's wall
+time and its largest force difference to the reference model (the first of
+``--models``, by default 0.5 mm S4) over the whole curve from the kiss point
+to full compression, relative to the reference's full-compression force, and
+pointwise above 10 % of it.
 
-    python -m cushion_clutch.benchmarks.sweep [--sizes 2e-3 1e-3 0.5e-3]
+Part 2 (``--sensitivity``) prints delta_kiss(195 degC) with kappa
+(``carrier.temperature_ratio``) and the tab stiffness each at 50 % and 150 %
+of the default, at the mesh of ``--sens-model``.
+
+    python -m cushion_clutch.benchmarks.sweep --models 0.5e-3:S4 1e-3:S4 --temps 20 --sensitivity
 """
 from __future__ import annotations
 
@@ -17,51 +24,97 @@ import numpy as np
 
 
 def compare(coarse, fine) -> tuple[float, float]:
-    """Largest relative force difference (body, stiff end) of two table sets."""
-    body = end = 0.0
+    """Largest force difference of two table sets over the whole curve.
+
+    Returns (largest |dF| / F_full of the reference, largest |dF| / F pointwise where
+    F > 10 % of F_full); u from the kiss point to the shorter curve's end.
+    """
+    full = point = 0.0
     for uc, fc, uf, ff in zip(coarse.u_m, coarse.force_N, fine.u_m, fine.force_N):
         u_max = min(uc[-1], uf[-1])
-        u = uf[(uf > 0) & (uf <= 0.9 * u_max)]
-        rel = np.abs(np.interp(u, uc, fc) / np.interp(u, uf, ff) - 1)
-        body = max(body, float(rel.max()))
-        u_end = uf[(uf > 0.9 * u_max) & (uf <= u_max)]
-        if len(u_end):
-            end = max(end, float(np.max(np.abs(np.interp(u_end, uc, fc) / np.interp(u_end, uf, ff) - 1))))
-    return body, end
+        u = np.linspace(0.0, u_max, 400)
+        a, b = np.interp(u, uc, fc), np.interp(u, uf, ff)
+        full = max(full, float(np.max(np.abs(a - b)) / ff[-1]))
+        big = b > 0.1 * ff[-1]
+        point = max(point, float(np.max(np.abs(a[big] / b[big] - 1))))
+    return full, point
+
+
+def _model(text: str) -> tuple[float, str, int | None]:
+    """``SIZE_M[:TYPE[:INCREMENTS]]``, e.g. ``1e-3:S4:30``."""
+    size, kind, inc = (text.split(":") + ["", ""])[:3]
+    return float(size), kind or "S4", int(inc) if inc else None
+
+
+def _sweep(params, cache, jobs):
+    from cushion_clutch.fe.sweep import build_tables, run_sweep
+    from cushion_clutch.fe.tables import read_tables
+    t0 = time.perf_counter()
+    outcomes = run_sweep(params, cache_dir=cache, jobs=jobs)
+    wall = time.perf_counter() - t0
+    out = Path(tempfile.mkdtemp(prefix="bench_tables_"))
+    build_tables(params, outcomes, out / "t", wall_time_s=wall)
+    return read_tables(out / "t"), outcomes, wall
 
 
 def main(argv=None) -> None:
     from cushion_clutch.fe.params import load_params
-    from cushion_clutch.fe.sweep import build_tables, run_sweep
-    from cushion_clutch.fe.tables import read_tables
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--sizes", type=float, nargs="+", default=[2e-3, 1e-3, 0.5e-3])
-    ap.add_argument("--jobs", type=int, default=None)
+    ap.add_argument("--models", nargs="*", default=["0.5e-3:S4", "1e-3:S4", "2e-3:S8R", "2e-3:S4"],
+                    help="SIZE_M[:TYPE[:INCREMENTS]], the first is the reference")
+    ap.add_argument("--temps", help="comma-separated temperatures (default: the spring's)")
+    ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--cache", type=Path, default=None,
-                    help="case cache to fill (default: a temporary one, so every case is solved)")
+                    help="case cache (default: a temporary one, so every case is solved)")
+    ap.add_argument("--sensitivity", action="store_true", help="kappa and tab stiffness +-50 %%")
+    ap.add_argument("--sens-model", default="2e-3:S4")
     args = ap.parse_args(argv)
+    base = load_params()
+    if args.temps:
+        base = base.replace(sweep={"temperatures_degC": tuple(float(t) for t in args.temps.split(","))})
+    cache = args.cache or Path(tempfile.mkdtemp(prefix="bench_cache_"))
     tables = {}
-    with tempfile.TemporaryDirectory() as tmp:
-        for size in args.sizes:
-            p = load_params().replace(mesh={"element_size_m": size})
-            t0 = time.perf_counter()
-            outcomes = run_sweep(p, cache_dir=args.cache or Path(tmp) / f"cache_{size:g}", jobs=args.jobs)
-            wall = time.perf_counter() - t0
-            out = Path(tmp) / f"tables_{size:g}"
-            build_tables(p, outcomes, out, wall_time_s=wall)
-            tables[size] = read_tables(out)
-            o = next(iter(outcomes.values()))
-            d195 = dict(zip(tables[size].theta_degC, tables[size].delta_kiss_m)).get(195.0, float("nan"))
-            print(f"mesh {size * 1e3:4.2f} mm: {o.n_elements:5d} elements, sweep wall time "
-                  f"{wall:7.1f} s, delta_kiss(195 C) = {d195 * 1e3:.4f} mm, "
-                  f"F_full(20 C) = {tables[size].force_N[0][-1]:.0f} N", flush=True)
-    finest = min(args.sizes)
-    for size in args.sizes:
-        if size != finest:
-            body, end = compare(tables[size], tables[finest])
-            print(f"mesh {size * 1e3:.2f} mm vs {finest * 1e3:.2f} mm: largest relative force "
-                  f"difference {body:.2%} (u up to 90 % of full compression), {end:.2%} at the stiff end")
+    for text in args.models:
+        size, kind, inc = _model(text)
+        p = base.replace(mesh={"element_size_m": size, "element_type": kind},
+                         solver={"compression_increments": inc or base.solver.compression_increments})
+        t, outcomes, wall = _sweep(p, cache, args.jobs)
+        tables[text] = t
+        o = next(iter(outcomes.values()))
+        cpu = sum(v.stats.wall_time_s for v in outcomes.values())
+        prog = t.metadata["progressivity"]
+        k = prog[f"{t.theta_degC[0]:g}"]["k90_over_k20"]
+        print(f"{size * 1e3:4.2f} mm {kind:4s} {p.solver.compression_increments:3d} inc: {o.n_elements:5d} elements, {len(outcomes)} temperatures, "
+              f"sweep wall {wall:7.1f} s (sum of ccx case times {cpu:7.1f} s), "
+              f"F_full({t.theta_degC[0]:g} C) = {t.force_N[0][-1]:.0f} N, k90/k20 = {k:.2f}", flush=True)
+    ref = args.models[0]
+    for text in args.models[1:]:
+        full, point = compare(tables[text], tables[ref])
+        print(f"{text} vs {ref}: largest force difference {full:.2%} of the full force, "
+              f"{point:.2%} pointwise above 10 % of it")
+    if args.sensitivity:
+        sensitivity(base, _model(args.sens_model), cache, args.jobs)
+
+
+def sensitivity(base, model, cache, jobs) -> None:
+    """Print delta_kiss(195 C) and crest growth with kappa and tab stiffness at 50/100/150 %."""
+    size, kind, _ = model
+    base = base.replace(mesh={"element_size_m": size, "element_type": kind},
+                        sweep={"temperatures_degC": (20.0, 195.0)})
+    kap, tab = base.carrier.temperature_ratio, base.carrier.far_end_stiffness_N_per_m
+    print(f"delta_kiss(195 C) sensitivity at {size * 1e3:g} mm {kind}:")
+    for label, car in [("default", {}), ("kappa x0.5", {"temperature_ratio": 0.5 * kap}),
+                       ("kappa x1.5", {"temperature_ratio": 1.5 * kap}),
+                       ("tab x0.5", {"far_end_stiffness_N_per_m": 0.5 * tab}),
+                       ("tab x1.5", {"far_end_stiffness_N_per_m": 1.5 * tab})]:
+        p = base.replace(carrier=car)
+        t, _, wall = _sweep(p, cache, jobs)
+        d = dict(zip(t.theta_degC, t.delta_kiss_m))[195.0]
+        g = t.metadata["kiss_point"]["195"]["crest_growth_m"]
+        print(f"  {label:11s} kappa = {p.carrier.temperature_ratio:.3g}, tab = "
+              f"{p.carrier.far_end_stiffness_N_per_m:.3g} N/m: delta_kiss = {d * 1e3:.4f} mm, "
+              f"crest growth = {g * 1e3:.4f} mm ({wall:.0f} s)", flush=True)
 
 
 if __name__ == "__main__":

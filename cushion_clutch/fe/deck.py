@@ -45,11 +45,11 @@ def _id_lines(ids: Iterable[int], per_line: int = 12) -> list[str]:
             for k in range(0, len(ids), per_line)]
 
 
-def _mesh_block(mesh: ShellMesh, elset: str = "PADDLE") -> list[str]:
+def _mesh_block(mesh: ShellMesh, elset: str = "PADDLE", element_type: str = "S4") -> list[str]:
     out = ["*NODE, NSET=NPADDLE"]
     out += [f"{i + 1}, {_fmt(x * MM)}, {_fmt(y * MM)}, {_fmt(z * MM)}"
             for i, (x, y, z) in enumerate(mesh.nodes)]
-    out.append(f"*ELEMENT, TYPE=S4, ELSET={elset}")
+    out.append(f"*ELEMENT, TYPE={element_type}, ELSET={elset}")
     out += [f"{e + 1}, " + ", ".join(str(n + 1) for n in conn) for e, conn in enumerate(mesh.elements)]
     for name, ids in mesh.node_sets.items():
         out.append(f"*NSET, NSET={name}")
@@ -122,10 +122,10 @@ def _contact_block(assembly: Assembly, params: SpringParams) -> list[str]:
     for surf, elset, face, _ in pairs:
         out += [f"*SURFACE, NAME={surf}, TYPE=ELEMENT", f"{elset}, {face}"]
     if sol.contact == "node_to_surface":
-        slope = sol.penalty_stiffness_N_per_m / MM          # N/mm per slave node
+        slope = sol.node_penalty_N_per_m / MM                 # N/m -> N/mm per slave node
         kind = "NODE TO SURFACE"
     else:
-        slope = sol.penalty_stiffness_N_per_m / MM          # used as MPa/mm for faces
+        slope = sol.surface_penalty_Pa_per_m * MPA / MM      # Pa/m -> MPa/mm
         kind = "SURFACE TO SURFACE"
     out += ["*SURFACE INTERACTION, NAME=SI",
             "*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR",
@@ -166,7 +166,7 @@ def paddle_deck(assembly: Assembly, params: SpringParams, theta_degC: float) -> 
     mesh, geom, sol = assembly.mesh, params.geometry, params.solver
     lines = [f"** cushion_clutch: spring '{params.name}', theta = {theta_degC:g} degC, "
              f"{assembly.paddles} paddle(s), units mm N MPa degC"]
-    lines += _mesh_block(mesh)
+    lines += _mesh_block(mesh, element_type=params.mesh.element_type)
     lines += _material_block(params.material, params.sweep.thermal_distortion)
     lines += ["*SHELL SECTION, ELSET=PADDLE, MATERIAL=STEEL", _fmt(mesh.thickness_m * MM)]
     plate_lines, refs = _plate_block(assembly.plates, mesh.n_nodes + 1, mesh.n_elements + 1)
@@ -202,7 +202,7 @@ def paddle_deck(assembly: Assembly, params: SpringParams, theta_degC: float) -> 
     lines.append("*END STEP")
 
     # step 2: displacement-controlled compression
-    travel_m = sol.initial_gap_m + sol.flatten_fraction * geom.wave_height_m
+    travel_m = sol.initial_gap_m + sol.flatten_fraction * geom.max_wave_height_m
     dt = 1.0 / sol.compression_increments
     lines += [f"*STEP, NLGEOM, INC={sol.max_increments}", *_CONTROLS, "*STATIC",
               f"{_fmt(dt)}, 1.0, {_fmt(dt * 1e-4)}, {_fmt(dt)}", "*BOUNDARY",

@@ -22,8 +22,20 @@ class Geometry(Checked):
 
     Angles are measured along the circumference from the paddle's clamped
     end. The paddle's mid-surface height above the carrier face is
-    ``t/2 + w(phi)``, with ``w = h/2 (1 - cos(2 pi s))`` for
-    ``s = (phi - wave_start)/(wave_end - wave_start)`` in [0, 1], else 0.
+    ``t/2 + c + w(r, phi)``. Between ``wave_start_deg`` and ``wave_end_deg``
+    lie ``waves`` equal waves; with ``s`` in [0, 1] the position within one
+    wave, ``w = h(r) p(s)`` with the unit profile ``p``:
+
+    - ``"cosine"``: ``p = (1 - cos(2 pi s)) / 2``;
+    - ``"flat_top"``: a flat crest over the middle ``crest_flat_fraction`` of
+      the wave, joined to the flat ends by half-cosine flanks (trapezoidal);
+    - ``"table"``: ``p`` linear through the points
+      (``profile_s``, ``profile_z``), both in [0, 1], starting and ending at 0
+      and peaking at 1.
+
+    ``h(r)`` is ``wave_height_m`` at the mean radius and varies linearly with
+    the radius by ``wave_tilt_m`` (outer edge height minus inner edge height):
+    a tilted wave touches first at one edge and contact spreads across.
     """
 
     inner_radius_m: float = 0.072
@@ -39,6 +51,22 @@ class Geometry(Checked):
     """Clearance between the paddle's underside and the carrier face (the
     back of the other paddle) outside the rivet zone, m. A few micrometres
     keep the penalty contact from chattering at zero gap."""
+    waves: int = 1
+    """Number of equal waves between ``wave_start_deg`` and ``wave_end_deg``."""
+    wave_tilt_m: float = 0.0
+    """Wave height at the outer edge minus that at the inner edge, m."""
+    wave_profile: str = "cosine"
+    """``"cosine"`` | ``"flat_top"`` | ``"table"`` (see the class docstring)."""
+    crest_flat_fraction: float = 0.3
+    """Share of one wave's span that is flat crest (``wave_profile = "flat_top"``)."""
+    profile_s: tuple[float, ...] = (0.0, 0.5, 1.0)
+    """Positions within one wave, 0..1, strictly increasing (``"table"``)."""
+    profile_z: tuple[float, ...] = (0.0, 1.0, 0.0)
+    """Heights as fractions of the wave height, 0..1, at ``profile_s`` (``"table"``)."""
+    far_zone_support: str = "slot"
+    """Axial support of the flat far zone (``wave_end_deg`` to ``span_deg``):
+    ``"slot"`` the carrier holds it flat in a slot; ``"carrier"`` it rests on
+    the carrier face, contact only, free to lift."""
     far_end: str = "elastic"
     """The flat far zone between ``wave_end_deg`` and ``span_deg`` sits in a
     slot of the carrier that holds it axially (flat) but lets it slide in its
@@ -76,6 +104,49 @@ class Geometry(Checked):
                        f"{self.wave_start_deg!r} < {self.wave_end_deg!r} <= {self.span_deg!r}")
         if self.far_end not in ("free", "locked", "elastic"):
             yield f"geometry.far_end = {self.far_end!r}: allowed 'free', 'locked' or 'elastic'"
+        if self.far_zone_support not in ("slot", "carrier"):
+            yield (f"geometry.far_zone_support = {self.far_zone_support!r}: allowed 'slot' or "
+                   "'carrier'")
+        if isinstance(self.waves, bool) or not isinstance(self.waves, int) or not 1 <= self.waves <= 8:
+            yield f"geometry.waves = {self.waves!r}: must be an integer in [1, 8]"
+        yield from self._ranges({"crest_flat_fraction": (0.0, 0.8)})
+        if ok("wave_height_m", "wave_tilt_m"):
+            lim = 2.0 * self.wave_height_m
+            if not abs(self.wave_tilt_m) <= lim:
+                yield (f"geometry.wave_tilt_m = {self.wave_tilt_m!r}: out of range, allowed "
+                       f"[{-lim:g}, {lim:g}] (both edge heights >= 0)")
+        if self.wave_profile not in ("cosine", "flat_top", "table"):
+            yield (f"geometry.wave_profile = {self.wave_profile!r}: allowed 'cosine', 'flat_top' "
+                   "or 'table'")
+        elif self.wave_profile == "table":
+            yield from self._profile_problems()
+
+    def _profile_problems(self) -> Iterable[str]:
+        s, z = self.profile_s, self.profile_z
+        if len(s) < 3 or len(s) != len(z):
+            yield (f"geometry.profile_s / profile_z: need equal lengths >= 3, got {len(s)} "
+                   f"and {len(z)}")
+            return
+        bad = [range_problem(f"geometry.profile_s[{i}]", v, 0.0, 1.0) for i, v in enumerate(s)]
+        bad += [range_problem(f"geometry.profile_z[{i}]", v, 0.0, 1.0) for i, v in enumerate(z)]
+        bad = [b for b in bad if b]
+        if bad:
+            yield from bad
+            return
+        if s[0] != 0.0 or s[-1] != 1.0 or any(b <= a for a, b in zip(s[:-1], s[1:])):
+            yield "geometry.profile_s: must rise strictly from 0 to 1"
+        if z[0] != 0.0 or z[-1] != 0.0 or abs(max(z) - 1.0) > 1e-9:
+            yield "geometry.profile_z: must start and end at 0 and peak at 1"
+
+    def edge_heights_m(self) -> tuple[float, float]:
+        """Wave height at the inner and the outer edge, m."""
+        return (self.wave_height_m - 0.5 * self.wave_tilt_m,
+                self.wave_height_m + 0.5 * self.wave_tilt_m)
+
+    @property
+    def max_wave_height_m(self) -> float:
+        """Largest wave height of the paddle (the higher edge), m."""
+        return max(self.edge_heights_m())
 
 
 @dataclass(frozen=True)
@@ -177,11 +248,16 @@ class Mesh(Checked):
     """Target shell element edge length, m."""
 
     element_size_m: float = 0.5e-3
+    element_type: str = "S4"
+    """CalculiX shell element: ``"S4"`` (4 nodes, full integration), ``"S4R"``
+    (reduced integration) or ``"S8R"`` (8 nodes, quadratic, reduced)."""
 
     _section = "mesh"
 
     def _problems(self) -> Iterable[str]:
         yield from self._ranges({"element_size_m": (0.1e-3, 10e-3)})
+        if self.element_type not in ("S4", "S4R", "S8R"):
+            yield f"mesh.element_type = {self.element_type!r}: allowed 'S4', 'S4R' or 'S8R'"
 
 
 @dataclass(frozen=True)
@@ -190,13 +266,18 @@ class Solver(Checked):
 
     ``initial_gap_m`` is the clearance between the paddle crest and the
     pressure plate before heating; it must exceed the thermal growth of one
-    paddle. Penalty contact: ``penalty_stiffness_N_per_m`` is the slope of
-    the linear pressure-overclosure law for node-to-surface contact (N/m per
-    slave node) and ``tension_N`` its small tension force at large gaps (node-to-surface).
+    paddle. Penalty contact is linear in the overclosure, with a slope that
+    means different things for the two contact kinds, hence two keys:
+    ``node_penalty_N_per_m`` is the force per slave node per metre of
+    penetration (node-to-surface; CalculiX reads it in N/mm),
+    ``surface_penalty_Pa_per_m`` the contact pressure per metre of
+    penetration (surface-to-surface; CalculiX reads MPa/mm).
+    ``tension_N`` is the small tension force at large gaps (node-to-surface).
     """
 
     contact: str = "node_to_surface"
-    penalty_stiffness_N_per_m: float = 1e8
+    node_penalty_N_per_m: float = 1e8
+    surface_penalty_Pa_per_m: float = 1e14
     tension_N: float = 0.01
     initial_gap_m: float = 0.15e-3
     compression_increments: int = 60
@@ -209,7 +290,8 @@ class Solver(Checked):
 
     def _problems(self) -> Iterable[str]:
         yield from self._ranges({
-            "penalty_stiffness_N_per_m": (1e5, 1e12),
+            "node_penalty_N_per_m": (1e5, 1e12),
+            "surface_penalty_Pa_per_m": (1e9, 1e18),
             "tension_N": (0.0, 10.0),
             "initial_gap_m": (0.0, 2e-3, True),
             "compression_increments": (30, 1000),

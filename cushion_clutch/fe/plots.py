@@ -28,7 +28,11 @@ def plot_force_deflection(tables: TableSet, path: Path, title: str = "") -> Path
 def plot_kiss_shift(tables: TableSet, path: Path) -> Path:
     """delta_kiss(theta): growth of the free height of one pair."""
     fig, ax = plt.subplots(figsize=(5.5, 4))
-    ax.plot(tables.theta_degC, tables.delta_kiss_m * 1e3, "o-")
-    ax.set(xlabel="cushion-spring temperature θ [°C]", ylabel="kiss-point shift δ [mm]",
+    ax.plot(tables.theta_degC, tables.delta_kiss_m * 1e3, "o-", label="kiss-point shift (10 N point)")
+    kp = tables.metadata.get("kiss_point", {})
+    if kp:
+        ax.plot(tables.theta_degC, [kp[f"{t:g}"]["crest_growth_m"] * 1e3 for t in tables.theta_degC],
+                "s--", label="crest growth from heating alone")
+    ax.set(xlabel="cushion-spring temperature θ [°C]", ylabel="growth of the pair's free height [mm]",
            title="Thermal growth of the pair's free height")
-    return finish_figure(fig, ax, path, legend=False)
+    return finish_figure(fig, ax, path, legend=bool(kp))

@@ -31,7 +31,7 @@ from ..errors import SweepError
 from .geometry import half_pair_assembly, pair_assembly
 from .params import SpringParams
 from .results import CaseResult, parse_case
-from .tables import Curve, curve_from_case, kiss_shift, write_tables
+from .tables import Curve, curve_from_case, kiss_shift, progressivity, write_tables
 
 log = logging.getLogger(__name__)
 
@@ -84,7 +84,7 @@ def solve_case(params: SpringParams, theta_degC: float, workdir: Path, *, paddle
     """
     size = params.mesh.element_size_m
     build = half_pair_assembly if paddles == 1 else pair_assembly
-    assembly = build(params.geometry, size, params.solver.initial_gap_m)
+    assembly = build(params.geometry, size, params.solver.initial_gap_m, params.mesh.element_type)
     deck, _ = paddle_deck(assembly, params, theta_degC)
     count = [0]
 
@@ -226,6 +226,8 @@ def build_tables(params: SpringParams, outcomes: dict[float, CaseOutcome], out_d
     curves = [curve_from_case(o.result, params.n_pairs, params.sweep.kiss_force_N)
               for o in outcomes.values()]
     shifts = kiss_shift(curves, params.material.reference_temperature_degC)
+    crest = crest_growth(outcomes, params.material.reference_temperature_degC)
+    prog = {f"{c.theta_degC:g}": progressivity(c.u_m, c.force_N) for c in curves}
     any_case = next(iter(outcomes.values()))
     metadata = {
         "generator": f"cushion_clutch {__version__} (cushion-clutch sweep)",
@@ -235,7 +237,7 @@ def build_tables(params: SpringParams, outcomes: dict[float, CaseOutcome], out_d
         "spring": params.to_dict(),
         "model": "half pair: paddle A against the carrier plane, composed in series "
                  "(pair travel = 2 x paddle travel)" if any_case.result.paddles == 1 else "full pair",
-        "mesh": {"element_size_m": params.mesh.element_size_m, "element_type": "S4",
+        "mesh": {"element_size_m": params.mesh.element_size_m, "element_type": params.mesh.element_type,
                  "nodes": any_case.n_nodes, "elements": any_case.n_elements},
         "units": {"theta_degC": "degC", "u_m": "m", "force_N": "N", "delta_kiss_m": "m"},
         "definitions": {
@@ -244,7 +246,15 @@ def build_tables(params: SpringParams, outcomes: dict[float, CaseOutcome], out_d
             "kiss_point": f"where the force of one pair passes {params.sweep.kiss_force_N:g} N",
             "delta_kiss_m": "growth of the free height (kiss-point shift towards the open side) "
                             "relative to the reference temperature",
+            "crest_growth_m": "rise of the pair's wave crests (mean radius) from heating alone, "
+                              "relative to the reference temperature (crest_growth.csv)",
+            "progressivity": "whole-spring tangent stiffness k (N/m, secant over 5 % of the travel) "
+                             "at 20, 50 and 90 % of the travel from the kiss point to full "
+                             "compression, and k(90 %)/k(20 %)",
         },
+        "progressivity": prog,
+        "kiss_point": {f"{t:g}": {"delta_kiss_m": shifts[t], "crest_growth_m": crest[t]}
+                       for t in sorted(shifts)},
         "cases": {f"{t:g}": {"increments": o.stats.increments, "iterations": o.stats.iterations,
                              "cutbacks": o.stats.cutbacks, "wall_time_s": round(o.stats.wall_time_s, 2),
                              "crest_rise_m": o.result.crest_rise_m,
@@ -255,5 +265,16 @@ def build_tables(params: SpringParams, outcomes: dict[float, CaseOutcome], out_d
         "cases_from_cache": [t for t, o in outcomes.items() if o.from_cache],
         "note": "wall_time_s per case is ccx's own run time, also for cases served from the cache",
     }
-    write_tables(out_dir, curves, params.material.reference_temperature_degC, metadata)
+    write_tables(out_dir, curves, params.material.reference_temperature_degC, metadata, crest)
     return curves, shifts
+
+
+def crest_growth(outcomes: dict[float, CaseOutcome], reference_degC: float) -> dict[float, float]:
+    """Free-height growth of one pair at the crest from heating, relative to the reference, m.
+
+    The half-pair model's crest rise stands for both paddles by symmetry;
+    the full-pair model's paddle A is one of two equal paddles.
+    """
+    rise = {t: 2.0 * o.result.crest_rise_m for t, o in outcomes.items()}
+    ref = min(rise, key=lambda t: abs(t - reference_degC))
+    return {t: r - rise[ref] for t, r in rise.items()}

@@ -11,8 +11,14 @@ Table files (all SI):
     ``theta_degC,delta_kiss_m``: growth of the spring's free height relative
     to the reference temperature, i.e. how far the kiss point moves towards
     the open side (m).
+``crest_growth.csv``
+    ``theta_degC,crest_growth_m``: growth of the pair's free height at the
+    wave crest (mean radius) from heating alone, relative to the reference
+    temperature (m). Unlike ``delta_kiss_m`` (where the 10 N point moves) it
+    holds no stiffness change; the two differ by how much softer the hot
+    spring is at first touch.
 ``metadata.json``
-    Parameters, mesh, solver, statistics, date and code version.
+    Parameters, mesh, solver, statistics, progressivity, date and code version.
 """
 from __future__ import annotations
 
@@ -111,8 +117,10 @@ def kiss_shift(curves: list[Curve], reference_degC: float) -> dict[float, float]
 
 
 def write_tables(out_dir: Path, curves: list[Curve], reference_degC: float,
-                 metadata: dict) -> Path:
+                 metadata: dict, crest_growth_m: dict[float, float] | None = None) -> Path:
     """Write a table set atomically: all files appear together or not at all.
+
+    ``crest_growth_m`` (theta to m), if given, goes to ``crest_growth.csv``.
 
     The set is built in a temporary sibling folder and renamed into place;
     an existing set is replaced only after the new one is complete.
@@ -133,6 +141,12 @@ def write_tables(out_dir: Path, curves: list[Curve], reference_degC: float,
             w.writerow(["theta_degC", "delta_kiss_m"])
             for t in sorted(shifts):
                 w.writerow([f"{t:g}", f"{shifts[t]:.9e}"])
+        if crest_growth_m is not None:
+            with open(tmp / "crest_growth.csv", "w", newline="") as fh:
+                w = csv.writer(fh)
+                w.writerow(["theta_degC", "crest_growth_m"])
+                for t in sorted(crest_growth_m):
+                    w.writerow([f"{t:g}", f"{crest_growth_m[t]:.9e}"])
         (tmp / "metadata.json").write_text(json.dumps(metadata, indent=2, default=_jsonable) + "\n")
         backup = None
         if out_dir.exists():
@@ -213,3 +227,33 @@ def _read_csv(path: Path, columns: list[str]) -> np.ndarray:
         return load_csv(path, tuple(columns))
     except ValueError as exc:
         raise TableError(str(exc)) from exc
+
+
+#: travel fractions (kiss point to full compression) at which progressivity is reported
+PROGRESSIVITY_FRACTIONS = (0.2, 0.5, 0.9)
+
+
+def tangent_stiffness(u_m: np.ndarray, force_N: np.ndarray, fractions=PROGRESSIVITY_FRACTIONS,
+                      window: float = 0.05) -> dict[float, float]:
+    """Tangent stiffness dF/du (N/m) at fractions of the travel from the kiss point to full compression.
+
+    The slope is a secant over ``window`` of that travel centred on each
+    point (clipped to the curve's ends), so that increment noise does not
+    dominate it.
+    """
+    u = np.asarray(u_m, dtype=float)
+    f = np.asarray(force_N, dtype=float)
+    u_full = float(u[-1])
+    out = {}
+    for x in fractions:
+        lo = max(0.0, (x - 0.5 * window) * u_full)
+        hi = min(u_full, (x + 0.5 * window) * u_full)
+        out[x] = float((np.interp(hi, u, f) - np.interp(lo, u, f)) / (hi - lo))
+    return out
+
+
+def progressivity(u_m: np.ndarray, force_N: np.ndarray) -> dict[str, float]:
+    """k(20 %), k(50 %), k(90 %) in N/m and the ratio k(90 %)/k(20 %) of one curve."""
+    k = tangent_stiffness(u_m, force_N)
+    return {"k20_N_per_m": k[0.2], "k50_N_per_m": k[0.5], "k90_N_per_m": k[0.9],
+            "k90_over_k20": k[0.9] / k[0.2]}

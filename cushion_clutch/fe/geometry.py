@@ -99,8 +99,11 @@ def wave_height(r_m: np.ndarray, phi_deg: np.ndarray, geom: Geometry) -> np.ndar
     phi_deg : array_like
         Angle from the paddle's clamped end, degrees.
     geom : Geometry
-        Paddle shape.
+        Paddle shape; with ``surface_file`` set, the fitted scanned surface.
     """
+    if geom.surface_file:   # a fitted scan (cushion-clutch import-scan), scaled to wave_height_m
+        from .scan import surface_height
+        return surface_height(r_m, phi_deg, geom)
     phi = np.asarray(phi_deg, dtype=float) + 0.0 * np.asarray(r_m, dtype=float)
     s = (phi - geom.wave_start_deg) / (geom.wave_end_deg - geom.wave_start_deg)
     inside = (s >= 0.0) & (s <= 1.0)

@@ -30,10 +30,15 @@ def synthetic_scan(geom: Geometry, n: int = 20000, noise_m: float = 5e-6, tilt_r
     if outliers:
         idx = rng.choice(n, outliers, replace=False)
         pts[idx, 2] += rng.choice([-1, 1], outliers) * rng.uniform(0.3e-3, 1e-3, outliers)
+    return rigid(pts, tilt_rad, tilt_axis_deg, offset_m)
+
+
+def rigid(points: np.ndarray, tilt_rad: float, tilt_axis_deg: float, offset_m: float) -> np.ndarray:
+    """Rotate about an axis through the origin in the xy-plane, then shift along z."""
     k = np.array([np.cos(np.radians(tilt_axis_deg)), np.sin(np.radians(tilt_axis_deg)), 0.0])
     kx = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
     rot = np.eye(3) + np.sin(tilt_rad) * kx + (1 - np.cos(tilt_rad)) * kx @ kx
-    return pts @ rot.T + [0.0, 0.0, offset_m]
+    return np.atleast_2d(points) @ rot.T + [0.0, 0.0, offset_m]
 
 
 def write_csv(path, points_m: np.ndarray, unit_m: float = 1e-3) -> None:

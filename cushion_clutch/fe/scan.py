@@ -36,6 +36,7 @@ COVERAGE_CELL_M = 2.0e-3       #: cell size of the coverage check
 MIN_COVERAGE = 0.90            #: fraction of the sector's cells that must hold points
 OUTLIER_MADS = 5.0             #: outlier threshold in robust standard deviations (1.4826 MAD)
 POINTS_PER_COEFFICIENT = 4
+MIN_POINTS = 1000              #: fewest points accepted on the paddle sector
 
 
 def read_scan(path: str | Path, unit: str = "mm") -> np.ndarray:
@@ -60,7 +61,11 @@ def read_scan(path: str | Path, unit: str = "mm") -> np.ndarray:
             pts = np.column_stack([np.atleast_1d(data[names[c]]) for c in "xyz"])
         elif suffix in MESH_SUFFIXES:
             import meshio
-            pts = np.asarray(meshio.read(path).points, dtype=float)
+            with warnings.catch_warnings():       # meshio's binary-or-ASCII probe of STL files
+                warnings.simplefilter("ignore", RuntimeWarning)
+                pts = np.asarray(meshio.read(path).points, dtype=float)
+            if pts.size == 0:
+                raise ScanError(["the file holds no points"], str(path))
             if pts.ndim != 2 or pts.shape[1] < 3:
                 raise ScanError([f"the mesh has {pts.shape[-1]}-D points; need 3-D"], str(path))
             pts = pts[:, :3]
@@ -94,8 +99,9 @@ def check_points(points: np.ndarray, geom: Geometry, unit: str, source: str,
         problems.append(f"{bad.sum()} point(s) with NaN or infinite coordinates (data rows {rows}"
                         f"{', ...' if bad.sum() > 5 else ''}); clean the scan first")
         points = points[~bad]
-    if len(points) == 0:
-        raise ScanError(problems + ["no points"], source)
+    if len(points) < MIN_POINTS:
+        raise ScanError(problems + [f"{len(points)} valid point(s); a paddle scan needs at least "
+                                    f"{MIN_POINTS}"], source)
     r, phi = polar(points)
     r_hi = float(np.percentile(r, 99))
     ratio = r_hi / geom.outer_radius_m
@@ -117,6 +123,9 @@ def check_points(points: np.ndarray, geom: Geometry, unit: str, source: str,
             f"{r.max():.4g} m, phi = {phi.min():.1f}..{phi.max():.1f} deg); give the scan in disc "
             "coordinates (origin on the axis, x through the clamped end), or --crop to drop them")
     points, r, phi = points[on], r[on], phi[on]
+    if len(points) < MIN_POINTS:
+        problems.append(f"{len(points)} point(s) on the paddle sector; need at least {MIN_POINTS}")
+        raise ScanError(problems, source)
     r_mean = 0.5 * (geom.inner_radius_m + geom.outer_radius_m)
     n_r = max(1, int((geom.outer_radius_m - geom.inner_radius_m) / COVERAGE_CELL_M))
     n_a = max(1, int(np.radians(geom.span_deg) * r_mean / COVERAGE_CELL_M))

@@ -181,6 +181,7 @@ def _tolerance(args: argparse.Namespace) -> int:
     from .fe.tolerance_report import RANK_BY, tolerance_study
 
     if not args.verbose:
+        import distributed  # noqa: F401 - its import sets its loggers' levels; quieten them after
         logging.getLogger("distributed").setLevel(logging.WARNING)
     params = load_params(args.spring)
     if args.mesh_size is not None:

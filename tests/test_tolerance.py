@@ -104,3 +104,17 @@ def test_study_on_a_local_cluster_equals_one_by_one_and_resumes(coarse, tmp_path
         fmu = build_fmu(out / f"default_{q}", tmp_path / f"{q}.fmu")
         assert validate_fmu(str(fmu)) == []
     assert (out / "default_tolerance" / "tolerance_bands.png").stat().st_size > 20000
+
+
+def test_cli_refuses_a_spring_without_tolerances_and_the_package_tables(tmp_path, capsys):
+    from cushion_clutch.cli import main
+    from cushion_clutch.data import tables_root
+    spring = tmp_path / "plain.toml"
+    spring.write_text(DEFAULT_SPRING.read_text().split("[tolerances]")[0])
+    assert main(["tolerance", "--spring", str(spring), "--samples", "4", "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert "[tolerances]: no tolerance declared" in err and "Traceback" not in err
+    assert main(["tolerance", "--samples", "4", "--out", str(tables_root())]) == 2
+    assert "shipped with cushion-clutch" in capsys.readouterr().err
+    assert main(["tolerance", "--samples", "4", "--temperatures", "195", "--out", str(tmp_path)]) == 2
+    assert "must include material.reference_temperature_degC = 20" in capsys.readouterr().err

@@ -69,7 +69,7 @@ def main(argv=None) -> None:
     print(f"projection: {args.project_samples} samples + nominal x {args.project_temperatures} temperatures "
           f"= {n} cases on {args.cores} single-threaded workers: {rounds} rounds x {case_s:.1f} s = "
           f"{ideal / 60:.1f} min at full efficiency, {ideal / efficiency / 60:.1f} min at the measured "
-          f"{efficiency:.0%} (per-core speed of this machine; at 0.5 mm mesh a case costs ~10x more)")
+          f"{efficiency:.0%} (per-core speed of this machine; a 0.5 mm case costs 10-20x more)")
 
 
 if __name__ == "__main__":

@@ -6,7 +6,8 @@ from cushion_clutch.cli import main
 from cushion_clutch.errors import ParameterError, ScanError
 from cushion_clutch.fe.geometry import paddle_mesh, wave_height
 from cushion_clutch.fe.params import DEFAULT_SPRING, load_params
-from cushion_clutch.fe.scan import load_surface, read_scan
+from cushion_clutch.fe.scan import read_scan
+from cushion_clutch.fe.surface import load_surface
 from cushion_clutch.fe.scan_import import import_scan
 from cushion_clutch.fe.sweep import case_key
 

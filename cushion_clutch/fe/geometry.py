@@ -102,7 +102,7 @@ def wave_height(r_m: np.ndarray, phi_deg: np.ndarray, geom: Geometry) -> np.ndar
         Paddle shape; with ``surface_file`` set, the fitted scanned surface.
     """
     if geom.surface_file:   # a fitted scan (cushion-clutch import-scan), scaled to wave_height_m
-        from .scan import surface_height
+        from .surface import surface_height
         return surface_height(r_m, phi_deg, geom)
     phi = np.asarray(phi_deg, dtype=float) + 0.0 * np.asarray(r_m, dtype=float)
     s = (phi - geom.wave_start_deg) / (geom.wave_end_deg - geom.wave_start_deg)

@@ -84,7 +84,7 @@ class Geometry(Checked):
         if not isinstance(self.surface_file, str):
             yield f"geometry.surface_file = {self.surface_file!r}: must be a file name (string)"
         elif self.surface_file:
-            from .scan import surface_problems
+            from .surface import surface_problems
             yield from surface_problems(self)
 
 

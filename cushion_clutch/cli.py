@@ -212,6 +212,72 @@ def _build_fmu(args: argparse.Namespace) -> int:
     return 0
 
 
+def _import_scan(args: argparse.Namespace) -> int:
+    from .fe.scan_import import import_scan
+
+    res = import_scan(args.scan, args.spring, args.out, unit=args.unit, face=args.face, datum=args.datum,
+                      crop=args.crop)
+    f, fr = res.fit, res.frame
+    print(f"{args.scan}: {res.n_read} points read, {res.n_on_sector} on the paddle sector, "
+          f"{res.n_rejected} rejected as outliers")
+    print(f"rivet-zone datum ({args.datum}): tilt {fr.tilt_rad * 1e3:.3f} mrad about an axis at "
+          f"{fr.tilt_axis_deg:.1f} deg, axial offset {fr.offset_m * 1e3:.4f} mm removed "
+          f"({fr.rivet_points} points, flatness RMS {fr.rivet_rms_m * 1e6:.2f} um)")
+    print(f"mid-surface fit residual: RMS {f.rms_m * 1e6:.2f} um, max {f.max_m * 1e6:.2f} um; "
+          f"peak height {f.peak_m * 1e3:.4f} mm")
+    print(f"wrote {res.toml}, {res.surface} and {res.plot}")
+    return 0
+
+
+def _tolerance(args: argparse.Namespace) -> int:
+    import numpy as np
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+    from .fe.params import load_params
+    from .fe.tolerance_report import RANK_BY, tolerance_study
+
+    if not args.verbose:
+        import distributed  # noqa: F401 - its import sets its loggers' levels; quieten them after
+        logging.getLogger("distributed").setLevel(logging.WARNING)
+    params = load_params(args.spring)
+    if args.mesh_size is not None:
+        params = params.replace(mesh={"element_size_m": args.mesh_size})
+    out = Path(args.out)
+    if out.resolve().is_relative_to(tables_root().resolve()):
+        raise ParameterError([f"--out {out} is inside the table sets shipped with cushion-clutch; give another"])
+    with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
+                  TextColumn("{task.fields[status]}"), TimeElapsedColumn()) as bar:
+        task = bar.add_task(f"{args.samples} samples + nominal", total=None, status="")
+
+        def progress(done: int, total: int, cached: int) -> None:
+            bar.update(task, completed=done, total=total, status=f"FE cases ({cached} from the cache)")
+
+        res = tolerance_study(params, samples=args.samples, temperatures=tuple(args.temperatures), out=out,
+                              method=args.method, seed=args.seed, rank_by=args.rank_by,
+                              cache_dir=Path(args.cache), scheduler=args.scheduler, workers=args.workers,
+                              progress=progress)
+    b = res.bands
+    print(f"{res.cases} FE cases ({res.cases_from_cache} from the cache) in {res.wall_time_s:.1f} s")
+    print(f"{'theta [degC]':>12} {'delta_kiss P5/P50/P95 [mm]':>28} "
+          f"{f'F(u = {b.u_m[-1] * 1e3:.3f} mm) P5/P50/P95 [N]':>34}")
+    for j, t in enumerate(b.temperatures_degC):
+        f = b.force_N[t][:, -1]
+        print(f"{t:>12g} {'/'.join(f'{v * 1e3:.4f}' for v in b.delta_kiss_m[:, j]):>28} "
+              f"{'/'.join(f'{v:.0f}' for v in f):>34}")
+    full = np.array([r[f"force_full_{b.ref_degC:g}degC_N"] for r in b.rows[1:]])
+    kiss = np.array([r[f"delta_kiss_{b.kiss_theta_degC:g}degC_m"] for r in b.rows[1:]])
+    for label, v, scale, unit in ((f"delta_kiss({b.kiss_theta_degC:g} degC)", kiss, 1e3, "mm"),
+                                  (f"force at full compression ({b.ref_degC:g} degC)", full, 1.0, "N")):
+        p5, p50, p95 = np.percentile(v, [5, 50, 95]) * scale
+        print(f"{label}: P5 {p5:.4g}, P50 {p50:.4g}, P95 {p95:.4g} {unit}; band width P95-P5 "
+              f"{p95 - p5:.4g} {unit}")
+    for q, (index, value, target) in res.picks.items():
+        print(f"P{q:02.0f} table set {res.sets[q]}: sample {index} (value {value:.4g}, P{q:02.0f} {target:.4g}; "
+              f"ranked by {RANK_BY[args.rank_by]})")
+    print("wrote " + ", ".join(str(f) for f in res.files))
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     from .fmu.build import add_backend, add_build_arguments
     from .fe.params import DEFAULT_SPRING
@@ -275,6 +341,37 @@ def build_parser() -> argparse.ArgumentParser:
     bf = sub.add_parser("build-fmu", help="build the clutch FMU from a table set (native C by default)")
     add_build_arguments(bf)
     bf.set_defaults(func=_build_fmu)
+
+    im = sub.add_parser("import-scan", help="fit a scanned paddle's mid-surface and write a spring TOML using it")
+    im.add_argument("scan", help="point cloud CSV (x,y,z header) or STL/PLY/OBJ surface")
+    im.add_argument("--spring", default=DEFAULT_SPRING, help="base spring TOML (plan shape, rivet zone, material)")
+    im.add_argument("--out", required=True, help="spring TOML to write (the surface .npz and PNG go next to it)")
+    im.add_argument("--unit", choices=("mm", "m"), default="mm", help="length unit of the scan (default mm)")
+    im.add_argument("--face", choices=("top", "bottom", "mid"), default="top",
+                    help="scanned face: top (away from the carrier, default), bottom, or mid-surface")
+    im.add_argument("--datum", choices=("rigid", "offset"), default="rigid",
+                    help="fit tilt and offset on the rivet zone (default) or the offset only")
+    im.add_argument("--crop", action="store_true", help="drop points off the paddle sector instead of refusing")
+    im.set_defaults(func=_import_scan)
+
+    to = sub.add_parser("tolerance", help="tolerance study: sampled springs swept on Dask, P5/P50/P95 bands")
+    to.add_argument("--spring", default=DEFAULT_SPRING, help="spring TOML with a [tolerances] table")
+    to.add_argument("--samples", type=int, default=16, help="number of drawn springs (default 16)")
+    to.add_argument("--method", choices=("lhs", "mc"), default="lhs", help="Latin hypercube or Monte Carlo")
+    to.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    to.add_argument("--temperatures", type=float, nargs="+", default=[20.0, 195.0, 300.0],
+                    help="temperatures [degC] (default 20 195 300; must include the reference)")
+    to.add_argument("--mesh-size", type=float, help="override mesh.element_size_m [m]")
+    to.add_argument("--scheduler", help="Dask scheduler address, e.g. tcp://host:8786 (default: a LocalCluster)")
+    to.add_argument("--workers", type=int, help="LocalCluster worker processes, one thread each (default: cores)")
+    to.add_argument("--rank-by", choices=("torque", "force", "kiss"), default="torque",
+                    help="figure that picks the P5/P95 samples (default: torque at the nominal half-engaged "
+                         "bearing position, 20 degC)")
+    to.add_argument("--out", default="lookup_tables",
+                    help="folder for <name>_tolerance/ and the <name>_p05/, <name>_p95/ table sets "
+                         "(default ./lookup_tables)")
+    to.add_argument("--cache", default=DEFAULT_CACHE, help="case cache folder (shared with sweep)")
+    to.set_defaults(func=_tolerance)
 
     ck = sub.add_parser("check-spring", help="validate a spring parameter TOML")
     ck.add_argument("spring")

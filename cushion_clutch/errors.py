@@ -121,3 +121,37 @@ class RunInterrupted(KeyboardInterrupt):
         self.signum = int(signum)
         self.exit_code = 128 + self.signum
         super().__init__(f"interrupted by {signal.Signals(self.signum).name}")
+
+
+class ScanError(ParameterError):
+    """A scanned paddle surface cannot be imported (too few points, wrong unit,
+    outside the paddle sector, non-finite coordinates, unreadable file).
+
+    Like :class:`ParameterError`, it lists every problem found.
+    """
+
+    def __init__(self, problems: Sequence[str], source: str | None = None):
+        super().__init__(problems, source)
+        where = f" {source}" if source else ""
+        lines = "\n  - ".join(self.problems)
+        self.args = (f"cannot import the scan{where}:\n  - {lines}",)
+
+    def __str__(self) -> str:
+        return self.args[0]
+
+
+class StudyError(SweepError):
+    """Cases of a tolerance study failed; finished cases are kept in the cache.
+
+    Attributes
+    ----------
+    failures : dict
+        ``(sample, theta_degC)`` to the exception raised for it.
+    """
+
+    def __init__(self, failures: dict):
+        self.failures = failures
+        lines = "\n".join(f"  sample {s}, theta = {t:g} degC: {e}" for (s, t), e in sorted(failures.items()))
+        RuntimeError.__init__(
+            self, f"{len(failures)} case(s) of the tolerance study failed; finished cases are cached "
+                  f"(a rerun resumes) and no band was written:\n{lines}")

@@ -103,8 +103,12 @@ def wave_height(r_m: np.ndarray, phi_deg: np.ndarray, geom: Geometry) -> np.ndar
         Paddle shape: ``waves`` waves of the unit profile ``wave_profile``
         between ``wave_start_deg`` and ``wave_end_deg``, scaled by the local
         height ``h(r)`` (``wave_height_m`` at the mean radius, tilted by
-        ``wave_tilt_m`` across the radius).
+        ``wave_tilt_m`` across the radius). With ``surface_file`` set, the
+        fitted scanned surface instead (scaled to ``wave_height_m``).
     """
+    if geom.surface_file:   # a fitted scan (cushion-clutch import-scan)
+        from .surface import surface_height
+        return surface_height(r_m, phi_deg, geom)
     r = np.asarray(r_m, dtype=float)
     phi = np.asarray(phi_deg, dtype=float) + 0.0 * r
     x = (phi - geom.wave_start_deg) / (geom.wave_end_deg - geom.wave_start_deg)

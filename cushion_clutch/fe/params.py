@@ -74,6 +74,11 @@ class Geometry(Checked):
     circumferential direction: ``"free"`` it slides freely; ``"locked"`` it
     moves only with the carrier's thermal expansion; ``"elastic"`` it is held
     through the carrier tab's stiffness ``carrier.far_end_stiffness_N_per_m``."""
+    surface_file: str = ""
+    """A fitted mid-surface (``.npz`` written by ``cushion-clutch import-scan``)
+    that replaces the analytic wave: w(r, phi) is interpolated from it and
+    scaled so that its peak equals ``wave_height_m``. A relative path is
+    taken from the TOML file's folder. Empty: the analytic ``1 - cos`` wave."""
 
     _section = "geometry"
 
@@ -115,6 +120,11 @@ class Geometry(Checked):
             if not abs(self.wave_tilt_m) <= lim:
                 yield (f"geometry.wave_tilt_m = {self.wave_tilt_m!r}: out of range, allowed "
                        f"[{-lim:g}, {lim:g}] (both edge heights >= 0)")
+        if not isinstance(self.surface_file, str):
+            yield f"geometry.surface_file = {self.surface_file!r}: must be a file name (string)"
+        elif self.surface_file:
+            from .surface import surface_problems
+            yield from surface_problems(self)
         if self.wave_profile not in ("cosine", "flat_top", "table"):
             yield (f"geometry.wave_profile = {self.wave_profile!r}: allowed 'cosine', 'flat_top' "
                    "or 'table'")
@@ -304,6 +314,52 @@ class Solver(Checked):
         yield from self._integers("compression_increments", "max_increments", "threads")
 
 
+#: tolerance keys: allowed range of the standard deviation, and its unit
+TOLERANCE_KEYS = {
+    "thickness_m": (0.0, 50e-6, "m, added to geometry.thickness_m"),
+    "wave_height_m": (0.0, 200e-6, "m, added to geometry.wave_height_m"),
+    "youngs_modulus_scale": (0.0, 0.1, "1, factor 1 + x on every material.youngs_modulus_Pa"),
+}
+
+
+@dataclass(frozen=True)
+class Tolerances(Checked):
+    """Production scatter for tolerance studies (``cushion-clutch tolerance``).
+
+    Each key is a table ``{sd = value}``: a normal distribution around the
+    nominal value with that standard deviation, truncated at
+    ``TRUNCATE_SD`` standard deviations. ``thickness_m`` and ``wave_height_m``
+    are in m and add to the nominal geometry; ``youngs_modulus_scale`` is
+    dimensionless and scales the whole E(theta) table by ``1 + x``. A key
+    left out does not vary. Tolerances never enter a sweep's result.
+    """
+
+    thickness_m: dict | None = None
+    wave_height_m: dict | None = None
+    youngs_modulus_scale: dict | None = None
+
+    TRUNCATE_SD = 3.0
+    _section = "tolerances"
+
+    def _problems(self) -> Iterable[str]:
+        for name, (lo, hi, unit) in TOLERANCE_KEYS.items():
+            value = getattr(self, name)
+            if value is None:
+                continue
+            key = f"tolerances.{name}"
+            if not isinstance(value, dict) or set(value) != {"sd"}:
+                yield f"{key} = {value!r}: must be a table {{sd = <standard deviation>}} ({unit})"
+                continue
+            msg = range_problem(f"{key}.sd", value["sd"], lo, hi)
+            if msg:
+                yield f"{msg} ({unit})"
+
+    def declared(self) -> dict[str, float]:
+        """Standard deviation of every declared, non-zero tolerance."""
+        return {k: float(getattr(self, k)["sd"]) for k in TOLERANCE_KEYS
+                if getattr(self, k) is not None and getattr(self, k)["sd"] > 0}
+
+
 @dataclass(frozen=True)
 class SpringParams(Checked):
     """A whole cushion spring: ``n_pairs`` identical paddle pairs in parallel."""
@@ -317,6 +373,7 @@ class SpringParams(Checked):
     sweep: Sweep = field(default_factory=Sweep)
     mesh: Mesh = field(default_factory=Mesh)
     solver: Solver = field(default_factory=Solver)
+    tolerances: Tolerances = field(default_factory=Tolerances)
 
     def _problems(self) -> Iterable[str]:
         if isinstance(self.n_pairs, bool) or not isinstance(self.n_pairs, int) or not 1 <= self.n_pairs <= 64:
@@ -362,4 +419,9 @@ def load_params(path: str | Path = DEFAULT_SPRING) -> SpringParams:
         On a missing or empty file, a TOML syntax error, a missing ``name``
         (a spring must name itself), an unknown key or an out-of-range value.
     """
-    return params_from_dict(load_toml(path, required=("name",)), str(Path(path)))
+    data = load_toml(path, required=("name",))
+    geom = data.get("geometry")
+    if isinstance(geom, dict) and isinstance(geom.get("surface_file"), str) and geom["surface_file"]:
+        # relative to the TOML's folder, so that a sweep from any folder finds it
+        geom["surface_file"] = str((Path(path).parent / geom["surface_file"]).resolve())
+    return params_from_dict(data, str(Path(path)))

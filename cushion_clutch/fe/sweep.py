@@ -104,6 +104,10 @@ def case_key(params: SpringParams, theta_degC: float, paddles: int, ccx: str) ->
     """Hash of everything that decides a case's result."""
     d = params.to_dict()
     d.pop("description", None)
+    d.pop("tolerances", None)                 # scatter declarations, not this case's values
+    if params.geometry.surface_file:          # the scan's content, wherever the file lies
+        from .surface import surface_digest
+        d["geometry"]["surface_file"] = surface_digest(params.geometry.surface_file)
     d["sweep"].pop("temperatures_degC", None)
     d["solver"].pop("threads", None)          # effort limits do not change a converged result
     d["solver"].pop("max_increments", None)

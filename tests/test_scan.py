@@ -34,17 +34,20 @@ def _grid_error(res):
 def test_synthetic_scan_recovers_the_analytic_wave(scanned):
     res = scanned
     assert res.frame.tilt_rad == pytest.approx(TILT, abs=0.15e-3)     # noise-limited (4 mm baseline)
-    # the offset removed: the scanned top face of the rivet zone (0.41 mm) at its centroid
+    # the offset removed: the scanned top face of the rivet zone (t + clearance) at its centroid
     g = load_params().geometry
     r_c = 2 / 3 * (g.outer_radius_m ** 3 - g.inner_radius_m ** 3) / (g.outer_radius_m ** 2 - g.inner_radius_m ** 2)
-    centre = [r_c * np.cos(np.radians(2.0)), r_c * np.sin(np.radians(2.0)), 0.41e-3]
+    centre = [r_c * np.cos(np.radians(2.0)), r_c * np.sin(np.radians(2.0)),
+              g.thickness_m + g.carrier_clearance_m]
     assert res.frame.offset_m == pytest.approx(-rigid(centre, TILT, 30.0, 2.5e-3)[0, 2], abs=5e-6)
     assert 40 <= res.n_rejected <= 80                                 # every spike, few good points
     assert 4e-6 < res.fit.rms_m < 6e-6                                # the scan's 5 um noise
     err = _grid_error(res)
     assert np.sqrt(np.mean(err ** 2)) < 3e-6
     assert np.abs(err).max() < 25e-6
-    assert res.params.geometry.wave_height_m == pytest.approx(0.7e-3, abs=10e-6)
+    # the surface replaces the tilted wave: its peak (the outer edge's crest) is the new wave_height_m
+    assert res.params.geometry.wave_height_m == pytest.approx(g.max_wave_height_m, abs=10e-6)
+    assert res.params.geometry.wave_tilt_m == 0.0
     assert res.params.name == "scanned"
 
 
@@ -107,7 +110,7 @@ def test_stl_surface_via_meshio(tmp_path):
     res = import_scan(tmp_path / "paddle.stl", DEFAULT_SPRING, tmp_path / "stl.toml", face="mid")
     err = _grid_error(res)
     assert res.frame.tilt_rad < 1e-6 and np.sqrt(np.mean(err ** 2)) < 1.5e-6
-    assert load_surface(res.surface).peak_m == pytest.approx(0.7e-3, abs=3e-6)
+    assert load_surface(res.surface).peak_m == pytest.approx(geom.max_wave_height_m, abs=3e-6)
 
 
 @pytest.mark.parametrize("case, unit, message", [

@@ -78,7 +78,9 @@ class Geometry(Checked):
     """A fitted mid-surface (``.npz`` written by ``cushion-clutch import-scan``)
     that replaces the analytic wave: w(r, phi) is interpolated from it and
     scaled so that its peak equals ``wave_height_m``. A relative path is
-    taken from the TOML file's folder. Empty: the analytic ``1 - cos`` wave."""
+    taken from the TOML file's folder. It carries the whole shape, so
+    ``wave_tilt_m``, ``wave_profile`` and ``waves`` keep their defaults.
+    Empty: the analytic wave above."""
 
     _section = "geometry"
 
@@ -125,6 +127,9 @@ class Geometry(Checked):
         elif self.surface_file:
             from .surface import surface_problems
             yield from surface_problems(self)
+            if self.wave_tilt_m != 0.0 or self.wave_profile != "cosine" or self.waves != 1:
+                yield ("geometry.surface_file: the fitted surface carries the whole wave shape; leave "
+                       "wave_tilt_m, wave_profile and waves at their defaults (0, 'cosine', 1)")
         if self.wave_profile not in ("cosine", "flat_top", "table"):
             yield (f"geometry.wave_profile = {self.wave_profile!r}: allowed 'cosine', 'flat_top' "
                    "or 'table'")

@@ -98,11 +98,19 @@ def import_scan(scan: str | Path, spring: str | Path, out_toml: str | Path, *, u
     return ScanImport(out_toml, surface, plot, params, fit, frame, len(raw), len(pts))
 
 
+# keys of the analytic wave that the fitted surface replaces (it carries tilt, profile and waves)
+SHAPE_KEYS = ("surface_file", "wave_height_m", "wave_tilt_m", "wave_profile", "crest_flat_fraction",
+              "profile_s", "profile_z", "waves")
 _SECTION = re.compile(r"^\s*\[([^\]]+)\]")
 
 
 def scanned_toml_text(base: str, name: str, surface_name: str, peak_m: float, comment: str) -> str:
-    """The base spring's TOML text with the name, ``surface_file`` and ``wave_height_m`` set."""
+    """The base spring's TOML text with the name, ``surface_file`` and ``wave_height_m`` set.
+
+    The analytic wave's shape keys (``SHAPE_KEYS``: tilt, profile, waves) are
+    dropped: the fitted surface carries the whole shape. Each must sit on one
+    line in ``base``.
+    """
     if not re.fullmatch(r"[A-Za-z0-9_.-]+", name):
         raise ParameterError([f"--out name {name!r}: the file stem becomes the spring name; use letters, "
                               "digits, '-', '_', '.'"])
@@ -121,7 +129,7 @@ def scanned_toml_text(base: str, name: str, surface_name: str, peak_m: float, co
         if section is None and key == "name":
             out.append(f'name = "{name}"')
             named = True
-        elif section == "geometry" and key in ("surface_file", "wave_height_m"):
+        elif section == "geometry" and key in SHAPE_KEYS:
             continue
         else:
             out.append(line)

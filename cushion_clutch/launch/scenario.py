@@ -10,6 +10,7 @@ from typing import Iterable
 
 from ..config import Checked, build_checked, load_toml, range_problem
 from ..data import DEFAULT_SCENARIO
+from ..errors import ParameterError
 
 
 
@@ -145,18 +146,123 @@ class Tcu(Checked):
 
 
 @dataclass(frozen=True)
+class Clutch(Checked):
+    """The plant clutch's friction: ``friction_csv`` = "" keeps mu = 0.28 constant (the paper's model).
+
+    Otherwise a ``theta_degC,omega_slip_rad_s,mu`` table, relative to the
+    scenario file's folder (or absolute), put into the plant FMU's resources.
+    The TCUs do not know it: their model keeps the nominal mu.
+    """
+
+    friction_csv: str = ""
+
+    _section = "clutch"
+
+    def _problems(self) -> Iterable[str]:
+        if not isinstance(self.friction_csv, str):
+            yield f"clutch.friction_csv = {self.friction_csv!r}: must be a file name or \"\""
+
+
+@dataclass(frozen=True)
+class Observer(Checked):
+    """The TCU's facing-temperature observer: its own (mismatched) lumped models.
+
+    ``C_f dtheta_cm/dt = share T_est w_slip - G_f (theta_cm - theta_a)`` with
+    the slip speed from the speed sensors and ``T_est`` its model's torque at
+    the measured bearing position; then the cushion-spring model
+    ``C dtheta_cs/dt = U (theta_cm - theta_cs) + H (theta_a - theta_cs)``.
+    """
+
+    capacity_J_per_K: float = 517.5
+    loss_W_per_K: float = 1.08
+    heat_share: float = 1.0
+    spring_U_W_per_K: float = 0.1
+    spring_H_W_per_K: float = 0.04
+    spring_C_J_per_K: float = 1.0
+
+    _section = "observer"
+
+    def _problems(self) -> Iterable[str]:
+        yield from self._ranges({
+            "capacity_J_per_K": (1.0, 1e6), "loss_W_per_K": (0.0, 1e4), "heat_share": (0.0, 1.0),
+            "spring_U_W_per_K": (0.0, 1e4), "spring_H_W_per_K": (0.0, 1e4), "spring_C_J_per_K": (0.0, 1e6, True)})
+        if self.spring_U_W_per_K + self.spring_H_W_per_K <= 0.0:
+            yield "observer.spring_U_W_per_K + spring_H_W_per_K: must be > 0"
+
+
+@dataclass(frozen=True)
+class Sensors(Checked):
+    """Engine and disc speed sensors as the TCU reads them: Gaussian noise, then quantisation."""
+
+    speed_noise_rad_s: float = 0.0
+    """standard deviation of the noise, rad/s (0: none)"""
+    speed_resolution_rad_s: float = 0.0
+    """quantisation step, rad/s (0: none)"""
+    seed: int = 1
+
+    _section = "sensors"
+
+    def _problems(self) -> Iterable[str]:
+        yield from self._ranges({"speed_noise_rad_s": (0.0, 100.0), "speed_resolution_rad_s": (0.0, 100.0),
+                                 "seed": (0, 2 ** 31 - 1)})
+        yield from self._integers("seed")
+
+
+@dataclass(frozen=True)
+class Adaptation(Checked):
+    """Kiss-point learning from the onset of torque transfer in each launch.
+
+    Once the measured disc speed has exceeded ``onset_speed_rad_s`` for
+    ``window_s``, the mean clutch torque over that window follows from the
+    disc's acceleration, ``J_d dw_d/dt + T_load``; the learner compares it with
+    its model's torque at the measured bearing positions and moves its kiss
+    point by ``gain`` times the difference (in bearing travel).
+    """
+
+    gain: float = 0.7
+    onset_speed_rad_s: float = 0.5
+    window_s: float = 0.05
+
+    _section = "adaptation"
+
+    def _problems(self) -> Iterable[str]:
+        yield from self._ranges({"gain": (0.0, 1.0, True), "onset_speed_rad_s": (0.01, 100.0),
+                                 "window_s": (1e-3, 1.0)})
+
+
+@dataclass(frozen=True)
 class Run(Checked):
-    """Repetition and co-simulation step."""
+    """Repetition and co-simulation step.
+
+    ``launches`` every ``period_s`` (the hot phase), then ``cool_launches``
+    every ``cool_period_s`` (a cool-down). Launches starting with the cushion
+    spring at or above ``hot_degC`` count as hot in the summary.
+    """
 
     launches: int = 12
     period_s: float = 60.0
     step_s: float = 0.001
+    cool_launches: int = 0
+    cool_period_s: float = 300.0
+    hot_degC: float = 100.0
 
     _section = "run"
 
     def _problems(self) -> Iterable[str]:
-        yield from self._ranges({"launches": (1, 1000), "period_s": (5.0, 3600.0), "step_s": (1e-5, 0.1)})
-        yield from self._integers("launches")
+        yield from self._ranges({"launches": (1, 1000), "period_s": (5.0, 3600.0), "step_s": (1e-5, 0.1),
+                                 "cool_launches": (0, 1000), "cool_period_s": (5.0, 3600.0),
+                                 "hot_degC": (-50.0, 400.0)})
+        yield from self._integers("launches", "cool_launches")
+
+    def starts(self) -> list[float]:
+        """Start time of every launch, s."""
+        hot = [i * self.period_s for i in range(self.launches)]
+        last = hot[-1]
+        return hot + [last + (j + 1) * self.cool_period_s for j in range(self.cool_launches)]
+
+    def duration(self) -> float:
+        """Simulated time, s: the last launch gets its own period."""
+        return self.starts()[-1] + (self.cool_period_s if self.cool_launches else self.period_s)
 
 
 @dataclass(frozen=True)
@@ -171,13 +277,35 @@ class Scenario(Checked):
     facing: Facing = field(default_factory=Facing)
     tcu: Tcu = field(default_factory=Tcu)
     run: Run = field(default_factory=Run)
+    clutch: Clutch = field(default_factory=Clutch)
+    observer: Observer = field(default_factory=Observer)
+    sensors: Sensors = field(default_factory=Sensors)
+    adaptation: Adaptation = field(default_factory=Adaptation)
+    folder: str = ""
+    """folder of the scenario file (set by :func:`load_scenario`), for relative file names"""
 
     def _problems(self) -> Iterable[str]:
-        if self.run.period_s <= self.tcu.drive_time_s + 5.0:
-            yield (f"run.period_s = {self.run.period_s!r}: must exceed tcu.drive_time_s + 5 s "
-                   "(time to brake to a stop)")
+        for key, period in (("period_s", self.run.period_s), ("cool_period_s", self.run.cool_period_s)):
+            if period <= self.tcu.drive_time_s + 5.0:
+                yield (f"run.{key} = {period!r}: must exceed tcu.drive_time_s + 5 s "
+                       "(time to brake to a stop)")
+
+    def friction_path(self) -> Path | None:
+        """The plant's friction table file, or None (mu constant)."""
+        if not self.clutch.friction_csv:
+            return None
+        path = Path(self.clutch.friction_csv)
+        return path if path.is_absolute() else Path(self.folder or ".") / path
 
 
 def load_scenario(path: str | Path = DEFAULT_SCENARIO) -> Scenario:
     """Load and check a scenario TOML file (unknown keys and bad ranges rejected)."""
-    return build_checked(Scenario, load_toml(path), str(path))
+    data = load_toml(path)
+    if "folder" in data:
+        raise ParameterError([f"folder: unknown key"], str(path))
+    data["folder"] = str(Path(path).resolve().parent)
+    sc = build_checked(Scenario, data, str(path))
+    fr = sc.friction_path()
+    if fr is not None and not fr.is_file():
+        raise ParameterError([f"clutch.friction_csv = {sc.clutch.friction_csv!r}: file {fr} not found"], str(path))
+    return sc

@@ -1,0 +1,100 @@
+"""The clutch FMU as seen by the launch master: one thin choke point for every FMI call.
+
+fmpy loads the FMU and runs its life cycle (instantiate, initialise,
+terminate). The hot path (``fmi2SetReal``, ``fmi2DoStep``, ``fmi2GetReal``
+once per communication step) calls the FMU's functions directly through
+ctypes with preallocated value-reference and value arrays, which avoids
+fmpy's per-call list conversion and logging wrapper. Every status other
+than fmi2OK/fmi2Warning raises :class:`~cushion_clutch.errors.FmuCallError`
+naming the FMI function.
+"""
+from __future__ import annotations
+
+import ctypes
+import shutil
+from pathlib import Path
+
+from ..errors import FmuCallError
+
+#: inputs and outputs exchanged every step, in this order
+INPUTS = ("x_to", "theta_cm", "omega_slip")
+OUTPUTS = ("torque", "theta_cs", "x_kiss")
+
+
+class ClutchFmu:
+    """The clutch FMU (FMI 2 co-simulation).
+
+    Parameters
+    ----------
+    fmu : Path
+        The ``.fmu`` file (native or pythonfmu backend).
+    start : dict of str to float
+        Start values of parameters, SI (e.g. ``theta_a`` in K).
+    """
+
+    def __init__(self, fmu: Path, start: dict[str, float]):
+        from fmpy import extract, read_model_description
+        from fmpy.fmi2 import FMU2Slave
+
+        md = read_model_description(str(fmu))
+        vr = {v.name: v.valueReference for v in md.modelVariables}
+        missing = [n for n in INPUTS + OUTPUTS if n not in vr]
+        if missing:
+            raise ValueError(f"{fmu}: the FMU has no variable(s) {', '.join(missing)}")
+        self.unzip = extract(str(fmu))
+        self.slave = FMU2Slave(guid=md.guid, unzipDirectory=self.unzip,
+                               modelIdentifier=md.coSimulation.modelIdentifier, instanceName="clutch")
+        s = self.slave
+        s.instantiate()
+        try:
+            s.setupExperiment(startTime=0.0)
+            if start:
+                s.setReal([vr[k] for k in start], list(start.values()))
+            s.enterInitializationMode()
+            s.exitInitializationMode()
+        except Exception as exc:            # fmpy raises FMICallException; keep one typed error
+            s.freeInstance()
+            raise FmuCallError("fmi2 initialisation", getattr(exc, "status", 3), str(exc)) from exc
+        dll, self._c = s.dll, s.component
+        self._set, self._do, self._get = dll.fmi2SetReal, dll.fmi2DoStep, dll.fmi2GetReal
+        uint_arr, real_arr = ctypes.c_uint * 3, ctypes.c_double * 3
+        self._vr_in = uint_arr(*(vr[n] for n in INPUTS))
+        self._vr_out = uint_arr(*(vr[n] for n in OUTPUTS))
+        self._v_in, self._v_out = real_arr(), real_arr()
+        self._three = ctypes.c_size_t(3)
+        self._true = ctypes.c_int(1)
+        self._set.argtypes = self._get.argtypes = [ctypes.c_void_p, uint_arr, ctypes.c_size_t, real_arr]
+        self._do.argtypes = [ctypes.c_void_p, ctypes.c_double, ctypes.c_double, ctypes.c_int]
+        self._set.restype = self._get.restype = self._do.restype = ctypes.c_int
+
+    def step(self, t: float, h: float, x_to: float, theta_cm: float, omega_slip: float) -> tuple[float, float, float]:
+        """Set the inputs (m, K, rad/s), advance ``h`` s from ``t``; return torque (N.m), theta_cs (K), x_kiss (m).
+
+        Raises
+        ------
+        FmuCallError
+            Naming the FMI function that did not return fmi2OK/fmi2Warning.
+        """
+        v = self._v_in
+        v[0] = x_to
+        v[1] = theta_cm
+        v[2] = omega_slip
+        st = self._set(self._c, self._vr_in, self._three, v)
+        if st > 1:
+            raise FmuCallError("fmi2SetReal", st, f"x_to={x_to!r}, theta_cm={theta_cm!r}, omega_slip={omega_slip!r}")
+        st = self._do(self._c, t, h, self._true)
+        if st > 1:
+            raise FmuCallError("fmi2DoStep", st, f"t={t!r}, h={h!r}")
+        o = self._v_out
+        st = self._get(self._c, self._vr_out, self._three, o)
+        if st > 1:
+            raise FmuCallError("fmi2GetReal", st)
+        return o[0], o[1], o[2]
+
+    def close(self) -> None:
+        """Terminate and free the instance, delete the extracted FMU."""
+        try:
+            self.slave.terminate()
+            self.slave.freeInstance()
+        finally:
+            shutil.rmtree(self.unzip, ignore_errors=True)

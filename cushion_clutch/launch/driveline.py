@@ -84,8 +84,19 @@ class Driveline:
         ``engaged``: the TCU is launching or closing (lock-up allowed);
         ``braking``: the service brake stops the car.
         """
-        h, i_tot, r, eta, j_e, j_d = self.h, self.i_tot, self.r, self.eta, self.j_e, self.j_d
         w_e, v, en = self.w_e, self.v, self.en
+        if v == 0.0 and t_cap == 0.0 and not self.locked:
+            # at rest, clutch open: the brake holds the car; only the engine moves (same
+            # arithmetic as below with every vehicle term zero)
+            h = self.h
+            w_e_new = w_e + t_e / self.j_e * h
+            if w_e_new < 0.0:
+                w_e_new = 0.0
+            en.engine_work += t_e * 0.5 * (w_e + w_e_new) * h
+            self.w_e = w_e_new
+            self.t_c = self.slip_J = self.slip_W = 0.0
+            return 0
+        h, i_tot, r, eta, j_e, j_d = self.h, self.i_tot, self.r, self.eta, self.j_e, self.j_d
         w_d = v * i_tot / r
         f_res = (self.f_roll if v > 0.0 else 0.0) + self.air * v * v + self.f_grade
         t_load = f_res * r / (eta * i_tot)                         # resistance felt at the clutch

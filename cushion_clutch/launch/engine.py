@@ -50,7 +50,14 @@ class EngineGovernor:
 
     def torque(self, w_e: float, engaged: bool, stalled: bool) -> float:
         """Engine torque (N.m) over the next step; updates the governor and ``throttle``."""
-        t_max = self.max_torque(w_e)
+        w, t = self.w, self.t
+        if w_e <= w[0]:
+            t_max = t[0]
+        elif w_e >= w[-1]:
+            t_max = t[-1]
+        else:
+            i = bisect_right(w, w_e) - 1
+            t_max = t[i] + (t[i + 1] - t[i]) * (w_e - w[i]) / (w[i + 1] - w[i])
         err = (self.w_launch if engaged else self.w_idle) - w_e
         gov = self.kp * err + self.ki * self.integral + self.drag * w_e      # drag feed-forward
         thr = gov / t_max

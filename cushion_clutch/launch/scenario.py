@@ -298,6 +298,13 @@ class Scenario(Checked):
         return path if path.is_absolute() else Path(self.folder or ".") / path
 
 
+def scenario_path(name: str | Path) -> Path:
+    """A scenario file: ``name`` itself, or the shipped ``<name>.toml`` (default, cooldown, fade)."""
+    path = Path(name)
+    shipped = DEFAULT_SCENARIO.parent / f"{name}.toml"
+    return shipped if not path.exists() and path.suffix == "" and shipped.is_file() else path
+
+
 def load_scenario(path: str | Path = DEFAULT_SCENARIO) -> Scenario:
     """Load and check a scenario TOML file (unknown keys and bad ranges rejected)."""
     data = load_toml(path)

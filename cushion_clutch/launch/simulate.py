@@ -99,11 +99,13 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
     n, rec, slot_start, slot_end = 0, recs[0], starts[0], ends[0]
     engaged = braking = launching = False
     countdown = 0
+    clutch_step, engine_torque, dl_step, facing_step = clutch.step, engine.torque, dl.step, facing.step
+    n_slots = len(starts)
     wall0 = time.perf_counter()
     try:
         for k in range(n_steps):
             t = k * h
-            if t >= slot_end - 0.5 * h and n + 1 < len(starts):
+            if t >= slot_end - 0.5 * h and n + 1 < n_slots:
                 n += 1
                 rec, slot_start, slot_end = recs[n], starts[n], ends[n]
             tl = t - slot_start
@@ -119,18 +121,18 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
             x_act = x_cmd + (x_act - x_cmd) * act
             w_e, v = dl.w_e, dl.v
             # -- clutch FMU, inputs held over the step
-            t_cap, theta_cs, x_kiss = clutch.step(t, h, x_act, theta_cm, w_e - v * r_to_disc)
+            t_cap, theta_cs, x_kiss = clutch_step(t, h, x_act, theta_cm, w_e - v * r_to_disc)
             if engaged and not rec.started:
-                rec.start(ctl.kiss() - x_kiss, theta_cs, ctl.theta_used() - theta_cs)
-            t_e = engine.torque(w_e, engaged, rec.stall)
-            ev = dl.step(t_e, t_cap, engaged, braking)
+                rec.start(ctl.kiss_now - x_kiss, theta_cs, ctl.theta_now - theta_cs)
+            t_e = engine_torque(w_e, engaged, rec.stall)
+            ev = dl_step(t_e, t_cap, engaged, braking)
             if ev:
                 events.append((n + 1, "lock" if ev > 0 else "unlock", t + h if ev > 0 else t))
                 if ev > 0 and rec.lock_time is None:
                     rec.lock_time = tl + h
             rec.slip_J += dl.slip_J
             theta_cm_step = theta_cm
-            theta_cm = profile(t + h) if profile is not None else facing.step(theta_cm, dl.slip_W)
+            theta_cm = profile(t + h) if profile is not None else facing_step(theta_cm, dl.slip_W)
             accel = (dl.v - v) / h
             if engaged:
                 rec.step(accel, tl + h, ctl.t_dem, t_cap, launching)
@@ -143,7 +145,7 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
                 dl.restart_engine(w_idle)
             if k % record_every == 0:
                 rows.append((t, n + 1, dl.w_e, dl.v * r_to_disc, dl.v, accel, x_cmd, x_act, ctl.t_dem, t_cap,
-                             dl.t_c, theta_cm_step, theta_cs, ctl.theta_used(), x_kiss, ctl.kiss(),
+                             dl.t_c, theta_cm_step, theta_cs, ctl.theta_now, x_kiss, ctl.kiss_now,
                              engine.throttle, float(dl.locked), ctl.theta_cm_estimate()))
                 if progress is not None and k % 10000 == 0:
                     progress(t)

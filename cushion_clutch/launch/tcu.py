@@ -24,6 +24,7 @@ uncompensated one keeps it fixed.
 """
 from __future__ import annotations
 
+import copy
 from dataclasses import dataclass
 
 from ..fmu_src.clutch_model import KELVIN, ClutchParameters, SpringTable, outputs, thermal_step, x_to_for_torque
@@ -71,6 +72,9 @@ class TcuController:
 
     def __init__(self, variant: Variant, sc: Scenario, table: SpringTable, p: ClutchParameters, theta0: float,
                  j_d_kg_m2: float, t_load_Nm: float):
+        if table.friction is not None:          # the TCU's model has the nominal, constant mu
+            table = copy.copy(table)
+            table.friction = None
         self.v, self.sc, self.table, self.p = variant, sc, table, p
         self.period = sc.tcu.period_s
         self.theta_ref = table.theta_degC[0] + KELVIN
@@ -82,6 +86,8 @@ class TcuController:
         self.offset = 0.0               #: learned kiss point minus the model's at the assumed temperature, m
         self.phase, self.t_dem, self.x_cmd = OPEN, 0.0, 0.0
         self.launch = 0
+        #: the assumed theta_cs (K) and believed kiss point (m) after the last cycle
+        self.theta_now, self.kiss_now = self.theta_used(), self.kiss()
 
     @property
     def name(self) -> str:
@@ -157,3 +163,4 @@ class TcuController:
             self.phase, self.t_dem, self.x_cmd = OPEN, 0.0, self.command(0.0)    # pre-fill to first contact
         else:
             self.phase, self.t_dem, self.x_cmd = OPEN, 0.0, 0.0
+        self.theta_now, self.kiss_now = self.theta_used(), self.kiss()

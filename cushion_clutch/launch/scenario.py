@@ -155,10 +155,13 @@ class Clutch(Checked):
     """
 
     friction_csv: str = ""
+    x_kiss_offset_m: float = 0.0
+    """the plant's kiss point minus the TCU's nominal one, at the bearing (tolerances, wear), m"""
 
     _section = "clutch"
 
     def _problems(self) -> Iterable[str]:
+        yield from self._ranges({"x_kiss_offset_m": (-0.005, 0.005)})
         if not isinstance(self.friction_csv, str):
             yield f"clutch.friction_csv = {self.friction_csv!r}: must be a file name or \"\""
 
@@ -307,6 +310,8 @@ def scenario_path(name: str | Path) -> Path:
 
 def load_scenario(path: str | Path = DEFAULT_SCENARIO) -> Scenario:
     """Load and check a scenario TOML file (unknown keys and bad ranges rejected)."""
+    if not Path(path).is_file():
+        raise ParameterError([f"scenario file {path} not found (shipped: default, cooldown, fade)"])
     data = load_toml(path)
     if "folder" in data:
         raise ParameterError([f"folder: unknown key"], str(path))

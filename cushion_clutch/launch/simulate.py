@@ -87,7 +87,8 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
     w_idle, w_stall = engine.w_idle, engine.w_stall
     r_to_disc = dl.i_tot / dl.r
 
-    clutch = ClutchFmu(fmu, {"theta_a": theta_a, "theta_cs_start": theta0})
+    clutch = ClutchFmu(fmu, {"theta_a": theta_a, "theta_cs_start": theta0,
+                             "x_kiss_ref": p.x_kiss_ref + sc.clutch.x_kiss_offset_m})
     theta_cm = theta0
     x_act = 0.0
     theta_cs, x_kiss = theta0, p.x_kiss_ref

@@ -9,7 +9,8 @@ from cushion_clutch.errors import FmuCallError
 from cushion_clutch.fmu.build import build_fmu
 from cushion_clutch.fmu.model import DEFAULT_TABLES, load_table
 from cushion_clutch.launch.fmu_client import ClutchFmu
-from cushion_clutch.launch.scenario import Observer, load_scenario
+from cushion_clutch.launch.scenario import load_scenario
+from cushion_clutch.launch.tcu_params import Observer
 from cushion_clutch.launch.simulate import simulate_launches
 from cushion_clutch.fmu_src.clutch_model import KELVIN
 

@@ -14,7 +14,7 @@ value is used until the next adaptation.
 """
 from __future__ import annotations
 
-from .scenario import Adaptation
+from .tcu_params import Adaptation
 
 
 class KissLearner:

@@ -11,7 +11,7 @@ from __future__ import annotations
 import random
 
 from ..fmu_src.clutch_model import ClutchParameters, thermal_step
-from .scenario import Observer, Sensors
+from .tcu_params import Observer, Sensors
 from .thermal import FacingModel
 
 

@@ -66,30 +66,37 @@ class ClutchFmu:
         self._set.argtypes = self._get.argtypes = [ctypes.c_void_p, uint_arr, ctypes.c_size_t, real_arr]
         self._do.argtypes = [ctypes.c_void_p, ctypes.c_double, ctypes.c_double, ctypes.c_int]
         self._set.restype = self._get.restype = self._do.restype = ctypes.c_int
+        self.step = self._make_step()
 
-    def step(self, t: float, h: float, x_to: float, theta_cm: float, omega_slip: float) -> tuple[float, float, float]:
-        """Set the inputs (m, K, rad/s), advance ``h`` s from ``t``; return torque (N.m), theta_cs (K), x_kiss (m).
+    def _make_step(self):
+        """The hot-path step as a closure over the ctypes functions and arrays (no attribute look-ups)."""
+        set_real, do_step, get_real, comp = self._set, self._do, self._get, self._c
+        vr_in, vr_out, v, o, three, true = self._vr_in, self._vr_out, self._v_in, self._v_out, self._three, self._true
 
-        Raises
-        ------
-        FmuCallError
-            Naming the FMI function that did not return fmi2OK/fmi2Warning.
-        """
-        v = self._v_in
-        v[0] = x_to
-        v[1] = theta_cm
-        v[2] = omega_slip
-        st = self._set(self._c, self._vr_in, self._three, v)
-        if st > 1:
-            raise FmuCallError("fmi2SetReal", st, f"x_to={x_to!r}, theta_cm={theta_cm!r}, omega_slip={omega_slip!r}")
-        st = self._do(self._c, t, h, self._true)
-        if st > 1:
-            raise FmuCallError("fmi2DoStep", st, f"t={t!r}, h={h!r}")
-        o = self._v_out
-        st = self._get(self._c, self._vr_out, self._three, o)
-        if st > 1:
-            raise FmuCallError("fmi2GetReal", st)
-        return o[0], o[1], o[2]
+        def step(t: float, h: float, x_to: float, theta_cm: float, omega_slip: float) -> tuple[float, float, float]:
+            """Set the inputs (m, K, rad/s), advance ``h`` s from ``t``; return torque (N.m), theta_cs (K), x_kiss (m).
+
+            Raises
+            ------
+            FmuCallError
+                Naming the FMI function that did not return fmi2OK/fmi2Warning.
+            """
+            v[0] = x_to
+            v[1] = theta_cm
+            v[2] = omega_slip
+            st = set_real(comp, vr_in, three, v)
+            if st > 1:
+                raise FmuCallError("fmi2SetReal", st, f"x_to={x_to!r}, theta_cm={theta_cm!r}, omega_slip={omega_slip!r}")
+            st = do_step(comp, t, h, true)
+            if st > 1:
+                raise FmuCallError("fmi2DoStep", st, f"t={t!r}, h={h!r}")
+            st = get_real(comp, vr_out, three, o)
+            if st > 1:
+                raise FmuCallError("fmi2GetReal", st)
+            return o[0], o[1], o[2]
+
+        return step
+
 
     def close(self) -> None:
         """Terminate and free the instance, delete the extracted FMU."""

@@ -104,13 +104,20 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
     countdown = 0
     clutch_step, engine_torque, dl_step, facing_step = clutch.step, engine.torque, dl.step, facing.step
     n_slots = len(starts)
+    next_switch = slot_end - 0.5 * h if n_slots > 1 else math.inf
+    stalled = False
+    rec_countdown = 0
+    cool_free = profile is None and facing.g > 0.0        # no slip: exact decay towards ambient, inlined
+    fac_decay = facing.decay
     wall0, cpu0 = time.perf_counter(), time.process_time()
     try:
         for k in range(n_steps):
             t = k * h
-            if t >= slot_end - 0.5 * h and n + 1 < n_slots:
+            if t >= next_switch:
                 n += 1
                 rec, slot_start, slot_end = recs[n], starts[n], ends[n]
+                next_switch = slot_end - 0.5 * h if n + 1 < n_slots else math.inf
+                stalled = False
             tl = t - slot_start
             if countdown == 0:                                   # -- TCU cycle
                 countdown = tcu_every
@@ -127,31 +134,39 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
             t_cap, theta_cs, x_kiss = clutch_step(t, h, x_act, theta_cm, w_e - v * r_to_disc)
             if engaged and not rec.started:
                 rec.start(ctl.kiss_now - x_kiss, theta_cs, ctl.theta_now - theta_cs)
-            t_e = engine_torque(w_e, engaged, rec.stall)
+            t_e = engine_torque(w_e, engaged, stalled)
             ev = dl_step(t_e, t_cap, engaged, braking)
             if ev:
                 events.append((n + 1, "lock" if ev > 0 else "unlock", t + h if ev > 0 else t))
                 if ev > 0 and rec.lock_time is None:
                     rec.lock_time = tl + h
-            rec.slip_J += dl.slip_J
+            slip_J = dl.slip_J
             theta_cm_step = theta_cm
-            theta_cm = profile(t + h) if profile is not None else facing_step(theta_cm, dl.slip_W)
+            if slip_J != 0.0:
+                rec.slip_J += slip_J
+                theta_cm = profile(t + h) if profile is not None else facing_step(theta_cm, dl.slip_W)
+            elif cool_free:
+                theta_cm = theta_a + (theta_cm - theta_a) * fac_decay
+            else:
+                theta_cm = profile(t + h) if profile is not None else facing_step(theta_cm, 0.0)
             accel = (dl.v - v) / h
             if engaged:
                 rec.step(accel, tl + h, ctl.t_dem, t_cap, launching)
                 if dl.w_e <= w_stall:
-                    rec.stall = True
+                    rec.stall = stalled = True
             elif dl.locked:
                 dl.locked = False
                 events.append((n + 1, "unlock", t + h))
-            if rec.stall and tl + h >= slot_end - slot_start - h:     # restart for the next launch
+            if stalled and tl + h >= slot_end - slot_start - h:     # restart for the next launch
                 dl.restart_engine(w_idle)
-            if k % record_every == 0:
+            if rec_countdown == 0:
+                rec_countdown = record_every
                 rows.append((t, n + 1, dl.w_e, dl.v * r_to_disc, dl.v, accel, x_cmd, x_act, ctl.t_dem, t_cap,
                              dl.t_c, theta_cm_step, theta_cs, ctl.theta_now, x_kiss, ctl.kiss_now,
                              engine.throttle, float(dl.locked), ctl.theta_cm_estimate()))
                 if progress is not None and k % 10000 == 0:
                     progress(t)
+            rec_countdown -= 1
     finally:
         clutch.close()
     wall, cpu = time.perf_counter() - wall0, time.process_time() - cpu0

@@ -3,7 +3,7 @@
     python -m cushion_clutch.benchmarks.launch [--scenario NAME|FILE] [--backend native|python] [--repeat N]
 
 Also times one FMU step (set inputs, doStep, get outputs) through the
-master's ctypes client and through fmpy's ``FMU2Slave`` in the same run.
+master's cffi client and through fmpy's ``FMU2Slave`` in the same run.
 Machines are noisy: compare figures from one run, or medians (``--repeat``).
 """
 from __future__ import annotations
@@ -16,7 +16,7 @@ from pathlib import Path
 
 
 def _fmu_call_us(fmu: Path, n: int = 50000) -> tuple[float, float]:
-    """Microseconds per step: the ctypes client and fmpy FMU2Slave (name-based set/get)."""
+    """Microseconds per step: the cffi client and fmpy FMU2Slave (name-based set/get)."""
     from fmpy import extract, read_model_description
     from fmpy.fmi2 import FMU2Slave
 
@@ -67,7 +67,7 @@ def main(argv=None) -> None:
         fmu = build_plant_fmu(DEFAULT_TABLES, sc, Path(tmp) / "CushionClutch.fmu", backend=args.backend)
         ours, theirs = _fmu_call_us(fmu)
         print(f"FMU step (set 3 inputs, doStep, get 3 outputs), {args.backend} FMU: {ours:.2f} us through the "
-              f"ctypes client, {theirs:.2f} us through fmpy FMU2Slave ({theirs / ours:.1f}x)")
+              f"cffi client, {theirs:.2f} us through fmpy FMU2Slave ({theirs / ours:.1f}x)")
         for name in VARIANTS:
             runs = [simulate_launches(fmu, sc, load_table(), name) for _ in range(args.repeat)]
             wall = statistics.median(r.wall_time_s for r in runs)

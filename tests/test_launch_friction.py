@@ -46,6 +46,7 @@ def test_fade_table_lowers_the_torque_by_its_ratio(tmp_path):
         finally:
             c.close()
     ratio = table(300.0, 150.0) / table(20.0, 150.0)
+    assert torque[20.0] > 10.0                            # the clutch carries torque at 5 mm
     assert ratio < 0.85                                   # it does fade
     assert torque[300.0] / torque[20.0] == pytest.approx(ratio, rel=1e-9)
 

@@ -106,4 +106,5 @@ class ClutchFmu:
             self.slave.terminate()
             self.slave.freeInstance()
         finally:
+            self._ffi.dlclose(self._lib)        # drop our handle too, so the library can be deleted (Windows)
             shutil.rmtree(self.unzip, ignore_errors=True)

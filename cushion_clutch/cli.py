@@ -114,7 +114,7 @@ def _launch(args: argparse.Namespace) -> int:
                                                           backend=args.backend)
     total = sc.run.duration()
     start = time.perf_counter()
-    with Progress() as bar:
+    with Progress(refresh_per_second=2) as bar:        # the bar's thread competes for the GIL
         tasks = {n: bar.add_task(f"{n} TCU", total=total) for n in VARIANTS}
         results = run_all(fmu, sc, load_table(args.tables),
                           progress=lambda n, t: bar.update(tasks[n], completed=t))

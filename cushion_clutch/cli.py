@@ -152,33 +152,40 @@ def _simulate(args: argparse.Namespace) -> int:
 def _launch(args: argparse.Namespace) -> int:
     from rich.progress import Progress
 
-    from .launch.report import metrics_table, run_both, write_outputs
+    from .fmu.check import check_fmu
     from .fmu.model import load_table
-    from .launch.scenario import load_scenario
+    from .launch.plant import build_plant_fmu
+    from .launch.report import metrics_table, run_all, summary_table, write_outputs
+    from .launch.scenario import load_scenario, scenario_path
+    from .launch.tcu import VARIANTS
     from .outputs import OutputSet
 
-    sc = load_scenario(args.scenario)
+    sc = load_scenario(scenario_path(args.scenario))
     out = _guard_out(Path(args.out), args.force)
     table = load_table(args.tables)
     with OutputSet(out, "launch") as stage:                # checks --out before the simulation
-        fmu = _fmu_arg(args, stage)
-        total = sc.run.launches * sc.run.period_s
+        fmu = (check_fmu(args.fmu) if args.fmu else
+               build_plant_fmu(Path(args.tables), sc, stage / "CushionClutch.fmu", backend=args.backend))
+        total = sc.run.duration()
         start = time.perf_counter()
-        with Progress() as bar:
-            tasks = {n: bar.add_task(f"{n} TCU", total=total) for n in ("naive", "aware")}
-            results = run_both(fmu, sc, table, progress=lambda n, t: bar.update(tasks[n], completed=t))
+        with Progress(refresh_per_second=2) as bar:        # the bar's thread competes for the GIL
+            tasks = {n: bar.add_task(f"{n} TCU", total=total) for n in VARIANTS}
+            results = run_all(fmu, sc, table, progress=lambda n, t: bar.update(tasks[n], completed=t))
             for task in tasks.values():
                 bar.update(task, completed=total)
         wall = time.perf_counter() - start
         paths = write_outputs(results, stage)
     paths = [out / p.relative_to(stage) for p in paths]
     print(metrics_table(results))
+    print()
+    print(summary_table(results))
+    print()
     for name, res in results.items():
         e = res.energy
         print(f"{name}: energy balance residual {e.residual():.3g} J of {e.engine_work / 1e3:.1f} kJ engine "
               f"work; real-time factor {total / res.wall_time_s:.0f}x")
-    print(f"scenario '{sc.name}': {sc.run.launches} launches with both TCUs in {wall:.1f} s; wrote "
-          + ", ".join(str(p) for p in paths))
+    print(f"scenario '{sc.name}': {len(results[next(iter(results))].metrics)} launches with {len(results)} TCUs "
+          f"in {wall:.1f} s; wrote " + ", ".join(str(p) for p in paths))
     return 0
 
 
@@ -323,8 +330,9 @@ def build_parser() -> argparse.ArgumentParser:
     sm.add_argument("--step", type=float, default=0.1, help="communication step [s]")
     sm.set_defaults(func=_simulate)
 
-    la = sub.add_parser("launch", help="repeated launches, naive vs temperature-aware TCU (main job)")
-    la.add_argument("--scenario", default=DEFAULT_SCENARIO, help="scenario TOML")
+    la = sub.add_parser("launch", help="repeated launches with the five TCU variants (main job)")
+    la.add_argument("--scenario", default=DEFAULT_SCENARIO,
+                    help="scenario TOML, or a shipped one: default, cooldown, fade")
     la.add_argument("--fmu", help="clutch FMU (default: build one from --tables into --out)")
     la.add_argument("--tables", default=DEFAULT_TABLES, help="table folder")
     add_backend(la)

@@ -155,3 +155,23 @@ class StudyError(SweepError):
         RuntimeError.__init__(
             self, f"{len(failures)} case(s) of the tolerance study failed; finished cases are cached "
                   f"(a rerun resumes) and no band was written:\n{lines}")
+
+
+class FmuCallError(RuntimeError):
+    """An FMI function returned a status other than fmi2OK (or fmi2Warning).
+
+    Attributes
+    ----------
+    function : str
+        The FMI function, e.g. ``fmi2DoStep``.
+    status : int
+        The FMI status code (2 discard, 3 error, 4 fatal, 5 pending).
+    """
+
+    STATUS = {0: "fmi2OK", 1: "fmi2Warning", 2: "fmi2Discard", 3: "fmi2Error", 4: "fmi2Fatal", 5: "fmi2Pending"}
+
+    def __init__(self, function: str, status: int, detail: str = ""):
+        self.function = function
+        self.status = status
+        name = self.STATUS.get(status, f"status {status}")
+        super().__init__(f"{function} returned {name}" + (f" ({detail})" if detail else ""))

@@ -10,6 +10,8 @@ from typing import Iterable
 
 from ..config import Checked, build_checked, load_toml, range_problem
 from ..data import DEFAULT_SCENARIO
+from ..errors import ParameterError
+from .tcu_params import Adaptation, Observer, Sensors
 
 
 
@@ -145,18 +147,59 @@ class Tcu(Checked):
 
 
 @dataclass(frozen=True)
+class Clutch(Checked):
+    """The plant clutch's friction: ``friction_csv`` = "" keeps mu = 0.28 constant (the paper's model).
+
+    Otherwise a ``theta_degC,omega_slip_rad_s,mu`` table, relative to the
+    scenario file's folder (or absolute), put into the plant FMU's resources.
+    The TCUs do not know it: their model keeps the nominal mu.
+    """
+
+    friction_csv: str = ""
+    x_kiss_offset_m: float = 0.0
+    """the plant's kiss point minus the TCU's nominal one, at the bearing (tolerances, wear), m"""
+
+    _section = "clutch"
+
+    def _problems(self) -> Iterable[str]:
+        yield from self._ranges({"x_kiss_offset_m": (-0.005, 0.005)})
+        if not isinstance(self.friction_csv, str):
+            yield f"clutch.friction_csv = {self.friction_csv!r}: must be a file name or \"\""
+
+
+@dataclass(frozen=True)
 class Run(Checked):
-    """Repetition and co-simulation step."""
+    """Repetition and co-simulation step.
+
+    ``launches`` every ``period_s`` (the hot phase), then ``cool_launches``
+    every ``cool_period_s`` (a cool-down). Launches starting with the cushion
+    spring at or above ``hot_degC`` count as hot in the summary.
+    """
 
     launches: int = 12
     period_s: float = 60.0
     step_s: float = 0.001
+    cool_launches: int = 0
+    cool_period_s: float = 300.0
+    hot_degC: float = 100.0
 
     _section = "run"
 
     def _problems(self) -> Iterable[str]:
-        yield from self._ranges({"launches": (1, 1000), "period_s": (5.0, 3600.0), "step_s": (1e-5, 0.1)})
-        yield from self._integers("launches")
+        yield from self._ranges({"launches": (1, 1000), "period_s": (5.0, 3600.0), "step_s": (1e-5, 0.1),
+                                 "cool_launches": (0, 1000), "cool_period_s": (5.0, 3600.0),
+                                 "hot_degC": (-50.0, 400.0)})
+        yield from self._integers("launches", "cool_launches")
+
+    def starts(self) -> list[float]:
+        """Start time of every launch, s."""
+        hot = [i * self.period_s for i in range(self.launches)]
+        last = hot[-1]
+        return hot + [last + (j + 1) * self.cool_period_s for j in range(self.cool_launches)]
+
+    def duration(self) -> float:
+        """Simulated time, s: the last launch gets its own period."""
+        return self.starts()[-1] + (self.cool_period_s if self.cool_launches else self.period_s)
 
 
 @dataclass(frozen=True)
@@ -171,13 +214,44 @@ class Scenario(Checked):
     facing: Facing = field(default_factory=Facing)
     tcu: Tcu = field(default_factory=Tcu)
     run: Run = field(default_factory=Run)
+    clutch: Clutch = field(default_factory=Clutch)
+    observer: Observer = field(default_factory=Observer)
+    sensors: Sensors = field(default_factory=Sensors)
+    adaptation: Adaptation = field(default_factory=Adaptation)
+    folder: str = ""
+    """folder of the scenario file (set by :func:`load_scenario`), for relative file names"""
 
     def _problems(self) -> Iterable[str]:
-        if self.run.period_s <= self.tcu.drive_time_s + 5.0:
-            yield (f"run.period_s = {self.run.period_s!r}: must exceed tcu.drive_time_s + 5 s "
-                   "(time to brake to a stop)")
+        for key, period in (("period_s", self.run.period_s), ("cool_period_s", self.run.cool_period_s)):
+            if period <= self.tcu.drive_time_s + 5.0:
+                yield (f"run.{key} = {period!r}: must exceed tcu.drive_time_s + 5 s "
+                       "(time to brake to a stop)")
+
+    def friction_path(self) -> Path | None:
+        """The plant's friction table file, or None (mu constant)."""
+        if not self.clutch.friction_csv:
+            return None
+        path = Path(self.clutch.friction_csv)
+        return path if path.is_absolute() else Path(self.folder or ".") / path
+
+
+def scenario_path(name: str | Path) -> Path:
+    """A scenario file: ``name`` itself, or the shipped ``<name>.toml`` (default, cooldown, fade)."""
+    path = Path(name)
+    shipped = DEFAULT_SCENARIO.parent / f"{name}.toml"
+    return shipped if not path.exists() and path.suffix == "" and shipped.is_file() else path
 
 
 def load_scenario(path: str | Path = DEFAULT_SCENARIO) -> Scenario:
     """Load and check a scenario TOML file (unknown keys and bad ranges rejected)."""
-    return build_checked(Scenario, load_toml(path), str(path))
+    if not Path(path).is_file():
+        raise ParameterError([f"scenario file {path} not found (shipped: default, cooldown, fade)"])
+    data = load_toml(path)
+    if "folder" in data:
+        raise ParameterError([f"folder: unknown key"], str(path))
+    data["folder"] = str(Path(path).resolve().parent)
+    sc = build_checked(Scenario, data, str(path))
+    fr = sc.friction_path()
+    if fr is not None and not fr.is_file():
+        raise ParameterError([f"clutch.friction_csv = {sc.clutch.friction_csv!r}: file {fr} not found"], str(path))
+    return sc

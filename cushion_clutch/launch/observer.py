@@ -1,0 +1,61 @@
+"""What the TCU measures and infers: speed sensors and the facing-temperature observer.
+
+The observer uses only what a TCU has: the engine and disc speeds (through
+:class:`SpeedSensors`), the clutch torque its own model expects at the
+measured bearing position, the ambient temperature and time. Its facing and
+cushion-spring models have their own parameters (scenario ``[observer]``),
+deliberately mismatched with the plant's in the shipped scenarios.
+"""
+from __future__ import annotations
+
+import random
+
+from ..fmu_src.clutch_model import ClutchParameters, thermal_step
+from .tcu_params import Observer, Sensors
+from .thermal import FacingModel
+
+
+class SpeedSensors:
+    """A speed as the TCU reads it: plus Gaussian noise (std, rad/s), then quantised (step, rad/s).
+
+    Deterministic for a given ``seed``.
+    """
+
+    __slots__ = ("noise", "step", "rng")
+
+    def __init__(self, s: Sensors):
+        self.noise, self.step = s.speed_noise_rad_s, s.speed_resolution_rad_s
+        self.rng = random.Random(s.seed)
+
+    def read(self, w: float) -> float:
+        """Measured value of the speed ``w`` (rad/s)."""
+        if self.noise > 0.0:
+            w += self.rng.gauss(0.0, self.noise)
+        if self.step > 0.0:
+            w = self.step * round(w / self.step)
+        return w
+
+
+class FacingObserver:
+    """Estimates theta_cm and theta_cs (K) from the slip power the TCU computes.
+
+    Call :meth:`update` once per TCU period with the slip power (W) sampled at
+    this cycle; it first advances both temperatures over the period that just
+    ended with the power sampled at the previous cycle (causal, held).
+    """
+
+    __slots__ = ("facing", "p", "dt", "theta_cm", "theta_cs", "p_prev")
+
+    def __init__(self, obs: Observer, theta_a: float, theta0: float, dt: float):
+        self.facing = FacingModel(obs.capacity_J_per_K, obs.loss_W_per_K, obs.heat_share, theta_a, dt)
+        self.p = ClutchParameters(U=obs.spring_U_W_per_K, H=obs.spring_H_W_per_K, C=obs.spring_C_J_per_K,
+                                  theta_a=theta_a, theta_cs_start=theta0)
+        self.dt = dt
+        self.theta_cm = self.theta_cs = theta0
+        self.p_prev = 0.0
+
+    def update(self, p_slip_W: float) -> None:
+        """Advance over the last period; remember ``p_slip_W`` for the next one."""
+        self.theta_cs = thermal_step(self.theta_cs, self.theta_cm, self.dt, self.p)
+        self.theta_cm = self.facing.step(self.theta_cm, self.p_prev)
+        self.p_prev = p_slip_W

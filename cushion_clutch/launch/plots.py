@@ -1,0 +1,64 @@
+"""Plots of a launch study: the hottest launch, temperatures and estimates, metrics per launch."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..fmu_src.clutch_model import KELVIN
+from .simulate import LaunchResult
+
+STYLE = {"naive": "-", "aware": "--", "aware_estimated": "-.", "adaptive": ":", "adaptive_aware_estimated": (0, (5, 1, 1, 1, 1, 1))}
+
+
+def plot_launches(results: dict[str, LaunchResult], out: Path) -> list[Path]:
+    """``launch_last.png``, ``launch_temperatures.png`` and ``launch_metrics.png`` in ``out``."""
+    import matplotlib.pyplot as plt
+
+    from ..plotting import finish_figure
+
+    any_res = next(iter(results.values()))
+    hottest = max(any_res.metrics, key=lambda m: m["theta_cs_start_degC"])["launch"]
+    fig, axes = plt.subplots(3, 1, figsize=(9, 10), sharex=True)
+    for i, (name, res) in enumerate(results.items()):
+        s = res.series
+        sel = s["launch"] == hottest
+        t = s["time_s"][sel] - s["time_s"][sel][0]
+        ls = STYLE.get(name, "-")
+        axes[0].plot(t, s["w_disc_rad_s"][sel] * 30 / np.pi, linestyle=ls, color=f"C{i}", label=f"disc ({name})")
+        axes[1].plot(t, s["x_to_m"][sel] * 1e3, linestyle=ls, color=f"C{i}", label=f"x_to ({name})")
+        axes[1].plot(t, s["x_kiss_tcu_m"][sel] * 1e3, linestyle=ls, color=f"C{i}", alpha=0.5, lw=0.8)
+        axes[2].plot(t, s["torque_capacity_Nm"][sel], linestyle=ls, color=f"C{i}", label=f"delivered ({name})")
+        if i == 0:
+            axes[0].plot(t, s["w_engine_rad_s"][sel] * 30 / np.pi, color="grey", label="engine (naive)")
+            axes[1].plot(t, s["x_kiss_m"][sel] * 1e3, color="k", lw=1.5, label="true kiss point")
+            axes[2].plot(t, s["torque_demand_Nm"][sel], color="k", lw=1.5, label="demanded")
+    axes[0].set(ylabel="speed [rpm]", title=f"Launch {hottest} (hottest start): the five TCUs")
+    axes[1].set(ylabel="bearing [mm] (thin: kiss point believed)")
+    axes[2].set(ylabel="clutch torque [N·m]", xlabel="time since launch start [s]", xlim=(0, 3))
+    p1 = finish_figure(fig, axes, out / "launch_last.png", fontsize=7)
+
+    fig, ax = plt.subplots(figsize=(9, 4.5))
+    s = any_res.series
+    ax.plot(s["time_s"], s["theta_cm_K"] - KELVIN, color="C3", label="facing θ_cm (plant)")
+    ax.plot(s["time_s"], s["theta_cs_K"] - KELVIN, color="C0", label="cushion spring θ_cs (FMU)")
+    est = results.get("aware_estimated")
+    if est is not None:
+        e = est.series
+        ax.plot(e["time_s"], e["theta_cm_tcu_K"] - KELVIN, "--", color="C3", label="θ_cm estimated (observer)")
+        ax.plot(e["time_s"], e["theta_cs_tcu_K"] - KELVIN, "--", color="C0", label="θ_cs estimated (observer)")
+    ax.set(xlabel="time [s]", ylabel="temperature [°C]",
+           title="Temperatures over the launches: plant and the TCU's mismatched observer")
+    p2 = finish_figure(fig, ax, out / "launch_temperatures.png")
+
+    fig, axes = plt.subplots(3, 1, figsize=(9, 9), sharex=True)
+    for i, (name, res) in enumerate(results.items()):
+        n = [m["launch"] for m in res.metrics]
+        ls = STYLE.get(name, "-")
+        for ax, col in zip(axes, ("torque_error_rms_Nm", "kiss_point_error_mm", "creep_shortfall_Nm")):
+            ax.plot(n, [m[col] for m in res.metrics], marker="o", ms=3, linestyle=ls, color=f"C{i}", label=name)
+    axes[0].set(ylabel="RMS torque error [N·m]", title="Metrics per launch and TCU")
+    axes[1].set(ylabel="kiss-point error [mm]\n(believed − true)")
+    axes[2].set(ylabel="creep shortfall [N·m]\n(demand ≤ 30 N·m)", xlabel="launch")
+    p3 = finish_figure(fig, axes, out / "launch_metrics.png", fontsize=7)
+    return [p1, p2, p3]

@@ -1,0 +1,63 @@
+"""The plant's friction table in the launches: constant mu unchanged, fade by the table's ratio."""
+import dataclasses
+
+import numpy as np
+import pytest
+
+from cushion_clutch.fmu.build import build_fmu
+from cushion_clutch.fmu.model import DEFAULT_TABLES, load_table
+from cushion_clutch.fmu_src.clutch_model import KELVIN
+from cushion_clutch.fmu_src.friction import FrictionTable
+from cushion_clutch.launch.fmu_client import ClutchFmu
+from cushion_clutch.launch.plant import build_plant_fmu
+from cushion_clutch.launch.scenario import load_scenario, scenario_path
+from cushion_clutch.launch.simulate import simulate_launches
+
+from test_launch import short
+
+pytestmark = pytest.mark.fmu
+
+
+def test_constant_mu_table_gives_todays_results(tmp_path):
+    flat = tmp_path / "flat.csv"
+    flat.write_text("theta_degC,omega_slip_rad_s,mu\n0,0,0.28\n400,0,0.28\n0,500,0.28\n400,500,0.28\n")
+    sc = short(load_scenario(), launches=2)
+    with_table = dataclasses.replace(sc, clutch=dataclasses.replace(sc.clutch, friction_csv=str(flat)))
+    plain_fmu = build_fmu(DEFAULT_TABLES, tmp_path / "a" / "plain.fmu")
+    flat_fmu = build_plant_fmu(DEFAULT_TABLES, with_table, tmp_path / "b" / "flat.fmu")
+    a = simulate_launches(plain_fmu, sc, load_table(), "aware_estimated")
+    b = simulate_launches(flat_fmu, with_table, load_table(), "aware_estimated")
+    # equal to round-off: the bilinear weights make mu = 0.28 within one ulp, not bit for bit
+    for f in a.series.dtype.names:
+        np.testing.assert_allclose(b.series[f], a.series[f], rtol=1e-12, atol=1e-12, equal_nan=True)
+    for ma, mb in zip(a.metrics, b.metrics):
+        assert mb == pytest.approx(ma, rel=1e-9, abs=1e-9, nan_ok=True)
+
+
+def test_fade_table_lowers_the_torque_by_its_ratio(tmp_path):
+    sc = load_scenario(scenario_path("fade"))
+    table = FrictionTable.from_csv(sc.friction_path())
+    fmu = build_plant_fmu(DEFAULT_TABLES, sc, tmp_path / "fade.fmu")
+    torque = {}
+    for theta_c in (20.0, 300.0):
+        c = ClutchFmu(fmu, {"theta_cs_start": 373.15})
+        try:
+            torque[theta_c] = c.step(0.0, 1e-9, 0.005, theta_c + KELVIN, 150.0)[0]
+        finally:
+            c.close()
+    ratio = table(300.0, 150.0) / table(20.0, 150.0)
+    assert torque[20.0] > 10.0                            # the clutch carries torque at 5 mm
+    assert ratio < 0.85                                   # it does fade
+    assert torque[300.0] / torque[20.0] == pytest.approx(ratio, rel=1e-9)
+
+
+def test_fade_scenario_delivers_less_torque_when_hot(tmp_path):
+    sc = load_scenario(scenario_path("fade"))
+    sc = dataclasses.replace(short(sc, launches=2, initial_degC=300.0))
+    fmu = build_plant_fmu(DEFAULT_TABLES, sc, tmp_path / "fade.fmu")
+    plain = build_fmu(DEFAULT_TABLES, tmp_path / "p" / "plain.fmu")
+    fade = simulate_launches(fmu, sc, load_table(), "aware").metrics
+    const = simulate_launches(plain, sc, load_table(), "aware").metrics
+    for f, c in zip(fade, const):
+        assert f["torque_error_rms_Nm"] > c["torque_error_rms_Nm"] + 5.0
+        assert f["engagement_time_s"] > c["engagement_time_s"]

@@ -61,9 +61,6 @@ def install_logger() -> None:
     addLoggerProxy(byref(CALLBACKS))
 
 
-install_logger()
-
-
 def status(fn, *args) -> int:
     """The FMI status of a call (fmpy raises above Warning)."""
     try:

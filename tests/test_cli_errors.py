@@ -39,7 +39,7 @@ CASES = [
     (["check-spring", "{d}/missing.toml"], ["missing.toml", "does not exist"]),
     (["check-spring", "{d}/bad.toml"], ["bad.toml", "TOML syntax error"]),
     (["sweep", "--spring", "{d}/empty.toml", "--out", "{d}/o"], ["empty.toml", "empty"]),
-    (["launch", "--scenario", "{d}/missing.toml", "--out", "{d}/o"], ["missing.toml", "does not exist"]),
+    (["launch", "--scenario", "{d}/missing.toml", "--out", "{d}/o"], ["missing.toml", "not found"]),
     (["launch", "--scenario", "{d}/empty.toml", "--out", "{d}/o"], ["empty.toml", "empty"]),
     (["launch", "--fmu", "{d}/text.fmu", "--out", "{d}/o"], ["text.fmu", "not a zip"]),
     (["launch", "--fmu", "{d}/nomd.fmu", "--out", "{d}/o"], ["nomd.fmu", "no modelDescription.xml"]),

@@ -86,7 +86,7 @@ def test_me_and_cs_match_each_other_and_the_closed_form(runs):
     table, p = load_table(), ClutchParameters()
     for k in (400, 750, 1000):                                           # engaged; ME vs the Python model
         ref = outputs(0.003 + 0.0005 * me["time"][k], exact[k], table, p)
-        assert me["torque"][k] > 20.0
+        assert me["torque"][k] > 5.0     # engaged, so not 0 = 0
         assert me["torque"][k] == pytest.approx(ref.torque, rel=1e-6)
         assert master[k, 1] == pytest.approx(ref.torque, rel=1e-11)
 

@@ -21,6 +21,8 @@
 #include <stdint.h>
 #include <stdio.h>
 
+#include "resource_uri.h"
+
 enum {
     VR_X_TO, VR_THETA_CM, VR_TORQUE, VR_FORCE, VR_THETA_CS, VR_U_F, VR_X_KISS,
     VR_N_SURFACES, VR_MU, VR_R_EQ, VR_U, VR_H, VR_C, VR_THETA_A, VR_THETA_CS_START,
@@ -89,11 +91,6 @@ void cc_table_free(Table *tb);
 double cc_table_force(const Table *tb, double u, double theta_degC);
 double cc_table_delta(const Table *tb, double theta_degC);
 double cc_table_mu(const Table *tb, double theta_degC, double omega);
-/* file URI (RFC 8089 forms) to a file-system path; windows selects drive-letter / UNC rules.
-   Returns 0, or -1 with a reason in err. */
-int cc_uri_to_path(const char *uri, int windows, char *out, size_t len, char *err, size_t errlen);
-/* fopen of a UTF-8 path (wide-character API on Windows) */
-FILE *cc_fopen(const char *path, const char *mode);
 
 /* ---- model (clutch_core.c) */
 int cc_instantiate(CcModel *m, const char *resource_dir, int me, CcLogger logger, void *ctx, int logging_on);

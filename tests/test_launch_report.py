@@ -1,6 +1,5 @@
 """Five TCU variants, the metrics CSV, the summary and the CLI."""
 import csv
-import dataclasses
 
 import pytest
 

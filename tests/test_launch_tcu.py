@@ -12,7 +12,6 @@ from cushion_clutch.launch.fmu_client import ClutchFmu
 from cushion_clutch.launch.scenario import load_scenario
 from cushion_clutch.launch.tcu_params import Observer
 from cushion_clutch.launch.simulate import simulate_launches
-from cushion_clutch.fmu_src.clutch_model import KELVIN
 
 from test_launch import short
 

@@ -339,7 +339,7 @@ def test_resource_uri_forms(tmp_path):
     exe = tmp_path / "uri_driver"
     src = fmu_sources()
     subprocess.run([shutil.which("gcc"), "-std=c99", "-Wall", "-I", str(src), str(Path(__file__).parent / "c/uri_driver.c"),
-                    str(src / "clutch_tables.c"), "-o", str(exe), "-lm"], check=True)
+                    str(src / "resource_uri.c"), "-o", str(exe), "-lm"], check=True)
     for windows in (0, 1):
         cases = [c for c in URIS if c[0] == windows]
         out = subprocess.run([str(exe), str(windows), *[c[1] for c in cases]], capture_output=True, check=True)

@@ -12,7 +12,6 @@ from __future__ import annotations
 import logging
 import shutil
 import tempfile
-import zipfile
 from pathlib import Path
 from xml.etree import ElementTree as ET
 
@@ -123,14 +122,8 @@ def build_fmu(tables: Path, output: Path, backend: str = "native", fmi_version: 
 
 
 def _rewrite_description(src: Path, dst: Path) -> None:
-    tmp = dst.with_suffix(".fmu.tmp")
-    with zipfile.ZipFile(src) as zin, zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as zout:
-        for item in zin.infolist():
-            data = zin.read(item.filename)
-            if item.filename == "modelDescription.xml":
-                data = complete_model_description(data.decode("utf-8")).encode("utf-8")
-            zout.writestr(item, data)
-    tmp.replace(dst)
+    from .guard import guard_fmu
+    guard_fmu(src, dst, complete_model_description)
 
 
 def add_backend(parser) -> None:

@@ -39,11 +39,12 @@ def zig_available() -> bool:
     return importlib.util.find_spec("ziglang") is not None
 
 
-def compile_command(platform: str, fmi_version: int, src: Path, files: tuple[str, ...], out: Path) -> list[str]:
+def compile_command(platform: str, fmi_version: int, src: Path, files: tuple[str, ...], out: Path,
+                    linux_libs: tuple[str, ...] = ()) -> list[str]:
     """The zig (or, for the host without ziglang, gcc) command building one platform's library."""
     target, suffix = TARGETS[fmi_version][platform]
     srcs = [str(src / f) for f in files]
-    libs = ["-lm"] if "linux" in target else []
+    libs = ["-lm", *linux_libs] if "linux" in target else []
     pic = [] if "windows" in target else ["-fPIC"]
     if zig_available():
         return [sys.executable, "-m", "ziglang", "cc", "-target", target, *CFLAGS, *pic, f"-I{src}", *srcs,
@@ -57,9 +58,9 @@ def compile_command(platform: str, fmi_version: int, src: Path, files: tuple[str
 
 
 def build_binaries(src: Path, files: tuple[str, ...], fmi_version: int, out_dir: Path,
-                   platforms: tuple[str, ...] | None = None) -> dict[str, Path]:
+                   platforms: tuple[str, ...] | None = None, linux_libs: tuple[str, ...] = ()) -> dict[str, Path]:
     """Compile ``files`` (in ``src``, with the headers) for ``platforms`` (default: all, or the host
-    without ziglang) in parallel; return platform -> library path."""
+    without ziglang) in parallel, linking ``linux_libs`` too on Linux; return platform -> library path."""
     if platforms is None:
         platforms = tuple(TARGETS[fmi_version]) if zig_available() else (HOST[fmi_version],)
         if not zig_available():
@@ -70,7 +71,7 @@ def build_binaries(src: Path, files: tuple[str, ...], fmi_version: int, out_dir:
         _, suffix = TARGETS[fmi_version][platform]
         out = out_dir / platform / f"CushionClutch{suffix}"
         out.parent.mkdir(parents=True, exist_ok=True)
-        cmd = compile_command(platform, fmi_version, src, files, out)
+        cmd = compile_command(platform, fmi_version, src, files, out, linux_libs)
         jobs[platform] = (cmd, out, subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                                                      text=True))
     failed = []

@@ -15,8 +15,8 @@ from ..fmu_src.clutch_model import OMEGA_SLIP_START, VARIABLES, ClutchParameters
 from .build import BASE_UNITS, SLAVE
 
 #: the model core (shared) and the front end of each FMI version, as shipped in sources/
-CORE_SOURCES = ("clutch_core.c", "clutch_tables.c")
-CORE_HEADERS = ("clutch_core.h", "cushion_guid.h")
+CORE_HEADERS = ("clutch_core.h", "resource_uri.h")
+CORE_SOURCES = ("clutch_core.c", "clutch_tables.c", "resource_uri.c")
 FRONT_ENDS = {2: "fmi2_frontend.c", 3: "fmi3_frontend.c"}
 #: value references beyond clutch_model.VARIABLES
 VR_DER = len(VARIABLES)

@@ -248,7 +248,7 @@ def load_scenario(path: str | Path = DEFAULT_SCENARIO) -> Scenario:
         raise ParameterError([f"scenario file {path} not found (shipped: default, cooldown, fade)"])
     data = load_toml(path)
     if "folder" in data:
-        raise ParameterError([f"folder: unknown key"], str(path))
+        raise ParameterError(["folder: unknown key"], str(path))
     data["folder"] = str(Path(path).resolve().parent)
     sc = build_checked(Scenario, data, str(path))
     fr = sc.friction_path()

@@ -1,0 +1,239 @@
+/*
+ * The pythonfmu FMU's front door: a thin FMI 2.0 Co-Simulation library in front of pythonfmu's
+ * wrapper (shipped next to it as CushionClutch_pythonfmu.<so|dll>), which it loads on the first
+ * fmi2Instantiate and to which it forwards every call unchanged.
+ *
+ * It exists for what pythonfmu's wrapper (0.7) does before any slave code runs and that kills the
+ * host: a NULL resource location (std::string from NULL: abort), a resource folder without the
+ * slave (NULL dereference: SIGSEGV), and percent-encoded characters other than %20 in the
+ * location (the wrapper decodes only %20, then cannot find the slave: SIGSEGV). Here:
+ *   - the GUID is checked against the one this FMU was built with (pythonfmu does not check it);
+ *   - the location is decoded (resource_uri.c) and the folder must hold the slave module;
+ *   - the wrapper gets the location in the only form it decodes correctly ("file://" + the path
+ *     with spaces as %20), or the call is refused if the path itself holds "%20";
+ *   - every refusal is logged through the host's logger (as a "%s" argument, never as the format)
+ *     and fmi2Instantiate returns NULL, as FMI 2.0 asks.
+ * The wrapper library is never unloaded (pythonfmu's interpreter must outlive its last instance).
+ */
+#ifndef _WIN32
+#define _GNU_SOURCE /* dladdr */
+#endif
+#include "cushion_guid.h" /* CC_GUID, generated when the FMU is built */
+#include "fmi2Functions.h"
+#include "resource_uri.h"
+
+#include <stdio.h>
+#include <string.h>
+#ifdef _WIN32
+#include <windows.h>
+#define WRAPPER_NAME "CushionClutch_pythonfmu.dll"
+#define IS_WINDOWS 1
+#else
+#include <dlfcn.h>
+#define WRAPPER_NAME "CushionClutch_pythonfmu.so"
+#define IS_WINDOWS 0
+#endif
+
+#define PATH_MAX_LEN 4096
+
+static void *wrapper = NULL;
+
+static void refuse(const fmi2CallbackFunctions *functions, fmi2String name, const char *fmt, const char *arg) {
+    char msg[PATH_MAX_LEN + 512];
+    snprintf(msg, sizeof msg, fmt, arg ? arg : "(null)");
+    if (functions && functions->logger)
+        functions->logger(functions->componentEnvironment, name ? name : "CushionClutch", fmi2Error, "error", "%s",
+                          msg);
+}
+
+/* load the wrapper next to this library; 0 on success, else a reason in err */
+static int load_wrapper(char *err, size_t errlen) {
+    char path[PATH_MAX_LEN];
+    char *slash;
+    if (wrapper) return 0;
+#ifdef _WIN32
+    {
+        HMODULE self = NULL;
+        wchar_t wpath[PATH_MAX_LEN], *wslash;
+        if (!GetModuleHandleExW(GET_MODULE_HANDLE_EX_FLAG_FROM_ADDRESS | GET_MODULE_HANDLE_EX_FLAG_UNCHANGED_REFCOUNT,
+                                (LPCWSTR)(void *)&load_wrapper, &self) ||
+            !GetModuleFileNameW(self, wpath, PATH_MAX_LEN)) {
+            snprintf(err, errlen, "cannot locate the FMU's library (error %lu)", (unsigned long)GetLastError());
+            return -1;
+        }
+        wslash = wcsrchr(wpath, L'\\');
+        if (!wslash) wslash = wcsrchr(wpath, L'/');
+        if (!wslash || (size_t)(wslash - wpath) + 40 > PATH_MAX_LEN) {
+            snprintf(err, errlen, "unexpected library path");
+            return -1;
+        }
+        wcscpy(wslash + 1, L"" WRAPPER_NAME);
+        wrapper = (void *)LoadLibraryW(wpath);
+        if (!wrapper) {
+            snprintf(err, errlen, "cannot load %s next to the FMU's library (error %lu; is Python on the PATH?)",
+                     WRAPPER_NAME, (unsigned long)GetLastError());
+            return -1;
+        }
+    }
+    (void)path;
+    (void)slash;
+#else
+    {
+        Dl_info info;
+        if (!dladdr((void *)&load_wrapper, &info) || !info.dli_fname) {
+            snprintf(err, errlen, "cannot locate the FMU's library");
+            return -1;
+        }
+        if (strlen(info.dli_fname) + 40 > sizeof path) {
+            snprintf(err, errlen, "library path too long");
+            return -1;
+        }
+        strcpy(path, info.dli_fname);
+        slash = strrchr(path, '/');
+        if (slash) strcpy(slash + 1, WRAPPER_NAME);
+        else strcpy(path, WRAPPER_NAME);
+        wrapper = dlopen(path, RTLD_NOW | RTLD_LOCAL);
+        if (!wrapper) {
+            snprintf(err, errlen, "cannot load %s: %s", path, dlerror());
+            return -1;
+        }
+    }
+#endif
+    return 0;
+}
+
+static void *sym(const char *name) {
+    if (!wrapper) return NULL;
+#ifdef _WIN32
+    return (void *)GetProcAddress((HMODULE)wrapper, name);
+#else
+    return dlsym(wrapper, name);
+#endif
+}
+
+/* the location in the form pythonfmu's wrapper decodes: it strips "file://" ("file:///" on Windows)
+   and replaces "%20" by a space, nothing else */
+static int wrapper_uri(const char *dir, char *out, size_t len) {
+    size_t o;
+    const char *p;
+    if (strstr(dir, "%20")) return -1;
+    o = (size_t)snprintf(out, len, IS_WINDOWS ? "file:///" : "file://");
+    for (p = dir; *p; ++p) {
+        if (o + 4 >= len) return -1;
+        if (*p == ' ') { memcpy(out + o, "%20", 3); o += 3; }
+        else out[o++] = *p;
+    }
+    out[o] = 0;
+    return 0;
+}
+
+fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2String fmuGUID,
+                              fmi2String fmuResourceLocation, const fmi2CallbackFunctions *functions,
+                              fmi2Boolean visible, fmi2Boolean loggingOn) {
+    char dir[PATH_MAX_LEN], file[PATH_MAX_LEN + 32], uri[3 * PATH_MAX_LEN + 16], err[PATH_MAX_LEN + 256];
+    FILE *probe;
+    fmi2InstantiateTYPE *real;
+    if (!functions || !functions->logger) return NULL;
+    if (!instanceName || !*instanceName) {
+        refuse(functions, instanceName, "fmi2Instantiate: instanceName is %s; FMI 2.0 requires a non-empty name",
+               instanceName ? "empty" : "NULL");
+        return NULL;
+    }
+    if (fmuType != fmi2CoSimulation) {
+        refuse(functions, instanceName, "fmi2Instantiate: %s", "the pythonfmu FMU supports Co-Simulation only");
+        return NULL;
+    }
+    if (!fmuGUID || strcmp(fmuGUID, CC_GUID) != 0) {
+        refuse(functions, instanceName, "fmi2Instantiate: GUID %s does not match this FMU's " CC_GUID
+               " (a modelDescription.xml from another build?)", fmuGUID);
+        return NULL;
+    }
+    if (!fmuResourceLocation || !*fmuResourceLocation) {
+        refuse(functions, instanceName, "fmi2Instantiate: fmuResourceLocation is %s; the pythonfmu FMU needs its "
+               "resources folder (slave module and tables)", fmuResourceLocation ? "empty" : "NULL");
+        return NULL;
+    }
+    if (cc_uri_to_path(fmuResourceLocation, IS_WINDOWS, dir, sizeof dir, err, sizeof err) != 0) {
+        refuse(functions, instanceName, "fmi2Instantiate: resource location: %s", err);
+        return NULL;
+    }
+    snprintf(file, sizeof file, IS_WINDOWS ? "%s\\slavemodule.txt" : "%s/slavemodule.txt", dir);
+    probe = cc_fopen(file, "r");
+    if (!probe) {
+        refuse(functions, instanceName, "fmi2Instantiate: the resource folder has no slave module "
+               "(slavemodule.txt): %s", dir);
+        return NULL;
+    }
+    fclose(probe);
+    if (wrapper_uri(dir, uri, sizeof uri) != 0) {
+        refuse(functions, instanceName, "fmi2Instantiate: resource folder %s: pythonfmu cannot open a path "
+               "holding \"%%20\" or this long; unpack the FMU elsewhere", dir);
+        return NULL;
+    }
+    if (load_wrapper(err, sizeof err) != 0) {
+        refuse(functions, instanceName, "fmi2Instantiate: %s", err);
+        return NULL;
+    }
+    real = (fmi2InstantiateTYPE *)sym("fmi2Instantiate");
+    if (!real) {
+        refuse(functions, instanceName, "fmi2Instantiate: %s", "the pythonfmu wrapper exports no fmi2Instantiate");
+        return NULL;
+    }
+    return real(instanceName, fmuType, fmuGUID, uri, functions, visible, loggingOn);
+}
+
+/* ---- every other call: forwarded; before the wrapper is loaded there is no instance to call */
+#define FORWARD_C(name, params, args)                 \
+    fmi2Status name params {                          \
+        name##TYPE *f = (name##TYPE *)sym(#name);     \
+        if (!c) return fmi2Error;                     \
+        return f ? f args : fmi2Error;                \
+    }
+
+const char *fmi2GetTypesPlatform(void) { return fmi2TypesPlatform; }
+const char *fmi2GetVersion(void) { return fmi2Version; }
+
+void fmi2FreeInstance(fmi2Component c) {
+    fmi2FreeInstanceTYPE *f = (fmi2FreeInstanceTYPE *)sym("fmi2FreeInstance");
+    if (c && f) f(c);
+}
+
+FORWARD_C(fmi2SetDebugLogging, (fmi2Component c, fmi2Boolean on, size_t n, const fmi2String cat[]), (c, on, n, cat))
+FORWARD_C(fmi2SetupExperiment, (fmi2Component c, fmi2Boolean tolDef, fmi2Real tol, fmi2Real t0, fmi2Boolean stopDef,
+                                fmi2Real t1), (c, tolDef, tol, t0, stopDef, t1))
+FORWARD_C(fmi2EnterInitializationMode, (fmi2Component c), (c))
+FORWARD_C(fmi2ExitInitializationMode, (fmi2Component c), (c))
+FORWARD_C(fmi2Terminate, (fmi2Component c), (c))
+FORWARD_C(fmi2Reset, (fmi2Component c), (c))
+FORWARD_C(fmi2GetReal, (fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2Real v[]), (c, vr, n, v))
+FORWARD_C(fmi2GetInteger, (fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2Integer v[]), (c, vr, n, v))
+FORWARD_C(fmi2GetBoolean, (fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2Boolean v[]), (c, vr, n, v))
+FORWARD_C(fmi2GetString, (fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2String v[]), (c, vr, n, v))
+FORWARD_C(fmi2SetReal, (fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Real v[]), (c, vr, n, v))
+FORWARD_C(fmi2SetInteger, (fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Integer v[]),
+          (c, vr, n, v))
+FORWARD_C(fmi2SetBoolean, (fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Boolean v[]),
+          (c, vr, n, v))
+FORWARD_C(fmi2SetString, (fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2String v[]),
+          (c, vr, n, v))
+FORWARD_C(fmi2GetFMUstate, (fmi2Component c, fmi2FMUstate *s), (c, s))
+FORWARD_C(fmi2SetFMUstate, (fmi2Component c, fmi2FMUstate s), (c, s))
+FORWARD_C(fmi2FreeFMUstate, (fmi2Component c, fmi2FMUstate *s), (c, s))
+FORWARD_C(fmi2SerializedFMUstateSize, (fmi2Component c, fmi2FMUstate s, size_t *size), (c, s, size))
+FORWARD_C(fmi2SerializeFMUstate, (fmi2Component c, fmi2FMUstate s, fmi2Byte b[], size_t size), (c, s, b, size))
+FORWARD_C(fmi2DeSerializeFMUstate, (fmi2Component c, const fmi2Byte b[], size_t size, fmi2FMUstate *s),
+          (c, b, size, s))
+FORWARD_C(fmi2GetDirectionalDerivative, (fmi2Component c, const fmi2ValueReference u[], size_t nu,
+                                         const fmi2ValueReference z[], size_t nz, const fmi2Real dv[], fmi2Real d[]),
+          (c, u, nu, z, nz, dv, d))
+FORWARD_C(fmi2SetRealInputDerivatives, (fmi2Component c, const fmi2ValueReference vr[], size_t n,
+                                        const fmi2Integer order[], const fmi2Real v[]), (c, vr, n, order, v))
+FORWARD_C(fmi2GetRealOutputDerivatives, (fmi2Component c, const fmi2ValueReference vr[], size_t n,
+                                         const fmi2Integer order[], fmi2Real v[]), (c, vr, n, order, v))
+FORWARD_C(fmi2DoStep, (fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolean noSetPrior), (c, t, h, noSetPrior))
+FORWARD_C(fmi2CancelStep, (fmi2Component c), (c))
+FORWARD_C(fmi2GetStatus, (fmi2Component c, const fmi2StatusKind k, fmi2Status *v), (c, k, v))
+FORWARD_C(fmi2GetRealStatus, (fmi2Component c, const fmi2StatusKind k, fmi2Real *v), (c, k, v))
+FORWARD_C(fmi2GetIntegerStatus, (fmi2Component c, const fmi2StatusKind k, fmi2Integer *v), (c, k, v))
+FORWARD_C(fmi2GetBooleanStatus, (fmi2Component c, const fmi2StatusKind k, fmi2Boolean *v), (c, k, v))
+FORWARD_C(fmi2GetStringStatus, (fmi2Component c, const fmi2StatusKind k, fmi2String *v), (c, k, v))

@@ -8,7 +8,7 @@ import tempfile
 from pathlib import Path
 
 from cushion_clutch.fmu.build import build_fmu
-from cushion_clutch.fmu.model import DEFAULT_TABLES
+from cushion_clutch.fmu.model import DEFAULT_TABLES, ClutchParameters, load_table, outputs, thermal_step
 
 
 @functools.cache
@@ -17,3 +17,15 @@ def native_fmus() -> dict[int, Path]:
     tmp = Path(tempfile.mkdtemp(prefix="cushion_native_tests_"))
     atexit.register(shutil.rmtree, tmp, ignore_errors=True)
     return {v: build_fmu(DEFAULT_TABLES, tmp / f"fmi{v}.fmu", fmi_version=v) for v in (2, 3)}
+
+
+def model_final(steps: int, h: float) -> list[float]:
+    """The Python model after the hosts' fixed input sequence: [torque N.m, force N, theta_cs K, u_f m, x_kiss m]."""
+    table, p = load_table(), ClutchParameters()
+    theta = p.theta_cs_start
+    for k in range(steps):
+        x = 0.003 + 0.005 * ((k * 7919) % 1000) / 1000.0
+        th = 300.0 + 300.0 * ((k * 104729) % 1000) / 1000.0
+        theta = thermal_step(theta, th, h, p)
+    o = outputs(x, theta, table, p)
+    return [o.torque, o.force, theta, o.u_f, o.x_kiss]

@@ -17,6 +17,7 @@ from cushion_clutch.fmu.descriptions import sources
 from cushion_clutch.fmu.native import fmi2_header_dir
 from cushion_clutch.fmu_src.clutch_model import VARIABLES
 from cushion_clutch.fmu.model import DEFAULT_TABLES, ClutchParameters, load_table, outputs, thermal_step
+from native_builds import model_final
 
 pytestmark = pytest.mark.fmu
 
@@ -135,22 +136,11 @@ def _host(tmp_path, fmus, flags=()):
     return [str(host), str(lib), (unzip / "resources").as_uri(), guid]
 
 
-def _model_final(steps, h):
-    table, p = load_table(), ClutchParameters()
-    theta = p.theta_cs_start
-    for k in range(steps):
-        x = 0.003 + 0.005 * ((k * 7919) % 1000) / 1000.0
-        th = 300.0 + 300.0 * ((k * 104729) % 1000) / 1000.0
-        theta = thermal_step(theta, th, h, p)
-    o = outputs(x, theta, table, p)
-    return [o.torque, o.force, theta, o.u_f, o.x_kiss]
-
-
 def test_c_host_drives_a_simulation(fmus, tmp_path):
     cmd = _host(tmp_path, fmus)
     out = subprocess.run(cmd + ["20000", "0.01"], capture_output=True, text=True, check=True).stdout
     got = [float(v) for v in out.splitlines()[0].split()[1:]]
-    assert got == pytest.approx(_model_final(20000, 0.01), rel=1e-12, abs=1e-15)
+    assert got == pytest.approx(model_final(20000, 0.01), rel=1e-12, abs=1e-15)
 
 
 def test_c_host_under_address_sanitizer_is_clean(fmus, tmp_path):

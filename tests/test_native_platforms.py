@@ -13,10 +13,9 @@ import pytest
 from fmpy import read_model_description
 
 from cushion_clutch.data import fmu_sources
-from cushion_clutch.fmu.model import ClutchParameters, load_table, outputs, thermal_step
 from cushion_clutch.fmu.descriptions import sources
 from cushion_clutch.fmu.native import fmi_header_dir
-from native_builds import native_fmus
+from native_builds import model_final, native_fmus
 
 pytestmark = pytest.mark.fmu
 WINE = Path("/usr/lib/wine/wine64")
@@ -79,17 +78,6 @@ def wine_env(tmp_path_factory):
     return env
 
 
-def _model_final(steps, h):
-    table, p = load_table(), ClutchParameters()
-    theta = p.theta_cs_start
-    for k in range(steps):
-        x = 0.003 + 0.005 * ((k * 7919) % 1000) / 1000.0
-        th = 300.0 + 300.0 * ((k * 104729) % 1000) / 1000.0
-        theta = thermal_step(theta, th, h, p)
-    o = outputs(x, theta, table, p)
-    return [o.torque, o.force, theta, o.u_f, o.x_kiss]
-
-
 def _windows_host(tmp_path, version):
     host = tmp_path / f"fmi{version}_host.exe"
     subprocess.run([sys.executable, "-m", "ziglang", "cc", "-target", "x86_64-windows-gnu", "-std=c99", "-O2",
@@ -106,7 +94,7 @@ def test_win64_binary_runs_under_wine_with_windows_resource_uris(tmp_path, wine_
     host = _windows_host(tmp_path, 2)
     fmu = native_fmus()[2]
     guid = read_model_description(str(fmu)).guid
-    expected = _model_final(3000, 0.01)
+    expected = model_final(3000, 0.01)
     plain = tmp_path / "plain"
     spaced = tmp_path / "r\u00e9s dir"                      # space and non-ASCII: percent-encoded in the URI
     for folder in (plain, spaced):
@@ -132,7 +120,7 @@ def test_fmi3_windows_binary_runs_under_wine(tmp_path, wine_env):
                           win(unzip / "resources") + "\\", token, "3000", "0.01"],
                          env=wine_env, capture_output=True, text=True, timeout=120)
     assert res.returncode == 0, (res.stdout, res.stderr[-2000:])
-    assert _final_outputs(res.stdout) == pytest.approx(_model_final(3000, 0.01), rel=1e-12, abs=1e-15)
+    assert _final_outputs(res.stdout) == pytest.approx(model_final(3000, 0.01), rel=1e-12, abs=1e-15)
 
 
 def test_fmi3_c_host_under_address_sanitizer_matches_the_model(tmp_path):
@@ -154,4 +142,4 @@ def test_fmi3_c_host_under_address_sanitizer_matches_the_model(tmp_path):
                               "PATH": "/usr/bin:/bin"})
     assert res.returncode == 0, res.stderr[-3000:]
     assert "runtime error" not in res.stderr
-    assert _final_outputs(res.stdout) == pytest.approx(_model_final(3000, 0.01), rel=1e-12, abs=1e-15)
+    assert _final_outputs(res.stdout) == pytest.approx(model_final(3000, 0.01), rel=1e-12, abs=1e-15)

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import re
 import tomllib
 from dataclasses import fields
 from pathlib import Path
@@ -160,3 +161,44 @@ def load_toml(path: str | Path, required: tuple[str, ...] = ()) -> dict[str, Any
     if missing:
         raise ParameterError(missing, str(path))
     return data
+
+
+_BARE_KEY = re.compile(r"[A-Za-z0-9_-]+")
+
+
+def _toml_string(text: str) -> str:
+    out = text.replace("\\", "\\\\").replace('"', '\\"')
+    return '"' + "".join(f"\\u{ord(c):04x}" if ord(c) < 0x20 or ord(c) == 0x7F else c for c in out) + '"'
+
+
+def toml_value(v: Any) -> str:
+    """``v`` (bool, int, float incl. nan/inf, str, list/tuple, dict as inline table) as TOML text."""
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, int):
+        return str(v)
+    if isinstance(v, float):
+        return "nan" if math.isnan(v) else ("inf" if v > 0 else "-inf") if math.isinf(v) else repr(v)
+    if isinstance(v, str):
+        return _toml_string(v)
+    if isinstance(v, (list, tuple)):
+        return "[" + ", ".join(toml_value(x) for x in v) + "]"
+    if isinstance(v, dict):
+        return "{" + ", ".join(f"{toml_key(k)} = {toml_value(x)}" for k, x in v.items()) + "}"
+    raise TypeError(f"cannot write {type(v).__name__} to TOML")
+
+
+def toml_key(key: str) -> str:
+    """A TOML key: bare when it can be, quoted and escaped otherwise."""
+    return key if _BARE_KEY.fullmatch(key) else _toml_string(key)
+
+
+def toml_document(doc: dict[str, Any], header: str = "") -> str:
+    """``doc`` as TOML text that :func:`load_toml` reads back equal: ``header`` as comment lines,
+    then top-level values, then one ``[section]`` per dict (dicts inside sections as inline tables)."""
+    lines = [f"# {h}" for h in header.splitlines()]
+    lines += [f"{toml_key(k)} = {toml_value(v)}" for k, v in doc.items() if not isinstance(v, dict)]
+    for sec, vals in doc.items():
+        if isinstance(vals, dict):
+            lines += ["", f"[{toml_key(sec)}]"] + [f"{toml_key(k)} = {toml_value(v)}" for k, v in vals.items()]
+    return "\n".join(lines) + "\n"

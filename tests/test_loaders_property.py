@@ -9,7 +9,6 @@ exception.
 """
 from __future__ import annotations
 
-import math
 import tomllib
 
 import pytest
@@ -17,6 +16,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from cushion_clutch.data import DEFAULT_SCENARIO, DEFAULT_SPRING
+from cushion_clutch.config import toml_document
 from cushion_clutch.errors import ParameterError
 from cushion_clutch.fe.params import SpringParams, load_params
 from cushion_clutch.launch.scenario import Scenario, load_scenario
@@ -26,28 +26,7 @@ BASE = {"spring": tomllib.loads(DEFAULT_SPRING.read_text()),
 LOADERS = {"spring": (load_params, SpringParams), "scenario": (load_scenario, Scenario)}
 
 
-def _toml_value(v) -> str:
-    if isinstance(v, bool):
-        return "true" if v else "false"
-    if isinstance(v, int):
-        return str(v)
-    if isinstance(v, float):
-        return "nan" if math.isnan(v) else ("inf" if v == math.inf else "-inf" if v == -math.inf else repr(v))
-    if isinstance(v, str):
-        return '"' + v.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n") + '"'
-    if isinstance(v, list):
-        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
-    if isinstance(v, dict):
-        return "{" + ", ".join(f'"{k}" = {_toml_value(x)}' for k, x in v.items()) + "}"
-    raise TypeError(type(v))
-
-
-def to_toml(doc: dict) -> str:
-    """A small TOML writer for the documents this test makes (no dependency needed)."""
-    plain = [f'"{k}" = {_toml_value(v)}' for k, v in doc.items() if not isinstance(v, dict)]
-    tables = [f'["{k}"]\n' + "\n".join(f'"{kk}" = {_toml_value(vv)}' for kk, vv in v.items())
-              for k, v in doc.items() if isinstance(v, dict)]
-    return "\n".join(plain) + "\n\n" + "\n\n".join(tables) + "\n"
+to_toml = toml_document     # the project's TOML writer; keys quoted and escaped where needed
 
 
 scalars = st.one_of(

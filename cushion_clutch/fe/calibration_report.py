@@ -1,39 +1,17 @@
 """Outputs of a calibration: the calibrated TOML, a text report and a Fig. 9 style PNG."""
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
+from ..config import toml_document
 from ..plotting import finish_figure, plt
 from .calibrate import Calibration
 from .params import SpringParams
 
 
-def _toml_value(v) -> str:
-    if isinstance(v, bool):
-        return "true" if v else "false"
-    if isinstance(v, int):
-        return str(v)
-    if isinstance(v, float):
-        return repr(v) if math.isfinite(v) else "nan"
-    if isinstance(v, str):
-        return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
-    if isinstance(v, (list, tuple)):
-        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
-    if isinstance(v, dict):               # an inline table, e.g. a tolerance {sd = 5e-6}
-        return "{" + ", ".join(f"{k} = {_toml_value(x)}" for k, x in v.items()) + "}"
-    raise TypeError(f"cannot write {type(v).__name__} to TOML")
-
-
 def params_toml(params: SpringParams, header: str = "") -> str:
     """A spring parameter set as TOML text that :func:`load_params` reads back unchanged."""
-    d = params.to_dict()
-    lines = [f"# {h}" for h in header.splitlines()]
-    lines += [f"{k} = {_toml_value(v)}" for k, v in d.items() if not isinstance(v, dict)]
-    for sec, vals in d.items():
-        if isinstance(vals, dict):
-            lines += ["", f"[{sec}]"] + [f"{k} = {_toml_value(v)}" for k, v in vals.items()]
-    return "\n".join(lines) + "\n"
+    return toml_document(params.to_dict(), header)
 
 
 def report_text(cal: Calibration) -> str:

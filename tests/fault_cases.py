@@ -490,23 +490,23 @@ def c_path_format_chars(h):
     return {"instantiated": True, "probe": max(sts + [h.step(s, 0.0, 0.01)]), "torque_ok": h.outs(s)[0] > 0}
 
 
-def c_resources_null(h):
-    s = h.slave(resource_uri=None)
+def _ready_and_step(h, s):
+    """A refused instantiation is probe 3; else initialise, take one step and give the worst status."""
     if not s.component:
         return {"instantiated": False, "probe": 3}
     sts = h.ready(s)
     return {"instantiated": True, "probe": max(sts + [h.step(s, 0.0, 0.01)])}
+
+
+def c_resources_null(h):
+    return _ready_and_step(h, h.slave(resource_uri=None))
 
 
 def c_resources_missing(h):
     d = h.unzip_copy("nores")
     shutil.rmtree(d / "resources")
     (d / "resources").mkdir()
-    s = h.slave(unzip=d)
-    if not s.component:
-        return {"instantiated": False, "probe": 3}
-    sts = h.ready(s)
-    return {"instantiated": True, "probe": max(sts + [h.step(s, 0.0, 0.01)])}
+    return _ready_and_step(h, h.slave(unzip=d))
 
 
 def c_wrong_guid(h):

@@ -294,6 +294,12 @@ int cc_set_state_value(CcModel *m, double theta_cs, const char *fn) {
     return CC_OK;
 }
 
+int cc_get_state_value(CcModel *m, double *theta_cs, const char *fn) {
+    if (!cc_allowed(m, PH_INIT | PH_EVENT | PH_CONT | PH_TERMINATED | PH_ERROR, fn)) return CC_ERROR;
+    *theta_cs = m->phase == PH_INIT ? m->r[VR_THETA_CS_START] : m->r[VR_THETA_CS];
+    return CC_OK;
+}
+
 /* -------------------------------------------------------------- saved state */
 static uint64_t fnv1a(const void *data, size_t n) {
     const unsigned char *p = (const unsigned char *)data;

@@ -109,6 +109,8 @@ int cc_exit_init(CcModel *m, const char *fn);
 int cc_do_step(CcModel *m, double t, double h, const char *fn);
 int cc_derivative(CcModel *m, double *der, const char *fn);
 int cc_set_state_value(CcModel *m, double theta_cs, const char *fn);
+/* the continuous state theta_cs, K (its start value during initialisation) */
+int cc_get_state_value(CcModel *m, double *theta_cs, const char *fn);
 void cc_state_save(const CcModel *m, CcState *s);
 int cc_state_check(CcModel *m, const void *bytes, size_t size, const char *fn);
 void cc_state_load(CcModel *m, const CcState *s);

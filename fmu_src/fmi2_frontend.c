@@ -252,10 +252,7 @@ fmi2Status fmi2GetContinuousStates(fmi2Component comp, fmi2Real x[], size_t nx) 
     COMP(fmi2Error)
     ME_ONLY("fmi2GetContinuousStates")
     if (nx != 1 || !x) { cc_log(m, CC_ERROR, "fmi2GetContinuousStates: nx = %lu, expected 1", (unsigned long)nx); return fmi2Error; }
-    if (!cc_allowed(m, PH_INIT | PH_EVENT | PH_CONT | PH_TERMINATED | PH_ERROR, "fmi2GetContinuousStates"))
-        return fmi2Error;
-    x[0] = m->phase == PH_INIT ? m->r[VR_THETA_CS_START] : m->r[VR_THETA_CS];
-    return fmi2OK;
+    return (fmi2Status)cc_get_state_value(m, x, "fmi2GetContinuousStates");
 }
 
 fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component comp, fmi2Real nominal[], size_t nx) {

@@ -368,10 +368,7 @@ fmi3Status fmi3GetContinuousStates(fmi3Instance instance, fmi3Float64 x[], size_
     INST(fmi3Error)
     ME_ONLY("fmi3GetContinuousStates")
     if (nx != 1 || !x) { cc_log(m, CC_ERROR, "fmi3GetContinuousStates: nx = %lu, expected 1", (unsigned long)nx); return fmi3Error; }
-    if (!cc_allowed(m, PH_INIT | PH_EVENT | PH_CONT | PH_TERMINATED | PH_ERROR, "fmi3GetContinuousStates"))
-        return fmi3Error;
-    x[0] = m->phase == PH_INIT ? m->r[VR_THETA_CS_START] : m->r[VR_THETA_CS];
-    return fmi3OK;
+    return (fmi3Status)cc_get_state_value(m, x, "fmi3GetContinuousStates");
 }
 
 fmi3Status fmi3GetNominalsOfContinuousStates(fmi3Instance instance, fmi3Float64 nominals[], size_t nx) {

@@ -1,13 +1,17 @@
-"""Shared fixtures: coarse-mesh parameters and a session cache for ccx cases."""
+"""Shared fixtures: coarse-mesh parameters, a session cache for ccx cases, a Wine prefix."""
 from __future__ import annotations
 
+import os
 import shutil
+import subprocess
+from pathlib import Path
 
 import pytest
 
 from cushion_clutch.fe.params import load_params
 
 COARSE_M = 2e-3
+WINE = Path("/usr/lib/wine/wine64")     # Debian wine64 (.ci/install)
 
 
 def pytest_collection_modifyitems(config, items):
@@ -27,3 +31,14 @@ def coarse():
 @pytest.fixture(scope="session")
 def case_cache(tmp_path_factory):
     return tmp_path_factory.mktemp("ccx_cache")
+
+
+@pytest.fixture(scope="session")
+def wine_env(tmp_path_factory):
+    """Environment of one initialised Wine prefix for the Windows binaries' tests."""
+    if not WINE.exists():
+        pytest.skip("wine64 is not installed (.ci/install installs it)")
+    prefix = tmp_path_factory.mktemp("wineprefix")
+    env = dict(os.environ, WINEPREFIX=str(prefix), WINEDEBUG="-all", WINEDLLOVERRIDES="mscoree,mshtml=")
+    subprocess.run([str(WINE), "wineboot", "--init"], env=env, capture_output=True, timeout=300)
+    return env

@@ -12,7 +12,8 @@ from fmpy import read_model_description
 
 from cushion_clutch.data import DEFAULT_TABLES
 from cushion_clutch.fmu.build import build_fmu
-from test_native_platforms import WINE, _windows_host, fmi_functions, wine_env  # noqa: F401
+from conftest import WINE
+from test_native_platforms import _windows_host, fmi_functions
 
 pytestmark = pytest.mark.fmu
 

@@ -1,12 +1,10 @@
 """Native FMU binaries for other platforms: the win64 DLL run by our Windows host under Wine, and
 every binary checked for its architecture and its exported FMI functions (lief)."""
-import os
 import re
 import shutil
 import subprocess
 import sys
 import zipfile
-from pathlib import Path
 
 import lief
 import pytest
@@ -15,10 +13,10 @@ from fmpy import read_model_description
 from cushion_clutch.data import fmu_sources
 from cushion_clutch.fmu.descriptions import sources
 from cushion_clutch.fmu.native import fmi_header_dir
+from conftest import WINE
 from native_builds import model_final, native_fmus
 
 pytestmark = pytest.mark.fmu
-WINE = Path("/usr/lib/wine/wine64")
 
 
 def fmi_functions(version: int) -> set[str]:
@@ -66,16 +64,6 @@ def test_every_binary_has_its_architecture_and_exports_exactly_the_fmi_api(tmp_p
             seen.add(platform)
     assert seen == set(EXPECTED)
     assert len(fmi_functions(2)) == 44 and len(fmi_functions(3)) > 70
-
-
-@pytest.fixture(scope="module")
-def wine_env(tmp_path_factory):
-    if not WINE.exists():
-        pytest.skip("wine64 is not installed (.ci/install installs it)")
-    prefix = tmp_path_factory.mktemp("wineprefix")
-    env = dict(os.environ, WINEPREFIX=str(prefix), WINEDEBUG="-all", WINEDLLOVERRIDES="mscoree,mshtml=")
-    subprocess.run([str(WINE), "wineboot", "--init"], env=env, capture_output=True, timeout=300)
-    return env
 
 
 def _windows_host(tmp_path, version):

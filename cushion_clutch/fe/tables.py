@@ -33,7 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ResultError, TableError
-from ..fmu_src.clutch_model import load_csv
+from ..model.spring_table import load_csv
 from .results import CaseResult
 
 #: relative force decrease (of the case's largest force) treated as solver noise

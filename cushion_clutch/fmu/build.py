@@ -19,6 +19,7 @@ from ..data import fmu_sources
 from ..errors import ParameterError, TableError
 from ..fe.tables import read_tables
 from ..model import VARIABLES, clutch_model
+from ..model.table_format import FMU_FILES, REQUIRED_FILES
 
 log = logging.getLogger(__name__)
 
@@ -29,8 +30,7 @@ MODEL_SRC = Path(clutch_model.__file__).parent
 #: the modules the pythonfmu slave imports (siblings inside the FMU): the slave class (from ``FMU_SRC``)
 #: and the numpy-only model (from ``MODEL_SRC``)
 SLAVE_MODULES = {"cushion_slave.py": FMU_SRC, "clutch_model.py": MODEL_SRC, "spring_table.py": MODEL_SRC,
-                 "friction.py": MODEL_SRC}
-TABLE_FILES = ("force_deflection.csv", "kiss_point.csv", "metadata.json", "friction.csv")
+                 "friction.py": MODEL_SRC, "table_format.py": MODEL_SRC}
 
 #: unit of each variable (from the shared model module); temperatures get degC as display unit
 UNITS = {name: unit for name, _, unit, _ in VARIABLES}
@@ -94,7 +94,7 @@ def build_fmu(tables: Path, output: Path, backend: str = "native", fmi_version: 
     """
     tables, output = Path(tables), Path(output)
     read_tables(tables)                                 # fail early, with the file's name
-    for name in TABLE_FILES[:2]:
+    for name in REQUIRED_FILES:
         if not (tables / name).exists():
             raise TableError(f"{tables / name} is missing")
     if fmi_version not in (2, 3):
@@ -114,7 +114,7 @@ def build_fmu(tables: Path, output: Path, backend: str = "native", fmi_version: 
         for module, folder in SLAVE_MODULES.items():
             shutil.copy(folder / module, stage / module)
         (stage / "tables").mkdir()
-        for name in TABLE_FILES:
+        for name in FMU_FILES:
             if (tables / name).exists():
                 shutil.copy(tables / name, stage / "tables" / name)
         built = FmuBuilder.build_FMU(stage / f"{SLAVE}.py", dest=stage / "out",

@@ -3,9 +3,10 @@
 - :mod:`.clutch_model`: the FMU interface (``VARIABLES``), parameters, outputs, thermal step;
 - :mod:`.spring_table`: F(u, theta) and the kiss-point shift from a table set;
 - :mod:`.friction`: the optional mu(theta_cm, omega_slip) table;
+- :mod:`.table_format`: the table-set format (file names, columns, units, metadata keys), its CSV reader;
 - :mod:`.api`: loading a table set, torque, the thermal model as a python-control system.
 
-The pythonfmu FMU carries ``clutch_model``, ``spring_table`` and ``friction`` as
+The pythonfmu FMU carries ``clutch_model``, ``spring_table``, ``friction`` and ``table_format`` as
 sibling modules (its build copies them), so they import each other relatively with a
 fallback to plain sibling imports. The FE pipeline, the FMU build, the launch
 simulation and the pythonfmu slave all use these modules; nothing here imports

@@ -12,12 +12,8 @@ from __future__ import annotations
 from xml.etree import ElementTree as ET
 
 from ..model import OMEGA_SLIP_START, VARIABLES, ClutchParameters
-from .build import BASE_UNITS, SLAVE
+from .constants import BASE_UNITS, SLAVE, sources
 
-#: the model core (shared) and the front end of each FMI version, as shipped in sources/
-CORE_HEADERS = ("clutch_core.h", "resource_uri.h")
-CORE_SOURCES = ("clutch_core.c", "clutch_tables.c", "resource_uri.c")
-FRONT_ENDS = {2: "fmi2_frontend.c", 3: "fmi3_frontend.c"}
 #: value references beyond clutch_model.VARIABLES
 VR_DER = len(VARIABLES)
 VR_TIME = VR_DER + 1
@@ -25,11 +21,6 @@ UNITS = dict(BASE_UNITS, **{"K/s": {"K": "1", "s": "-1"}, "s": {"s": "1"}})
 DESCRIPTION = ("Dry-clutch torque T = n*mu*R_eq*F(u_f(x_to, theta_cs), theta_cs) with the cushion-spring "
                "thermal ODE C dtheta_cs/dt = U (theta_cm - theta_cs) + H (theta_a - theta_cs); F from "
                "CalculiX tables (native C; Co-Simulation and Model Exchange)")
-
-
-def sources(fmi_version: int) -> tuple[str, ...]:
-    """C files compiled into the FMI ``fmi_version`` binary."""
-    return (*CORE_SOURCES, FRONT_ENDS[fmi_version])
 
 
 def _vr(name: str) -> int:

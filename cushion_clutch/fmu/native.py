@@ -1,10 +1,12 @@
 """The native C FMU: the model core plus the FMI 2.0 or FMI 3.0 front end, built for every platform.
 
 The FMU carries ``binaries/<platform>/`` for Windows, Linux and macOS
-(:mod:`.crossbuild`), ``sources/`` (core, front end, generated ``cushion_guid.h``
-and the FMI headers; ``<SourceFiles>`` for FMI 2.0, ``buildDescription.xml``
-for FMI 3.0) and ``resources/tables``. The GUID (instantiationToken) hashes the
-tables, the C sources and the FMI version; the binaries check it at instantiation.
+(:mod:`.crossbuild`), ``sources/`` (core, front end, the generated ``cushion_guid.h``
+and ``cushion_variables.h`` (:mod:`.variable_table`), and the FMI headers;
+``<SourceFiles>`` for FMI 2.0, ``buildDescription.xml`` for FMI 3.0) and
+``resources/tables``. The GUID (instantiationToken) hashes the tables, the C
+sources with the generated variable table and the FMI version; the binaries
+check it at instantiation.
 """
 from __future__ import annotations
 
@@ -17,29 +19,16 @@ import zipfile
 from pathlib import Path
 
 from ..model.table_format import FMU_FILES, FRICTION
-from .build import FMU_SRC
+from .constants import (CORE_HEADERS, CORE_SOURCES, FMI_HEADERS, FMU_SRC, FRONT_ENDS, fmi2_header_dir,  # noqa: F401
+                        fmi_header_dir, sources)
 from .crossbuild import build_binaries
-from .descriptions import (CORE_HEADERS, CORE_SOURCES, FRONT_ENDS, fmi2_description, fmi3_build_description,
-                           fmi3_description, sources)
+from .descriptions import fmi2_description, fmi3_build_description, fmi3_description
 
 log = logging.getLogger(__name__)
 
-FMI_HEADERS = {2: ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h"),
-               3: ("fmi3Functions.h", "fmi3FunctionTypes.h", "fmi3PlatformTypes.h")}
-FMI2_HEADERS = FMI_HEADERS[2]
-
-
-def fmi_header_dir() -> Path:
-    """The FMI 2.0 and 3.0 standard headers shipped with FMPy."""
-    import fmpy
-    return Path(fmpy.__file__).parent / "c-code"
-
-
-fmi2_header_dir = fmi_header_dir
-
 
 def model_guid(tables: Path, fmi_version: int) -> str:
-    """GUID / instantiationToken: a hash of the tables, the C sources and the FMI version."""
+    """GUID / instantiationToken: a hash of the tables, the C sources, the variable table and the FMI version."""
     digest = hashlib.sha256(f"fmi{fmi_version}".encode())
     for name in FMU_FILES:
         if (tables / name).exists():
@@ -50,7 +39,8 @@ def model_guid(tables: Path, fmi_version: int) -> str:
 
 
 def stage_sources(dest: Path, guid: str, fmi_version: int) -> list[str]:
-    """Copy the sources, the generated ``cushion_guid.h`` and the FMI headers to ``dest``; return the names."""
+    """Copy the sources, the generated ``cushion_guid.h`` and ``cushion_variables.h`` and the FMI headers to
+    ``dest``; return the names."""
     dest.mkdir(parents=True, exist_ok=True)
     names = [*CORE_HEADERS, *sources(fmi_version)]
     for name in names:
@@ -89,3 +79,15 @@ def build_native_fmu(tables: Path, output: Path, fmi_version: int = 2,
         tmp_out.replace(output)
     log.info("built native FMI %d.0 %s (%s) from tables %s", fmi_version, output, ", ".join(sorted(libs)), tables)
     return output
+
+
+def warm_cache() -> None:
+    """Build the default FMUs once (both FMI versions) so that zig's cache holds every target's libc."""
+    from ..data import DEFAULT_TABLES
+    with tempfile.TemporaryDirectory() as tmp:
+        for version in (2, 3):
+            build_native_fmu(DEFAULT_TABLES, Path(tmp) / f"fmi{version}.fmu", fmi_version=version)
+
+
+if __name__ == "__main__":
+    warm_cache()

@@ -289,7 +289,7 @@ def build_parser() -> argparse.ArgumentParser:
     from .fmu.build import add_backend, add_build_arguments
     from .fe.params import DEFAULT_SPRING
     from .launch.scenario import DEFAULT_SCENARIO
-    from .fe.sweep import DEFAULT_CACHE
+    from .fe.cases import DEFAULT_CACHE
 
     parser = argparse.ArgumentParser(prog="cushion-clutch", description=__doc__)
     parser.add_argument("-v", "--verbose", action="store_true", help="log progress details")

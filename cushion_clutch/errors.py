@@ -76,6 +76,10 @@ class ConvergenceError(CalculixError):
         super().__init__(message, returncode, log_tail)
 
 
+class CcxVersionError(RuntimeError):
+    """Dask workers report different ccx versions, or a case was solved by another version than its key's."""
+
+
 class ResultError(RuntimeError):
     """A finished FE case gives results that cannot be made into a table."""
 

@@ -9,7 +9,7 @@ from cushion_clutch.fe.params import DEFAULT_SPRING, load_params
 from cushion_clutch.fe.scan import read_scan
 from cushion_clutch.fe.surface import load_surface
 from cushion_clutch.fe.scan_import import import_scan
-from cushion_clutch.fe.sweep import case_key
+from cushion_clutch.fe.cases import case_key
 
 from scan_synthetic import rigid, synthetic_scan, write_csv
 

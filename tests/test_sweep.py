@@ -3,7 +3,8 @@ import numpy as np
 import pytest
 
 from cushion_clutch.errors import ConvergenceError, SweepError
-from cushion_clutch.fe.sweep import build_tables, run_sweep, solve_case
+from cushion_clutch.fe.cases import solve_case
+from cushion_clutch.fe.sweep import build_tables, run_sweep
 from cushion_clutch.fe.tables import curve_from_case, progressivity, read_tables
 
 pytestmark = pytest.mark.ccx

@@ -6,7 +6,7 @@ import pytest
 
 from cushion_clutch.errors import ParameterError
 from cushion_clutch.fe.params import DEFAULT_SPRING, Tolerances, load_params, params_from_dict
-from cushion_clutch.fe.sweep import case_key
+from cushion_clutch.fe.cases import case_key
 from cushion_clutch.fe.tolerance import apply_deviations, draw, make_samples
 
 

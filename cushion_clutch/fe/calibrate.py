@@ -25,7 +25,8 @@ import numpy as np
 
 from ..errors import ParameterError, TableError
 from .params import SpringParams
-from .sweep import DEFAULT_CACHE, run_sweep
+from .cases import DEFAULT_CACHE
+from .sweep import run_sweep
 from .tables import curve_from_case
 
 log = logging.getLogger(__name__)

@@ -1,6 +1,6 @@
-"""Temperature sweep: one ccx job per temperature, in parallel, cached, resumable.
+"""Temperature sweep: one ccx case per temperature, in parallel, cached, resumable.
 
-Each case runs in its own folder under the cache; a finished case leaves a
+The cases go through the FE case engine (:mod:`.cases`): a finished case leaves a
 ``result.json`` keyed by a hash of everything that decides its result, so a
 rerun after a failure only computes what is missing. On one machine cases
 run in threads (each thread waits on one ccx process); with a Dask
@@ -8,117 +8,25 @@ scheduler address they run on the cluster's workers instead.
 """
 from __future__ import annotations
 
-import dataclasses
 import datetime as _dt
-import hashlib
-import json
 import logging
-import os
 import platform
-import tempfile
-import threading
-from concurrent.futures import ThreadPoolExecutor, as_completed
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
-import numpy as np
-
-from .. import __version__, interrupt
-from .ccx import RunStats, ccx_version, run_ccx
-from .deck import paddle_deck
+from .. import __version__
 from ..errors import SweepError
-from .geometry import half_pair_assembly, pair_assembly
+from .cases import DEFAULT_CACHE, Case, CaseOutcome, run_cases
+from .ccx import ccx_version
 from .params import SpringParams
-from .results import CaseResult, parse_case
 from .tables import Curve, curve_from_case, kiss_shift, progressivity, write_tables
 
 log = logging.getLogger(__name__)
 
-DEFAULT_CACHE = Path(os.environ.get("CUSHION_CLUTCH_CACHE", ".cache/cushion_clutch"))
-
 #: progress callback: (theta_degC, event, value); events "start", "increment", "done", "failed"
 Progress = Callable[[float, str, float], None]
-
-
-@dataclass(frozen=True)
-class CaseOutcome:
-    """A solved case: its raw result, cost and model size."""
-
-    result: CaseResult
-    stats: RunStats
-    n_nodes: int
-    n_elements: int
-    from_cache: bool = False
-
-    def to_json(self) -> dict:
-        r = self.result
-        return {"theta_degC": r.theta_degC, "paddles": r.paddles, "crest_rise_m": r.crest_rise_m,
-                "travel_m": r.travel_m.tolist(), "force_N": r.force_N.tolist(),
-                "thermal_force_N": r.thermal_force_N, "stats": vars(self.stats),
-                "n_nodes": self.n_nodes, "n_elements": self.n_elements}
-
-    @classmethod
-    def from_json(cls, d: dict) -> "CaseOutcome":
-        r = CaseResult(d["theta_degC"], d["paddles"], d["crest_rise_m"], np.array(d["travel_m"]),
-                       np.array(d["force_N"]), d["thermal_force_N"])
-        return cls(r, RunStats(**d["stats"]), d["n_nodes"], d["n_elements"], from_cache=True)
-
-
-def solve_case(params: SpringParams, theta_degC: float, workdir: Path, *, paddles: int = 1,
-               on_increment: Callable[[int], None] | None = None) -> CaseOutcome:
-    """Build, run and parse one temperature case.
-
-    Parameters
-    ----------
-    params : SpringParams
-    theta_degC : float
-        Uniform paddle temperature, degC.
-    workdir : Path
-        Folder for ccx's files.
-    paddles : int
-        1: half-pair model with the carrier plane (default, composed in
-        series); 2: the full back-to-back pair.
-    on_increment : callable, optional
-        Called with the running count of converged increments.
-    """
-    size = params.mesh.element_size_m
-    build = half_pair_assembly if paddles == 1 else pair_assembly
-    assembly = build(params.geometry, size, params.solver.initial_gap_m, params.mesh.element_type)
-    deck, _ = paddle_deck(assembly, params, theta_degC)
-    count = [0]
-
-    def on_line(line: str) -> None:
-        if on_increment is not None and line.lstrip().startswith("convergence"):
-            count[0] += 1
-            on_increment(count[0])
-
-    stats = run_ccx(deck, Path(workdir), threads=params.solver.threads,
-                    theta_degC=theta_degC, on_line=on_line)
-    result = parse_case(Path(workdir) / "case.dat", theta_degC, assembly.paddles)
-    n_nodes = assembly.mesh.n_nodes
-    return CaseOutcome(result, stats, n_nodes, assembly.mesh.n_elements)
-
-
-def case_key(params: SpringParams, theta_degC: float, paddles: int, ccx: str) -> str:
-    """Hash of everything that decides a case's result."""
-    d = params.to_dict()
-    d.pop("description", None)
-    d.pop("tolerances", None)                 # scatter declarations, not this case's values
-    if params.geometry.surface_file:          # the scan's content, wherever the file lies
-        from .surface import surface_digest
-        d["geometry"]["surface_file"] = surface_digest(params.geometry.surface_file)
-    d["sweep"].pop("temperatures_degC", None)
-    d["solver"].pop("threads", None)          # effort limits do not change a converged result
-    d["solver"].pop("max_increments", None)
-    blob = json.dumps([d, float(theta_degC), paddles, ccx, __version__], sort_keys=True)
-    return hashlib.sha256(blob.encode()).hexdigest()[:16]
-
-
-def _dask_solve(params: SpringParams, theta: float, paddles: int) -> dict:
-    """Run on a Dask worker: solve in a private temporary folder, return JSON data."""
-    with tempfile.TemporaryDirectory(prefix="cushion_ccx_") as tmp:
-        return solve_case(params, theta, Path(tmp), paddles=paddles).to_json()
+#: the engine's events as the sweep reports them ("cached" cases count as done)
+_EVENTS = {"cached": "done", "start": "start", "increment": "increment", "done": "done", "failed": "failed"}
 
 
 def run_sweep(params: SpringParams, *, cache_dir: Path = DEFAULT_CACHE, jobs: int | None = None,
@@ -132,96 +40,25 @@ def run_sweep(params: SpringParams, *, cache_dir: Path = DEFAULT_CACHE, jobs: in
         Parallel ccx jobs on this machine (default: number of cores).
     scheduler : str or distributed.Client, optional
         A Dask scheduler address (``tcp://host:8786``) or client; cases then
-        run on its workers.
+        run on its workers (a scanned surface is shipped to them).
 
     Raises
     ------
     SweepError
         If any case failed; the finished ones stay in the cache.
     """
-    ccx = ccx_version()
-    cache_dir = Path(cache_dir) / params.name
-    todo: list[tuple[float, Path]] = []
-    done: dict[float, CaseOutcome] = {}
-    for theta in params.sweep.temperatures_degC:
-        folder = cache_dir / f"theta_{theta:g}_{case_key(params, theta, paddles, ccx)}"
-        cached = folder / "result.json"
-        if cached.exists():
-            done[theta] = CaseOutcome.from_json(json.loads(cached.read_text()))
-            log.info("theta = %g degC: cached (%s)", theta, folder)
-            if progress:
-                progress(theta, "done", 1.0)
-        else:
-            todo.append((theta, folder))
-    failures: dict[float, BaseException] = {}
+    thetas = list(params.sweep.temperatures_degC)
+    cases = [Case(params, t, paddles, f"theta = {t:g} degC") for t in thetas]
 
-    def finish(theta: float, folder: Path, outcome: CaseOutcome) -> None:
-        folder.mkdir(parents=True, exist_ok=True)
-        tmp = folder / "result.json.tmp"
-        tmp.write_text(json.dumps(outcome.to_json()))
-        os.replace(tmp, folder / "result.json")
-        done[theta] = outcome
+    def on_event(i: int, event: str, value: float) -> None:
         if progress:
-            progress(theta, "done", 1.0)
+            progress(thetas[i], _EVENTS[event], value)
 
-    if scheduler is not None and todo:
-        client = _dask_client(scheduler)
-        futures = {client.submit(_dask_solve, params, t, paddles, pure=False): (t, f) for t, f in todo}
-        from distributed import as_completed as dask_completed
-        for fut in dask_completed(futures):
-            theta, folder = futures[fut]
-            try:
-                outcome = CaseOutcome.from_json(fut.result())
-                finish(theta, folder, dataclasses.replace(outcome, from_cache=False))
-            except Exception as exc:  # noqa: BLE001 - collected and re-raised as SweepError
-                failures[theta] = exc
-                if progress:
-                    progress(theta, "failed", 0.0)
-    elif todo:
-        lock = threading.Lock()
-
-        def work(theta: float, folder: Path) -> CaseOutcome:
-            if progress:
-                progress(theta, "start", 0.0)
-
-            def inc(n: int) -> None:
-                if progress:
-                    with lock:
-                        progress(theta, "increment", n)
-            interrupt.check()                       # cancelled while queued: do not start
-            outcome = solve_case(params, theta, folder, paddles=paddles, on_increment=inc)
-            with lock:                              # cached at once, so an interrupt keeps it
-                finish(theta, folder, outcome)
-            return outcome
-
-        pool = ThreadPoolExecutor(max_workers=jobs or os.cpu_count() or 1)
-        try:
-            futs = {pool.submit(work, t, f): (t, f) for t, f in todo}
-            for fut in as_completed(futs):
-                theta, folder = futs[fut]
-                try:
-                    fut.result()
-                except Exception as exc:  # noqa: BLE001 - collected and re-raised as SweepError
-                    log.error("theta = %g degC failed: %s", theta, exc)
-                    failures[theta] = exc
-                    if progress:
-                        progress(theta, "failed", 0.0)
-        except BaseException as exc:                # Ctrl-C / SIGTERM: drop the queue, end running ccx
-            with interrupt.cancelling(isinstance(exc, KeyboardInterrupt)):
-                pool.shutdown(wait=True, cancel_futures=True)
-            raise
-        pool.shutdown(wait=True)
-        interrupt.check()
+    outcomes, failures = run_cases(cases, cache_dir=Path(cache_dir), jobs=jobs, scheduler=scheduler,
+                                   on_event=on_event)
     if failures:
-        raise SweepError(failures)
-    return {t: done[t] for t in sorted(done)}
-
-
-def _dask_client(scheduler):
-    if isinstance(scheduler, str):
-        from distributed import Client
-        return Client(scheduler)
-    return scheduler
+        raise SweepError({thetas[i]: exc for i, exc in failures.items()})
+    return {t: o for t, o in sorted(zip(thetas, outcomes), key=lambda to: to[0]) if o is not None}
 
 
 def build_tables(params: SpringParams, outcomes: dict[float, CaseOutcome], out_dir: Path,

@@ -4,19 +4,15 @@ Each sample is the spring with its ``[tolerances]`` keys drawn (Latin
 hypercube or Monte Carlo, seeded; normal distributions truncated at
 ``Tolerances.TRUNCATE_SD``). Every (sample, temperature) case goes through
 the sweep's cache (same folders and keys as :func:`cushion_clutch.fe.sweep.run_sweep`,
-so a study and ``cushion-clutch sweep`` share cases); only missing cases are
-submitted to a Dask cluster, and each finished case is cached as soon as it
-arrives, so an interrupted study resumes. The cluster is a
-``distributed.LocalCluster`` of single-threaded worker processes unless a
-scheduler address (``tcp://host:8786``) or a client is given.
+so a study and ``cushion-clutch sweep`` share cases); the FE case engine
+(:mod:`.cases`) submits only missing cases to a Dask cluster and caches each
+finished case as soon as it arrives, so an interrupted study resumes. The
+cluster is a ``distributed.LocalCluster`` of single-threaded worker processes
+unless a scheduler address (``tcp://host:8786``) or a client is given.
 """
 from __future__ import annotations
 
-import dataclasses
-import json
 import logging
-import os
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
@@ -25,9 +21,8 @@ import numpy as np
 from scipy.stats import norm, qmc
 
 from ..errors import ParameterError, StudyError
-from .ccx import ccx_version
+from .cases import DEFAULT_CACHE, Case, CaseOutcome, run_cases
 from .params import TOLERANCE_KEYS, SpringParams, Tolerances
-from .sweep import DEFAULT_CACHE, CaseOutcome, case_key, solve_case
 
 log = logging.getLogger(__name__)
 
@@ -106,42 +101,6 @@ def make_samples(base: SpringParams, n: int, method: str = "lhs", seed: int = 0)
     return samples
 
 
-def case_folder(cache_dir: Path, params: SpringParams, theta: float, ccx: str, paddles: int = 1) -> Path:
-    """The case's cache folder: the layout of :func:`cushion_clutch.fe.sweep.run_sweep`."""
-    return Path(cache_dir) / params.name / f"theta_{theta:g}_{case_key(params, theta, paddles, ccx)}"
-
-
-def _solve_remote(params: SpringParams, theta: float, surface: bytes | None) -> dict:
-    """On a worker: solve one case in a private folder, return the JSON data.
-
-    The fitted surface travels with the task, so workers need no shared disk.
-    """
-    with tempfile.TemporaryDirectory(prefix="cushion_tol_") as tmp:
-        if surface is not None:
-            path = Path(tmp) / "surface.npz"
-            path.write_bytes(surface)
-            params = params.replace(geometry={"surface_file": str(path)})
-        work = Path(tmp) / "ccx"
-        work.mkdir()
-        return solve_case(params, theta, work).to_json()
-
-
-def connect(scheduler: str | object | None = None, workers: int | None = None):
-    """A Dask client and the LocalCluster it owns (None for an external scheduler).
-
-    ``scheduler``: an address, a ``distributed.Client``, or None for a
-    LocalCluster of ``workers`` single-threaded processes (default: cores).
-    """
-    from distributed import Client, LocalCluster
-    if scheduler is None:
-        cluster = LocalCluster(n_workers=workers or os.cpu_count() or 1, threads_per_worker=1,
-                               processes=True, dashboard_address=None)
-        return Client(cluster), cluster
-    if isinstance(scheduler, str):
-        return Client(scheduler), None
-    return scheduler, None
-
-
 def run_study(samples: list[Sample], temperatures_degC: tuple[float, ...], *, cache_dir: Path = DEFAULT_CACHE,
               scheduler: str | object | None = None, workers: int | None = None,
               progress: StudyProgress | None = None) -> list[dict[float, CaseOutcome]]:
@@ -157,55 +116,23 @@ def run_study(samples: list[Sample], temperatures_degC: tuple[float, ...], *, ca
     StudyError
         If cases failed; the finished ones stay cached and a rerun resumes.
     """
-    ccx = ccx_version()
-    results: list[dict[float, CaseOutcome]] = [{} for _ in samples]
-    todo = []
-    for i, s in enumerate(samples):
-        for theta in temperatures_degC:
-            folder = case_folder(cache_dir, s.params, theta, ccx)
-            if (folder / "result.json").exists():
-                results[i][theta] = CaseOutcome.from_json(json.loads((folder / "result.json").read_text()))
-            else:
-                todo.append((i, theta, folder))
-    total = len(samples) * len(temperatures_degC)
-    cached = total - len(todo)
-    done = cached
-    if progress:
-        progress(done, total, cached)
-    failures = {}
-    if todo:
-        client, cluster = connect(scheduler, workers)
-        try:
-            from distributed import as_completed
-            blobs = {}
-            futures = {}
-            for i, theta, folder in todo:
-                sf = samples[i].params.geometry.surface_file
-                if sf and sf not in blobs:
-                    blobs[sf] = client.scatter(Path(sf).read_bytes(), broadcast=True)
-                fut = client.submit(_solve_remote, samples[i].params, theta, blobs.get(sf) if sf else None,
-                                    pure=False)
-                futures[fut] = (i, theta, folder)
-            for fut in as_completed(futures):
-                i, theta, folder = futures[fut]
-                try:
-                    data = fut.result()
-                except Exception as exc:  # noqa: BLE001 - collected and raised as StudyError
-                    log.error("sample %d, theta = %g degC failed: %s", samples[i].index, theta, exc)
-                    failures[(samples[i].index, theta)] = exc
-                else:
-                    folder.mkdir(parents=True, exist_ok=True)
-                    tmp = folder / "result.json.tmp"
-                    tmp.write_text(json.dumps(data))
-                    os.replace(tmp, folder / "result.json")
-                    results[i][theta] = dataclasses.replace(CaseOutcome.from_json(data), from_cache=False)
-                done += 1
-                if progress:
-                    progress(done, total, cached)
-        finally:
-            client.close()
-            if cluster is not None:
-                cluster.close()
+    cases = [Case(s.params, theta, 1, f"sample {s.index}, theta = {theta:g} degC")
+             for s in samples for theta in temperatures_degC]
+    total, counts = len(cases), {"done": 0, "cached": 0}
+
+    def on_event(i: int, event: str, value: float) -> None:
+        if event in ("cached", "done", "failed"):
+            counts["done"] += 1
+            counts["cached"] += event == "cached"
+            if progress:
+                progress(counts["done"], total, counts["cached"])
+
+    outcomes, failures = run_cases(cases, cache_dir=cache_dir, jobs=workers, scheduler=scheduler,
+                                   local_cluster=True, on_event=on_event)
     if failures:
-        raise StudyError(failures)
-    return [{t: r[t] for t in sorted(r)} for r in results]
+        raise StudyError({(samples[i // len(temperatures_degC)].index, cases[i].theta_degC): exc
+                          for i, exc in failures.items()})
+    n = len(temperatures_degC)
+    return [{cases[j].theta_degC: outcomes[j] for j in sorted(range(k * n, (k + 1) * n),
+                                                              key=lambda j: cases[j].theta_degC)}
+            for k in range(len(samples))]

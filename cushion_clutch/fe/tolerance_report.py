@@ -22,7 +22,8 @@ import numpy as np
 
 from ..model import KELVIN, ClutchParameters, SpringTable, outputs
 from .geometry import half_pair_assembly
-from .sweep import CaseOutcome, build_tables
+from .cases import CaseOutcome
+from .sweep import build_tables
 from .tables import curve_from_case
 from .tolerance import Sample
 
@@ -238,7 +239,7 @@ def tolerance_study(params, *, samples: int, temperatures: tuple, out: Path, met
     """
     import time
 
-    from .sweep import DEFAULT_CACHE
+    from .cases import DEFAULT_CACHE
     from .tolerance import make_samples, run_study
     from .tolerance_plots import plot_bands
 

@@ -86,8 +86,8 @@ def _sweep(args: argparse.Namespace) -> int:
 
 
 def _calibrate(args: argparse.Namespace) -> int:
-    from .fe.calibrate import calibrate, parse_bounds, read_measured
-    from .fe.calibration_report import params_toml, plot_calibration, report_text
+    from .fe.studies.calibrate import calibrate, parse_bounds, read_measured
+    from .fe.studies.calibration_report import params_toml, plot_calibration, report_text
     from .fe.params import load_params
 
     params = load_params(args.spring)
@@ -220,7 +220,7 @@ def _build_fmu(args: argparse.Namespace) -> int:
 
 
 def _import_scan(args: argparse.Namespace) -> int:
-    from .fe.scan_import import import_scan
+    from .fe.scan.importer import import_scan
 
     res = import_scan(args.scan, args.spring, args.out, unit=args.unit, face=args.face, datum=args.datum,
                       crop=args.crop)
@@ -241,7 +241,7 @@ def _tolerance(args: argparse.Namespace) -> int:
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
     from .fe.params import load_params
-    from .fe.tolerance_report import RANK_BY, tolerance_study
+    from .fe.studies.tolerance_report import RANK_BY, tolerance_study
 
     if not args.verbose:
         import distributed  # noqa: F401 - its import sets its loggers' levels; quieten them after

@@ -6,9 +6,9 @@ import pytest
 
 from cushion_clutch.cli import main
 from cushion_clutch.errors import ParameterError, TableError
-from cushion_clutch.fe.calibrate import (calibrate, check_bounds, fit_keys, parse_bounds,
+from cushion_clutch.fe.studies.calibrate import (calibrate, check_bounds, fit_keys, parse_bounds,
                                          read_measured, with_values, Measured)
-from cushion_clutch.fe.calibration_report import params_toml
+from cushion_clutch.fe.studies.calibration_report import params_toml
 from cushion_clutch.fe.params import load_params, params_from_dict
 from cushion_clutch.fe.sweep import run_sweep
 from cushion_clutch.fe.tables import curve_from_case

@@ -9,7 +9,7 @@ from cushion_clutch.fe import cases
 from cushion_clutch.fe.cases import Case, case_folder, case_key, run_cases, solve_remote
 from cushion_clutch.fe.ccx import ccx_version
 from cushion_clutch.fe.params import DEFAULT_SPRING, load_params
-from cushion_clutch.fe.scan_import import import_scan
+from cushion_clutch.fe.scan.importer import import_scan
 
 from scan_synthetic import synthetic_scan, write_csv
 

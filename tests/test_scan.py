@@ -6,9 +6,9 @@ from cushion_clutch.cli import main
 from cushion_clutch.errors import ParameterError, ScanError
 from cushion_clutch.fe.geometry import paddle_mesh, wave_height
 from cushion_clutch.fe.params import DEFAULT_SPRING, load_params
-from cushion_clutch.fe.scan import read_scan
+from cushion_clutch.fe.scan.fit import read_scan
 from cushion_clutch.fe.surface import load_surface
-from cushion_clutch.fe.scan_import import import_scan
+from cushion_clutch.fe.scan.importer import import_scan
 from cushion_clutch.fe.cases import case_key
 
 from scan_synthetic import rigid, synthetic_scan, write_csv

@@ -7,7 +7,7 @@ import pytest
 from cushion_clutch.errors import ParameterError
 from cushion_clutch.fe.params import DEFAULT_SPRING, Tolerances, load_params, params_from_dict
 from cushion_clutch.fe.cases import case_key
-from cushion_clutch.fe.tolerance import apply_deviations, draw, make_samples
+from cushion_clutch.fe.studies.tolerance import apply_deviations, draw, make_samples
 
 
 def test_default_spring_declares_the_issue_tolerances():
@@ -69,7 +69,7 @@ def test_study_on_a_local_cluster_equals_one_by_one_and_resumes(coarse, tmp_path
     from cushion_clutch.cli import main
     from cushion_clutch.fe.sweep import run_sweep
     from cushion_clutch.fe.tables import read_tables
-    from cushion_clutch.fe.tolerance import run_study
+    from cushion_clutch.fe.studies.tolerance import run_study
     from cushion_clutch.fmu.build import build_fmu
 
     base = coarse.replace(solver={"compression_increments": 30}, sweep={"temperatures_degC": (20.0,)})

@@ -20,8 +20,8 @@ TRUTH = {"wave_height_m": 1.08, "thickness_m": 0.95, "far_end_stiffness_N_per_m"
 
 
 def main(argv=None) -> None:
-    from cushion_clutch.fe.calibrate import Measured, calibrate, fit_keys, with_values
-    from cushion_clutch.fe.calibration_report import plot_calibration, report_text
+    from cushion_clutch.fe.studies.calibrate import Measured, calibrate, fit_keys, with_values
+    from cushion_clutch.fe.studies.calibration_report import plot_calibration, report_text
     from cushion_clutch.fe.params import load_params
     from cushion_clutch.fe.sweep import run_sweep
     from cushion_clutch.fe.tables import curve_from_case

@@ -23,7 +23,7 @@ import numpy as np
 
 def measure(samples, temperatures, workers: int, cache: Path) -> tuple[float, list[float]]:
     """Wall time (s) of solving every case on a LocalCluster of ``workers``, and ccx's time per case."""
-    from cushion_clutch.fe.tolerance import run_study
+    from cushion_clutch.fe.studies.tolerance import run_study
     start = time.perf_counter()
     results = run_study(samples, temperatures, cache_dir=cache, workers=workers)
     wall = time.perf_counter() - start
@@ -34,7 +34,7 @@ def main(argv=None) -> None:
     import logging
 
     from cushion_clutch.fe.params import load_params
-    from cushion_clutch.fe.tolerance import make_samples
+    from cushion_clutch.fe.studies.tolerance import make_samples
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--samples", type=int, default=3, help="drawn samples (plus the nominal spring)")

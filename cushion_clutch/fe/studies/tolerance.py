@@ -20,9 +20,9 @@ from typing import Callable
 import numpy as np
 from scipy.stats import norm, qmc
 
-from ..errors import ParameterError, StudyError
-from .cases import DEFAULT_CACHE, Case, CaseOutcome, run_cases
-from .params import TOLERANCE_KEYS, SpringParams, Tolerances
+from ...errors import ParameterError, StudyError
+from ..cases import DEFAULT_CACHE, Case, CaseOutcome, run_cases
+from ..params import TOLERANCE_KEYS, SpringParams, Tolerances
 
 log = logging.getLogger(__name__)
 

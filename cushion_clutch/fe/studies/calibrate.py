@@ -23,11 +23,11 @@ from typing import Callable, Sequence
 
 import numpy as np
 
-from ..errors import ParameterError, TableError
-from .params import SpringParams
-from .cases import DEFAULT_CACHE
-from .sweep import run_sweep
-from .tables import curve_from_case
+from ...errors import ParameterError, TableError
+from ..params import SpringParams
+from ..cases import DEFAULT_CACHE
+from ..sweep import run_sweep
+from ..tables import curve_from_case
 
 log = logging.getLogger(__name__)
 

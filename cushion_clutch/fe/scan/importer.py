@@ -1,7 +1,7 @@
 """``cushion-clutch import-scan``: a scan file and a base spring -> ``scanned.toml`` + surface + plot.
 
 Writes, next to the output TOML ``<stem>.toml``: ``<stem>_surface.npz`` (the
-fitted mid-surface, see :mod:`cushion_clutch.fe.scan`) and
+fitted mid-surface, see :mod:`cushion_clutch.fe.scan.fit`) and
 ``<stem>_surface.png`` (scan against fit). The TOML is the base spring's text
 with ``name = "<stem>"`` and, under ``[geometry]``, ``surface_file`` and
 ``wave_height_m`` (the fitted surface's peak) set; comments are kept.
@@ -16,9 +16,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import ParameterError, ScanError
-from .params import SpringParams, load_params
-from .scan import FrameFit, SurfaceFit, check_points, fit_mid_surface, place_in_frame, polar, read_scan, \
+from ...errors import ParameterError, ScanError
+from ..params import SpringParams, load_params
+from .fit import FrameFit, SurfaceFit, check_points, fit_mid_surface, place_in_frame, polar, read_scan, \
     write_surface
 
 log = logging.getLogger(__name__)
@@ -142,8 +142,8 @@ def scanned_toml_text(base: str, name: str, surface_name: str, peak_m: float, co
 
 def plot_scan_fit(points: np.ndarray, fit: SurfaceFit, geom, path: Path, label: str) -> Path:
     """Scan vs fit: mid-radius profile, residual map and fitted height map."""
-    from ..plotting import finish_figure, plt
-    from .geometry import wave_height
+    from ...plotting import finish_figure, plt
+    from ..geometry import wave_height
 
     r_mid, phi_mid = polar(fit.mid_points)
     r_mean = 0.5 * (geom.inner_radius_m + geom.outer_radius_m)

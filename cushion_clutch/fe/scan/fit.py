@@ -23,8 +23,8 @@ from pathlib import Path
 import numpy as np
 from scipy.interpolate import LSQBivariateSpline
 
-from ..errors import ScanError
-from .params import Geometry
+from ...errors import ScanError
+from ..params import Geometry
 
 #: length of one scan unit, m
 UNITS = {"mm": 1e-3, "m": 1.0}

@@ -5,7 +5,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..plotting import finish_figure, plt
+from ...plotting import finish_figure, plt
 
 
 def plot_bands(bands, summ, path: Path, title: str) -> Path:

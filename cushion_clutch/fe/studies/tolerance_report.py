@@ -20,11 +20,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ..model import KELVIN, ClutchParameters, SpringTable, outputs
-from .geometry import half_pair_assembly
-from .cases import CaseOutcome
-from .sweep import build_tables
-from .tables import curve_from_case
+from ...model import KELVIN, ClutchParameters, SpringTable, outputs
+from ..geometry import half_pair_assembly
+from ..cases import CaseOutcome
+from ..sweep import build_tables
+from ..tables import curve_from_case
 from .tolerance import Sample
 
 PERCENTILES = (5.0, 50.0, 95.0)
@@ -239,7 +239,7 @@ def tolerance_study(params, *, samples: int, temperatures: tuple, out: Path, met
     """
     import time
 
-    from .cases import DEFAULT_CACHE
+    from ..cases import DEFAULT_CACHE
     from .tolerance import make_samples, run_study
     from .tolerance_plots import plot_bands
 

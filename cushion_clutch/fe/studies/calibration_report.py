@@ -3,10 +3,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..config import toml_document
-from ..plotting import finish_figure, plt
+from ...config import toml_document
+from ...plotting import finish_figure, plt
 from .calibrate import Calibration
-from .params import SpringParams
+from ..params import SpringParams
 
 
 def params_toml(params: SpringParams, header: str = "") -> str:

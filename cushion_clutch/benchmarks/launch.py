@@ -55,7 +55,8 @@ def _fmu_call_us(fmu: Path, n: int = 50000) -> tuple[float, float]:
 
 def markdown(scenarios: list[str], backend: str = "native") -> str:
     """The launch results of every scenario as Markdown (summary table, ratio, real-time factors)."""
-    from cushion_clutch.fmu.model import DEFAULT_TABLES, load_table
+    from cushion_clutch.data import DEFAULT_TABLES
+    from cushion_clutch.model import load_table
     from cushion_clutch.launch.driveline import first_mode_hz
     from cushion_clutch.launch.plant import build_plant_fmu
     from cushion_clutch.launch.report import ratio_line, run_all, summary_table

@@ -18,6 +18,7 @@ import statistics
 import tempfile
 import time
 from pathlib import Path
+from typing import Iterator
 
 
 def _fmu_call_us(fmu: Path, n: int = 50000) -> tuple[float, float]:
@@ -53,8 +54,9 @@ def _fmu_call_us(fmu: Path, n: int = 50000) -> tuple[float, float]:
     return ours, theirs
 
 
-def markdown(scenarios: list[str], backend: str = "native") -> str:
-    """The launch results of every scenario as Markdown (summary table, ratio, real-time factors)."""
+def markdown(scenarios: list[str], backend: str = "native") -> Iterator[str]:
+    """The launch results of every scenario as Markdown (summary table, ratio, real-time factors), one
+    scenario at a time."""
     from cushion_clutch.data import DEFAULT_TABLES
     from cushion_clutch.model import load_table
     from cushion_clutch.launch.driveline import first_mode_hz
@@ -62,9 +64,9 @@ def markdown(scenarios: list[str], backend: str = "native") -> str:
     from cushion_clutch.launch.report import ratio_line, run_all, summary_table
     from cushion_clutch.launch.scenario import load_scenario, scenario_path
 
-    parts = []
     with tempfile.TemporaryDirectory() as tmp:
         for name in scenarios:
+            parts = []
             sc = load_scenario(scenario_path(name))
             fmu = build_plant_fmu(DEFAULT_TABLES, sc, Path(tmp) / name / "CushionClutch.fmu", backend=backend)
             results = run_all(fmu, sc, load_table())
@@ -80,7 +82,7 @@ def markdown(scenarios: list[str], backend: str = "native") -> str:
                 parts.append("- " + ratio_line(results, g))
             parts.append("- real-time factor (wall / CPU time): " + ", ".join(
                 f"{n} {sim / r.wall_time_s:.0f}x / {sim / r.cpu_time_s:.0f}x" for n, r in results.items()))
-    return "\n\n".join(parts)
+            yield "\n\n".join(parts)
 
 
 def main(argv=None) -> None:
@@ -99,7 +101,8 @@ def main(argv=None) -> None:
     ap.add_argument("--scenarios", default="default,creep,cooldown,fade", help="with --markdown")
     args = ap.parse_args(argv)
     if args.markdown:
-        print(markdown(args.scenarios.split(","), args.backend))
+        for part in markdown(args.scenarios.split(","), args.backend):
+            print(part + "\n", flush=True)
         return
     sc = load_scenario(scenario_path(args.scenario))
     sim = sc.run.duration()

@@ -155,7 +155,7 @@ def _launch(args: argparse.Namespace) -> int:
     from .fmu.check import check_fmu
     from .model import load_table
     from .launch.plant import build_plant_fmu
-    from .launch.report import metrics_table, run_all, summary_table, write_outputs
+    from .launch.report import metrics_table, ratio_line, run_all, summary_table, write_outputs
     from .launch.scenario import load_scenario, scenario_path
     from .launch.tcu import VARIANTS
     from .outputs import OutputSet
@@ -180,10 +180,11 @@ def _launch(args: argparse.Namespace) -> int:
     print()
     print(summary_table(results))
     print()
+    print(ratio_line(results, "hot"))
     for name, res in results.items():
         e = res.energy
         print(f"{name}: energy balance residual {e.residual():.3g} J of {e.engine_work / 1e3:.1f} kJ engine "
-              f"work; real-time factor {total / res.wall_time_s:.0f}x")
+              f"work; real-time factor {total / res.wall_time_s:.0f}x (CPU time {total / res.cpu_time_s:.0f}x)")
     print(f"scenario '{sc.name}': {len(results[next(iter(results))].metrics)} launches with {len(results)} TCUs "
           f"in {wall:.1f} s; wrote " + ", ".join(str(p) for p in paths))
     return 0
@@ -332,7 +333,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     la = sub.add_parser("launch", help="repeated launches with the five TCU variants (main job)")
     la.add_argument("--scenario", default=DEFAULT_SCENARIO,
-                    help="scenario TOML, or a shipped one: default, cooldown, fade")
+                    help="scenario TOML, or a shipped one: default, creep, cooldown, fade")
     la.add_argument("--fmu", help="clutch FMU (default: build one from --tables into --out)")
     la.add_argument("--tables", default=DEFAULT_TABLES, help="table folder")
     add_backend(la)

@@ -32,10 +32,13 @@ def plot_launches(results: dict[str, LaunchResult], out: Path) -> list[Path]:
         if i == 0:
             axes[0].plot(t, s["w_engine_rad_s"][sel] * 30 / np.pi, color="grey", label="engine (naive)")
             axes[1].plot(t, s["x_kiss_m"][sel] * 1e3, color="k", lw=1.5, label="true kiss point")
-            axes[2].plot(t, s["torque_demand_Nm"][sel], color="k", lw=1.5, label="demanded")
+            axes[2].plot(t, s["torque_demand_Nm"][sel], color="k", lw=1.5, label="demanded (naive)")
     axes[0].set(ylabel="speed [rpm]", title=f"Launch {hottest} (hottest start): the five TCUs")
     axes[1].set(ylabel="bearing [mm] (thin: kiss point believed)")
-    axes[2].set(ylabel="clutch torque [N·m]", xlabel="time since launch start [s]", xlim=(0, 3))
+    lock = max((m["engagement_time_s"] for r in results.values() for m in r.metrics
+                if m["launch"] == hottest and m["engagement_time_s"] == m["engagement_time_s"]), default=3.0)
+    axes[2].set(ylabel="clutch torque [N·m]", xlim=(0, min(12.0, lock + 1.5)),
+                xlabel="time since the launch slot's start [s] (pre-fill, then the pedal)")
     p1 = finish_figure(fig, axes, out / "launch_last.png", fontsize=7)
 
     fig, ax = plt.subplots(figsize=(9, 4.5))
@@ -55,10 +58,12 @@ def plot_launches(results: dict[str, LaunchResult], out: Path) -> list[Path]:
     for i, (name, res) in enumerate(results.items()):
         n = [m["launch"] for m in res.metrics]
         ls = STYLE.get(name, "-")
-        for ax, col in zip(axes, ("torque_error_rms_Nm", "kiss_point_error_mm", "creep_shortfall_Nm")):
+        for ax, col in zip(axes, ("characteristic_error_rms_Nm", "tracking_error_rms_Nm", "lockup_accel_step_m_s2")):
             ax.plot(n, [m[col] for m in res.metrics], marker="o", ms=3, linestyle=ls, color=f"C{i}", label=name)
-    axes[0].set(ylabel="RMS torque error [N·m]", title="Metrics per launch and TCU")
-    axes[1].set(ylabel="kiss-point error [mm]\n(believed − true)")
-    axes[2].set(ylabel="creep shortfall [N·m]\n(demand ≤ 30 N·m)", xlabel="launch")
+    axes[0].set(ylabel="characteristic_error_rms_Nm\n(believed − true at actual x)",
+                title="Metrics per launch and TCU")
+    axes[0].set_yscale("symlog", linthresh=0.01)
+    axes[1].set(ylabel="tracking_error_rms_Nm\n(delivered − demanded)")
+    axes[2].set(ylabel="lockup_accel_step_m_s2", xlabel="launch")
     p3 = finish_figure(fig, axes, out / "launch_metrics.png", fontsize=7)
     return [p1, p2, p3]

@@ -211,10 +211,12 @@ class ClutchEkf:
         self.energy_J = self.t_acc = 0.0
 
     # --- measurement ---------------------------------------------------------------------------
-    def correct(self, torque_meas_Nm: float, x_meas_m: float, w_slip_rad_s: float, launching: bool) -> bool:
-        """Measurement update with the engine-side clutch torque (N.m); True if accepted.
+    def correct(self, torque_meas_Nm: float, x_meas_m: float, w_slip_rad_s: float, launching: bool,
+                torque_sd_Nm: float | None = None) -> bool:
+        """Measurement update with a clutch torque (N.m) at the measured position (m); True if accepted.
 
-        Applies the excitation conditions of the module docstring.
+        Applies the excitation conditions of the module docstring; ``torque_sd_Nm``
+        overrides the measurement noise (another source of the torque).
         """
         e = self.e
         if not launching or abs(w_slip_rad_s) < e.slip_min_rad_s:
@@ -236,7 +238,7 @@ class ClutchEkf:
             hrow[i] = (self.model_torque(x_meas_m, sp) - h0) / d
         hrow[IX_MU] = h0 / max(self.mu_scale, 1e-6)
         # h has no direct facing term: the facings are corrected through their covariance with theta_cs
-        r = e.torque_sd_Nm ** 2
+        r = (e.torque_sd_Nm if torque_sd_Nm is None else torque_sd_Nm) ** 2
         s_inn = float(hrow @ self.P @ hrow) + r
         nu = torque_meas_Nm - h0
         if nu * nu > e.gate_sd ** 2 * s_inn:

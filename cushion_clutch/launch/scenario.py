@@ -11,7 +11,11 @@ from typing import Iterable
 from ..config import Checked, build_checked, load_toml, range_problem
 from ..data import DEFAULT_SCENARIO
 from ..errors import ParameterError
+from .ekf import EkfParams, TcuNetworkParams
+from .mass_grade import MassGrade
+from .sensors import ProductionSensors
 from .tcu_params import Adaptation, Observer, Sensors
+from .thermal_network import PlantThermal
 
 
 
@@ -218,6 +222,11 @@ class Scenario(Checked):
     observer: Observer = field(default_factory=Observer)
     sensors: Sensors = field(default_factory=Sensors)
     adaptation: Adaptation = field(default_factory=Adaptation)
+    plant_thermal: PlantThermal = field(default_factory=PlantThermal)
+    tcu_sensors: ProductionSensors = field(default_factory=ProductionSensors)
+    tcu_thermal: TcuNetworkParams = field(default_factory=TcuNetworkParams)
+    ekf: EkfParams = field(default_factory=EkfParams)
+    mass_grade: MassGrade = field(default_factory=MassGrade)
     folder: str = ""
     """folder of the scenario file (set by :func:`load_scenario`), for relative file names"""
 

@@ -26,8 +26,10 @@ from .fmu_client import ClutchFmu
 from .metrics import LaunchRecord
 from .observer import SpeedSensors
 from .scenario import Scenario
+from .production import ProductionTcu
 from .tcu import OPEN, LAUNCH, VARIANTS, TcuController
 from .thermal import FacingModel
+from .thermal_network import ThermalNetwork
 
 __all__ = ["COLUMNS", "Energy", "LaunchResult", "simulate_launches"]
 
@@ -76,7 +78,18 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
     p = ClutchParameters(theta_a=theta_a, theta_cs_start=theta0)
     engine = EngineGovernor(sc.engine, h)
     dl = Driveline(sc, engine.w_idle)
-    ctl = TcuController(VARIANTS[name], sc, table, p, theta0, dl.j_d, dl.t_load_rest)
+    if name == "production":
+        ctl = ProductionTcu(VARIANTS[name], sc, table, p, theta0, sc.tcu_sensors, sc.tcu_thermal, sc.ekf,
+                            sc.mass_grade, sc.engine.inertia_kg_m2,
+                            (dl.i_tot, dl.r, dl.eta, sc.driveline.disc_inertia_kg_m2, sc.vehicle.rolling_resistance,
+                             dl.air))
+        sense = ctl.sense
+    else:
+        ctl = TcuController(VARIANTS[name], sc, table, p, theta0, dl.j_d, dl.t_load_rest)
+        sense = None
+    net = ThermalNetwork(sc.plant_thermal, theta_a, theta0) if sc.plant_thermal.enabled else None
+    net_every = max(1, int(round(tc.period_s / h)))     # the network's time constants are seconds: 10 ms steps
+    net_n, net_e = 0, 0.0
     sensors = SpeedSensors(sc.sensors)
     facing = FacingModel(fac.capacity_J_per_K, fac.loss_W_per_K, fac.heat_share, theta_a, h)
     profile = _facing_profile(fac.profile_csv) if fac.profile_csv else None
@@ -135,6 +148,8 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
             if engaged and not rec.started:
                 rec.start(ctl.kiss_now - x_kiss, theta_cs, ctl.theta_now - theta_cs)
             t_e = engine_torque(w_e, engaged, stalled)
+            if sense is not None:
+                sense(t + h, w_e, v * r_to_disc, h, t_e)
             ev = dl_step(t_e, t_cap, engaged, braking)
             if ev:
                 events.append((n + 1, "lock" if ev > 0 else "unlock", t + h if ev > 0 else t))
@@ -142,7 +157,14 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
                     rec.lock_time = tl + h
             slip_J = dl.slip_J
             theta_cm_step = theta_cm
-            if slip_J != 0.0:
+            if net is not None:
+                rec.slip_J += slip_J
+                net_e += slip_J
+                net_n += 1
+                if net_n == net_every:
+                    net.step(net_n * h, net_e / (net_n * h), dl.w_e, dl.v * r_to_disc, engaged)
+                    theta_cm, net_n, net_e = net.theta_cm, 0, 0.0
+            elif slip_J != 0.0:
                 rec.slip_J += slip_J
                 theta_cm = profile(t + h) if profile is not None else facing_step(theta_cm, dl.slip_W)
             elif cool_free:

@@ -48,6 +48,7 @@ VARIANTS = {v.name: v for v in (
     Variant("aware_estimated", "estimated", False),
     Variant("adaptive", "none", True),
     Variant("adaptive_aware_estimated", "estimated", True),
+    Variant("production", "ekf", False),     # see .production: sensors, EKF, adaptations, mass and grade
 )}
 
 OPEN, LAUNCH, CLOSE = 0, 1, 2     #: TCU phases

@@ -182,6 +182,13 @@ class ThermalNetwork:
                 th[i] += flow * dt / caps[i]
 
 
+@dataclass(frozen=True)
+class PlantThermal(NetworkParams):
+    """Section ``[plant_thermal]``: the plant's network; ``enabled = false`` keeps the lumped ``[facing]`` model."""
+
+    enabled: bool = False
+
+
 def time_constants(p: NetworkParams, w_engine: float = 0.0, w_disc: float = 0.0,
                    clamped: bool = False) -> np.ndarray:
     """Time constants of the network's modes (``-1/eigenvalue`` of A), s, ascending."""

@@ -59,5 +59,5 @@ def test_fade_scenario_delivers_less_torque_when_hot(tmp_path):
     fade = simulate_launches(fmu, sc, load_table(), "aware").metrics
     const = simulate_launches(plain, sc, load_table(), "aware").metrics
     for f, c in zip(fade, const):
-        assert f["torque_error_rms_Nm"] > c["torque_error_rms_Nm"] + 5.0
+        assert f["characteristic_error_rms_Nm"] > c["characteristic_error_rms_Nm"] + 5.0
         assert f["engagement_time_s"] > c["engagement_time_s"]

@@ -67,7 +67,7 @@ def test_adaptation_converges_to_the_true_kiss_point_at_constant_temperature(fmu
     assert abs(adaptive[0]["kiss_point_error_mm"] + 0.2) < 1e-6        # first launch: nothing learned yet
     assert abs(adaptive[-1]["kiss_point_error_mm"]) < 0.02
     assert abs(naive[-1]["kiss_point_error_mm"] + 0.2) < 1e-6
-    assert adaptive[-1]["torque_error_rms_Nm"] < naive[-1]["torque_error_rms_Nm"]
+    assert adaptive[-1]["characteristic_error_rms_Nm"] < naive[-1]["characteristic_error_rms_Nm"]
 
 
 def test_compensated_adaptation_follows_the_temperature_between_adaptations(fmu):

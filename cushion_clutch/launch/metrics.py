@@ -1,12 +1,31 @@
 """Per-launch metrics of a TCU and their summary over groups of launches.
 
-Per launch (``METRIC_COLUMNS``): cushion-spring temperature at the start and
-the TCU's error in it, torque tracking error (demanded minus delivered
-capacity, RMS and max while launching), kiss-point error (believed minus
-true, at the start), engagement time, slip energy, peak jerk (acceleration
-low-passed at 20 ms) over the launch and within 0.2 s after lock-up, the
-creep shortfall (largest ``demand - delivered`` while the demand is at most
-30 N.m) and engine stall.
+Each metric measures one cause (SI units unless a name says otherwise):
+
+``characteristic_error_rms_Nm``, ``characteristic_error_max_Nm``
+    The torque the TCU's model believes at the *actual* bearing position
+    minus the true (plant FMU) torque there, sampled every TCU period while
+    the clutch is pre-filled or slipping in the launch (before lock-up).
+    Only what the TCU believes about the clutch enters (temperature, kiss
+    point, friction): not the actuator, not the controller.
+``tracking_error_rms_Nm``, ``tracking_error_max_Nm``
+    Delivered (clutch capacity while slipping) minus demanded torque, every
+    step while launching with a demand > 0, before lock-up: the characteristic
+    error plus what the actuator lag and its compensation leave.
+``creep_error_Nm``
+    Mean signed ``delivered - demanded`` while the demand is at most
+    :data:`CREEP_NM` (negative: the car creeps with less torque than asked).
+``lockup_accel_step_m_s2``
+    Vehicle acceleration averaged over one first-mode period after lock-up
+    minus the average over one period before (signed; a full period averages
+    the driveline oscillation out).
+``shuffle_amplitude_m_s2``
+    Peak-to-peak vehicle acceleration in the :data:`SHUFFLE_WINDOW_S` after
+    lock-up (driveline shuffle; it includes any acceleration trend there).
+
+Also: cushion-spring temperature at the start and the TCU's error in it,
+kiss-point error (believed minus true, at the start), engagement time, slip
+energy, peak jerk (acceleration low-passed at 20 ms), engine stall.
 """
 from __future__ import annotations
 
@@ -14,93 +33,156 @@ import math
 
 from ..fmu_src.clutch_model import KELVIN
 
-METRIC_COLUMNS = ("tcu", "launch", "theta_cs_start_degC", "torque_error_rms_Nm", "torque_error_max_Nm",
-                  "kiss_point_error_mm", "engagement_time_s", "slip_energy_kJ", "peak_jerk_m_s3",
-                  "engine_stall", "theta_cs_error_K", "creep_shortfall_Nm", "lockup_jerk_m_s3", "hot", "phase")
-#: demand up to which the creep shortfall is taken, N.m
+METRIC_COLUMNS = ("tcu", "launch", "demand_level", "theta_cs_start_degC", "characteristic_error_rms_Nm",
+                  "characteristic_error_max_Nm", "tracking_error_rms_Nm", "tracking_error_max_Nm",
+                  "creep_error_Nm", "lockup_accel_step_m_s2", "shuffle_amplitude_m_s2", "kiss_point_error_mm",
+                  "engagement_time_s", "slip_energy_kJ", "peak_jerk_m_s3", "engine_stall", "theta_cs_error_K",
+                  "hot", "phase")
+#: demand up to which the creep error is taken, N.m
 CREEP_NM = 30.0
-#: window after lock-up for the lock-up jerk, s
-LOCKUP_WINDOW_S = 0.2
+#: window after lock-up for the shuffle amplitude, s
+SHUFFLE_WINDOW_S = 1.0
 JERK_FILTER_S = 0.02
 
 
+def _rms_max(n: int, sq: float, mx: float) -> tuple[float, float]:
+    return (math.sqrt(sq / n), mx) if n else (math.nan, math.nan)
+
+
 class LaunchRecord:
-    """Collects one launch's metrics; :meth:`step` is called every step while the clutch is engaged."""
+    """Collects one launch's metrics.
+
+    :meth:`step` is called every step while the clutch is engaged,
+    :meth:`characteristic` at every TCU cycle before lock-up.
+
+    Parameters
+    ----------
+    launch : int
+        1-based launch number.
+    cool : bool
+        A cool-down launch.
+    h : float
+        Step, s.
+    mode_period_s : float
+        Period of the locked driveline's first mode, s (the lock-up step window).
+    level : str
+        The driver's demand level of this launch.
+    """
 
     __slots__ = ("launch", "cool", "lock_time", "stall", "slip_J", "n_err", "sq_err", "max_err", "jerk",
-                 "lock_jerk", "creep", "kiss_err", "theta_cs", "theta_err", "a_filt", "alpha", "h", "started")
+                 "n_ch", "sq_ch", "max_ch", "n_creep", "sum_creep", "kiss_err", "theta_cs", "theta_err",
+                 "a_filt", "alpha", "h", "started", "acc", "t_first", "window", "level")
 
-    def __init__(self, launch: int, cool: bool, h: float):
-        self.launch, self.cool, self.h = launch, cool, h
+    def __init__(self, launch: int, cool: bool, h: float, mode_period_s: float = 0.2, level: str = ""):
+        self.launch, self.cool, self.h, self.level = launch, cool, h, level
+        self.window = mode_period_s
         self.lock_time = None
         self.stall = False
         self.slip_J = 0.0
         self.n_err, self.sq_err, self.max_err = 0, 0.0, 0.0
-        self.jerk = self.lock_jerk = self.creep = 0.0
+        self.n_ch, self.sq_ch, self.max_ch = 0, 0.0, 0.0
+        self.n_creep, self.sum_creep = 0, 0.0
+        self.jerk = 0.0
         self.kiss_err = self.theta_cs = self.theta_err = None
         self.a_filt = 0.0
         self.alpha = h / (JERK_FILTER_S + h)
         self.started = False
+        self.acc: list[float] = []
+        self.t_first = math.nan
 
     def start(self, kiss_err_m: float, theta_cs_K: float, theta_err_K: float) -> None:
         """At the first engaged step: the TCU's kiss-point and temperature errors."""
         self.started = True
         self.kiss_err, self.theta_cs, self.theta_err = kiss_err_m, theta_cs_K, theta_err_K
 
+    def characteristic(self, believed_Nm: float, true_Nm: float) -> None:
+        """One TCU-cycle sample: the TCU's model torque and the true torque at the actual bearing position."""
+        if believed_Nm == 0.0 and true_Nm == 0.0:          # both open: nothing to compare
+            return
+        e = believed_Nm - true_Nm
+        self.n_ch += 1
+        self.sq_ch += e * e
+        if abs(e) > self.max_ch:
+            self.max_ch = abs(e)
+
     def step(self, accel: float, tl: float, t_dem: float, t_cap: float, launching: bool) -> None:
-        """One engaged step: acceleration (m/s2), time in launch (s), demand and capacity (N.m)."""
+        """One engaged step: vehicle acceleration (m/s2) at the end of the step, time in launch (s),
+        demanded and delivered torque (N.m)."""
+        if not self.acc:
+            self.t_first = tl
+        self.acc.append(accel)
         a_prev = self.a_filt
         self.a_filt += self.alpha * (accel - a_prev)
         jerk = abs(self.a_filt - a_prev) / self.h
         if jerk > self.jerk:
             self.jerk = jerk
-        if self.lock_time is not None and tl <= self.lock_time + LOCKUP_WINDOW_S and jerk > self.lock_jerk:
-            self.lock_jerk = jerk
         if launching and self.lock_time is None and t_dem > 0.0:
             e = t_cap - t_dem
             self.n_err += 1
             self.sq_err += e * e
             if abs(e) > self.max_err:
                 self.max_err = abs(e)
-            if t_dem <= CREEP_NM and -e > self.creep:
-                self.creep = -e
+            if t_dem <= CREEP_NM:
+                self.n_creep += 1
+                self.sum_creep += e
+
+    def _lockup(self) -> tuple[float, float]:
+        """(acceleration step, shuffle peak-to-peak) across lock-up, m/s2; NaN without lock-up."""
+        if self.lock_time is None or not self.acc:
+            return math.nan, math.nan
+        k = int(round((self.lock_time - self.t_first) / self.h))      # first sample after lock-up
+        m = max(1, int(round(self.window / self.h)))
+        before, after = self.acc[max(0, k - m):k], self.acc[k:k + m]
+        step = sum(after) / len(after) - sum(before) / len(before) if before and after else math.nan
+        shuffle = self.acc[k:k + int(round(SHUFFLE_WINDOW_S / self.h))]
+        return step, (max(shuffle) - min(shuffle)) if shuffle else math.nan
 
     def metrics(self, hot_degC: float) -> dict:
         """The launch's row (without ``tcu``)."""
-        nan = float("nan")
+        nan = math.nan
         theta = (self.theta_cs or KELVIN) - KELVIN
+        ch_rms, ch_max = _rms_max(self.n_ch, self.sq_ch, self.max_ch)
+        tr_rms, tr_max = _rms_max(self.n_err, self.sq_err, self.max_err)
+        step, shuffle = self._lockup()
         return {
             "launch": self.launch,
+            "demand_level": self.level,
             "theta_cs_start_degC": theta,
-            "torque_error_rms_Nm": math.sqrt(self.sq_err / self.n_err) if self.n_err else nan,
-            "torque_error_max_Nm": self.max_err if self.n_err else nan,
+            "characteristic_error_rms_Nm": ch_rms,
+            "characteristic_error_max_Nm": ch_max,
+            "tracking_error_rms_Nm": tr_rms,
+            "tracking_error_max_Nm": tr_max,
+            "creep_error_Nm": self.sum_creep / self.n_creep if self.n_creep else nan,
+            "lockup_accel_step_m_s2": step,
+            "shuffle_amplitude_m_s2": shuffle,
             "kiss_point_error_mm": (self.kiss_err or 0.0) * 1e3,
             "engagement_time_s": self.lock_time if self.lock_time is not None else nan,
             "slip_energy_kJ": self.slip_J / 1e3,
             "peak_jerk_m_s3": self.jerk,
             "engine_stall": bool(self.stall),
             "theta_cs_error_K": self.theta_err if self.theta_err is not None else nan,
-            "creep_shortfall_Nm": self.creep,
-            "lockup_jerk_m_s3": self.lock_jerk,
             "hot": bool(theta >= hot_degC),
             "phase": "cool-down" if self.cool else "repeated",
         }
 
 
 #: summarised columns: (column, how the worst is taken)
-SUMMARY = (("torque_error_rms_Nm", "max"), ("torque_error_max_Nm", "max"), ("kiss_point_error_mm", "absmax"),
-           ("theta_cs_error_K", "absmax"), ("creep_shortfall_Nm", "max"), ("engagement_time_s", "max"),
-           ("slip_energy_kJ", "max"), ("lockup_jerk_m_s3", "max"))
+SUMMARY = (("characteristic_error_rms_Nm", "max"), ("characteristic_error_max_Nm", "max"),
+           ("tracking_error_rms_Nm", "max"), ("tracking_error_max_Nm", "max"), ("creep_error_Nm", "absmax"),
+           ("lockup_accel_step_m_s2", "absmax"), ("shuffle_amplitude_m_s2", "max"),
+           ("kiss_point_error_mm", "absmax"), ("theta_cs_error_K", "absmax"), ("engagement_time_s", "max"),
+           ("slip_energy_kJ", "max"))
 
 
 def summarise(rows: list[dict], select) -> dict:
     """Mean and worst of the ``SUMMARY`` columns over the rows for which ``select(row)`` is true.
 
     Returns ``{"n": count, "<col>_mean": ..., "<col>_worst": ...}`` (NaN for no rows),
-    plus ``stalls`` (count).
+    plus ``stalls`` (count) and ``no_lockup`` (launches without lock-up).
     """
     rows = [r for r in rows if select(r)]
-    out: dict = {"n": len(rows), "stalls": sum(bool(r["engine_stall"]) for r in rows)}
+    out: dict = {"n": len(rows), "stalls": sum(bool(r["engine_stall"]) for r in rows),
+                 "no_lockup": sum(math.isnan(r["engagement_time_s"]) for r in rows)}
     for col, how in SUMMARY:
         vals = [r[col] for r in rows if not math.isnan(r[col])]
         if not vals:

@@ -55,10 +55,12 @@ def plot_launches(results: dict[str, LaunchResult], out: Path) -> list[Path]:
     for i, (name, res) in enumerate(results.items()):
         n = [m["launch"] for m in res.metrics]
         ls = STYLE.get(name, "-")
-        for ax, col in zip(axes, ("torque_error_rms_Nm", "kiss_point_error_mm", "creep_shortfall_Nm")):
+        for ax, col in zip(axes, ("characteristic_error_rms_Nm", "tracking_error_rms_Nm", "lockup_accel_step_m_s2")):
             ax.plot(n, [m[col] for m in res.metrics], marker="o", ms=3, linestyle=ls, color=f"C{i}", label=name)
-    axes[0].set(ylabel="RMS torque error [N·m]", title="Metrics per launch and TCU")
-    axes[1].set(ylabel="kiss-point error [mm]\n(believed − true)")
-    axes[2].set(ylabel="creep shortfall [N·m]\n(demand ≤ 30 N·m)", xlabel="launch")
+    axes[0].set(ylabel="characteristic_error_rms_Nm\n(believed − true at actual x)",
+                title="Metrics per launch and TCU")
+    axes[0].set_yscale("symlog", linthresh=0.01)
+    axes[1].set(ylabel="tracking_error_rms_Nm\n(delivered − demanded)")
+    axes[2].set(ylabel="lockup_accel_step_m_s2", xlabel="launch")
     p3 = finish_figure(fig, axes, out / "launch_metrics.png", fontsize=7)
     return [p1, p2, p3]

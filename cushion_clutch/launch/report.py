@@ -83,37 +83,62 @@ def _f(v: float, fmt: str) -> str:
 
 
 def metrics_table(results: dict[str, LaunchResult]) -> str:
-    """Per launch: theta_cs at the start, then RMS torque error and kiss-point error of every variant."""
+    """Per launch: demand level, theta_cs at the start, then the characteristic error (RMS) of every variant."""
     names = list(results)
     first = results[names[0]].metrics
-    head = "| launch | θ_cs start [°C] | " + " | ".join(f"RMS err {n} [N·m]" for n in names) + " | " + \
-        " | ".join(f"kiss err {n} [mm]" for n in names) + " |"
-    lines = [head, "|" + "---|" * (2 + 2 * len(names))]
+    head = ("| launch | demand | θ_cs start [°C] | " +
+            " | ".join(f"char. err RMS {n} [N·m]" for n in names) + " |")
+    lines = [head, "|" + "---|" * (3 + len(names))]
     for i, m in enumerate(first):
-        cells = [str(m["launch"]) + ("c" if m["phase"] == "cool-down" else ""), _f(m["theta_cs_start_degC"], ".1f")]
-        cells += [_f(results[n].metrics[i]["torque_error_rms_Nm"], ".2f") for n in names]
-        cells += [_f(results[n].metrics[i]["kiss_point_error_mm"], ".3f") for n in names]
+        cells = [str(m["launch"]) + ("c" if m["phase"] == "cool-down" else ""), m["demand_level"] or "–",
+                 _f(m["theta_cs_start_degC"], ".1f")]
+        cells += [_f(results[n].metrics[i]["characteristic_error_rms_Nm"], ".3f") for n in names]
         lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines)
 
 
-SUMMARY_LABELS = {"torque_error_rms_Nm": "RMS err [N·m]", "torque_error_max_Nm": "max err [N·m]",
-                  "kiss_point_error_mm": "kiss err [mm]", "theta_cs_error_K": "θ_cs err [K]",
-                  "creep_shortfall_Nm": "creep shortfall [N·m]", "engagement_time_s": "t_eng [s]",
-                  "slip_energy_kJ": "E_slip [kJ]", "lockup_jerk_m_s3": "lock-up jerk [m/s³]"}
+#: the summary table's columns: (column, label, format)
+SUMMARY_LABELS = {
+    "characteristic_error_rms_Nm": ("characteristic_error_rms_Nm", ".3f"),
+    "characteristic_error_max_Nm": ("characteristic_error_max_Nm", ".3f"),
+    "tracking_error_rms_Nm": ("tracking_error_rms_Nm", ".2f"),
+    "tracking_error_max_Nm": ("tracking_error_max_Nm", ".2f"),
+    "creep_error_Nm": ("creep_error_Nm", ".2f"),
+    "lockup_accel_step_m_s2": ("lockup_accel_step_m_s2", ".3f"),
+    "shuffle_amplitude_m_s2": ("shuffle_amplitude_m_s2", ".2f"),
+    "kiss_point_error_mm": ("kiss_point_error_mm", ".3f"),
+    "theta_cs_error_K": ("theta_cs_error_K", ".1f"),
+    "engagement_time_s": ("engagement_time_s", ".2f"),
+    "slip_energy_kJ": ("slip_energy_kJ", ".1f"),
+}
 
 
-def summary_table(results: dict[str, LaunchResult]) -> str:
-    """Markdown: per group and variant, ``mean / worst`` of each summarised metric."""
+def summary_table(results: dict[str, LaunchResult], groups: tuple[str, ...] | None = None) -> str:
+    """Markdown: per group and variant, ``mean / worst`` of each summarised metric (column names as in
+    ``launch_summary.csv``). ``groups`` None: every group but "all" when another group has launches."""
     cols = [c for c, _ in SUMMARY]
-    lines = ["| launches | TCU | n | " + " | ".join(SUMMARY_LABELS[c] + " mean / worst" for c in cols) + " | stalls |",
-             "|" + "---|" * (4 + len(cols))]
-    fmt = {"kiss_point_error_mm": ".3f", "engagement_time_s": ".3f", "theta_cs_error_K": ".1f",
-           "lockup_jerk_m_s3": ".1f"}
-    for r in summary_rows(results):
-        if r["group"] == "all" and any(x["group"] != "all" for x in summary_rows(results)):
+    rows = summary_rows(results)
+    if groups is None:
+        groups = tuple(g for g, _ in GROUPS if g != "all" or all(r["group"] == "all" for r in rows))
+    lines = ["| launches | TCU | n | " + " | ".join(SUMMARY_LABELS[c][0] + " mean / worst" for c in cols) +
+             " | stalls | no lock-up |",
+             "|" + "---|" * (5 + len(cols))]
+    for r in rows:
+        if r["group"] not in groups:
             continue
         cells = [r["group"], r["tcu"], str(r["n"])]
-        cells += [f"{_f(r[c + '_mean'], fmt.get(c, '.2f'))} / {_f(r[c + '_worst'], fmt.get(c, '.2f'))}" for c in cols]
-        lines.append("| " + " | ".join(cells + [str(r["stalls"])]) + " |")
+        cells += [f"{_f(r[c + '_mean'], SUMMARY_LABELS[c][1])} / {_f(r[c + '_worst'], SUMMARY_LABELS[c][1])}"
+                  for c in cols]
+        lines.append("| " + " | ".join(cells + [str(r["stalls"]), str(r["no_lockup"])]) + " |")
     return "\n".join(lines)
+
+
+def ratio_line(results: dict[str, LaunchResult], group: str = "hot") -> str:
+    """The naive / aware_estimated ratio of the worst characteristic error in ``group`` (one line)."""
+    worst = {r["tcu"]: r["characteristic_error_max_Nm_worst"] for r in summary_rows(results) if r["group"] == group}
+    if "naive" not in worst or "aware_estimated" not in worst:
+        return f"{group}: naive / aware_estimated characteristic error: –"
+    n, a = worst["naive"], worst["aware_estimated"]
+    ratio = n / a if a > 0 else math.inf
+    return (f"{group}: worst characteristic_error_max_Nm naive {n:.3f} / aware_estimated {a:.3f} = "
+            f"{ratio:.1f}x")

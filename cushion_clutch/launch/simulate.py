@@ -132,7 +132,8 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
                 next_switch = slot_end - 0.5 * h if n + 1 < n_slots else math.inf
                 stalled = False
             tl = t - slot_start
-            if countdown == 0:                                   # -- TCU cycle
+            cycled = countdown == 0
+            if cycled:                                           # -- TCU cycle
                 countdown = tcu_every
                 ctl.cycle(n + 1, tl, slot_end - slot_start, n + 1 < len(starts), rec.lock_time is not None,
                           sensors.read(dl.w_e), sensors.read(dl.v * r_to_disc), x_act, theta_cm)
@@ -147,6 +148,8 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
             t_cap, theta_cs, x_kiss = clutch_step(t, h, x_act, theta_cm, w_e - v * r_to_disc)
             if engaged and not rec.started:
                 rec.start(ctl.kiss_now - x_kiss, theta_cs, ctl.theta_now - theta_cs)
+            if cycled and launching and rec.lock_time is None:
+                rec.characteristic(ctl.model_torque(x_act), t_cap)
             t_e = engine_torque(w_e, engaged, stalled)
             if sense is not None:
                 sense(t + h, w_e, v * r_to_disc, h, t_e)

@@ -53,6 +53,8 @@ from ..fmu_src.clutch_model import ClutchParameters, SpringTable, outputs
 from .thermal_network import NetworkParams, ThermalNetwork
 
 IX_CS, IX_DX, IX_MU = 4, 5, 6   #: state indices
+#: speed band of the cached discretisation (convection), rad/s
+SPEED_BAND = 10.0
 
 
 @dataclass(frozen=True)
@@ -82,7 +84,7 @@ class TcuNetworkParams(NetworkParams):
 class EkfParams(Checked):
     """Section ``[ekf]``: noise, excitation conditions and the update period (SI)."""
 
-    period_s: float = 0.05
+    period_s: float = 0.1
     theta0_sd_K: float = 5.0
     heat_share_sd: float = 0.3
     """relative uncertainty of each node's slip heat"""
@@ -139,6 +141,7 @@ class ClutchEkf:
         self.q_rw = np.array([e.theta_walk_K2_per_s] * 5 + [e.kiss_walk_m2_per_s, e.mu_walk_per_s])
         self.energy_J = 0.0
         self.t_acc = 0.0
+        self._cache: dict = {}
         #: count of accepted measurement updates, and of rejected ones (gate)
         self.accepted = self.rejected = 0
 
@@ -191,20 +194,35 @@ class ClutchEkf:
         """True once a full EKF period has accumulated."""
         return self.t_acc >= self.e.period_s - 1e-12
 
+    def _discrete(self, w_engine: float, w_disc: float, clamped: bool, dt: float) -> tuple:
+        """``(F, G, b)``: ``s+ = F s + G (b + q)`` for the held inputs; cached per speed band.
+
+        The convection's speed is taken at the centre of a ``SPEED_BAND`` (rad/s) band.
+        """
+        key = (clamped, round(w_engine / SPEED_BAND), round(w_disc / SPEED_BAND), round(dt * 1e4))
+        hit = self._cache.get(key)
+        if hit is None:
+            a, b = self._jacobian_f(key[1] * SPEED_BAND, key[2] * SPEED_BAND, clamped)
+            # exp(A dt) and int_0^dt exp(A s) ds by their series to (A dt)^5: the EKF period is far
+            # below the network's time constants (a test checks the prediction against the plant network)
+            ad, term, f, g = a * dt, np.eye(7), np.eye(7), np.eye(7) * dt
+            for k in range(1, 6):
+                term = term @ ad / k
+                f = f + term
+                g = g + term * dt / (k + 1)
+            hit = self._cache[key] = (f, g, b)
+        return hit
+
     def predict(self, w_engine: float, w_disc: float, clamped: bool) -> None:
         """Advance the accumulated time with its mean slip power (the speeds and clamp state held)."""
         dt = self.t_acc
         if dt <= 0.0:
             return
         p_mean = self.energy_J / dt
-        a, b = self._jacobian_f(w_engine, w_disc, clamped)
-        ad = a * dt
-        f = np.eye(7) + ad + 0.5 * ad @ ad + ad @ ad @ ad / 6.0    # exp(A dt), third order (dt << time constants)
+        f, g, b = self._discrete(w_engine, w_disc, clamped, dt)
         q_heat = np.zeros(7)
-        q_heat[:4] = self.model.heat_inputs(p_mean)
-        q_heat[:4] /= self.model.caps
-        # integrate the affine part with the same series: s+ = F s + (I dt + A dt^2/2 + A^2 dt^3/6)(b + q)
-        g = np.eye(7) * dt + a * dt * dt / 2.0 + a @ a * dt ** 3 / 6.0
+        if p_mean != 0.0:
+            q_heat[:4] = np.array(self.model.heat_inputs(p_mean)) / self.model.caps
         self.s = f @ self.s + g @ (b + q_heat)
         qn = (self.e.heat_share_sd * q_heat * dt) ** 2 + self.q_rw * dt
         self.P = f @ self.P @ f.T + np.diag(qn)

@@ -44,7 +44,7 @@ VEHICLE_TORQUE_SD_NM = 6.0
 
 
 class ProductionTcu(TcuController):
-    """The ``production`` variant; call :meth:`sense` every simulation step and :meth:`cycle` every TCU period.
+    """The ``production`` variant; call :meth:`sense` and then :meth:`cycle` every TCU period.
 
     Parameters
     ----------
@@ -72,6 +72,7 @@ class ProductionTcu(TcuController):
         self.j_e = engine_inertia_kg_m2
         self.t = 0.0
         self.t_engine = 0.0
+        self.w_prev = (0.0, 0.0)
         self.hist: deque = deque(maxlen=WINDOW + 1)     # (w_e, w_d, T_est, x_meas)
         self.x_offset = sensors.position_offset_m
         super().__init__(variant, sc, table, p, theta0, 0.0, 0.0)
@@ -99,10 +100,18 @@ class ProductionTcu(TcuController):
         return self.ekf.model_torque(x_m + self.x_offset)
 
     # --- sensing -------------------------------------------------------------------------------------
-    def sense(self, t_end: float, w_engine: float, w_disc: float, dt: float, engine_torque_Nm: float) -> None:
-        """One simulation step of the true speeds (rad/s) and engine torque (N.m) past the sensors."""
-        self.sens.advance(t_end, w_engine, w_disc, dt)
-        self.t, self.t_engine = t_end, engine_torque_Nm
+    def sense(self, t: float, w_engine: float, w_disc: float, engine_torque_Nm: float) -> None:
+        """The true speeds (rad/s) and engine torque (N.m) at time ``t`` (s), once per TCU period.
+
+        The wheels turn by the trapezoidal angle since the last call; each edge's
+        time is interpolated with the period's mean speed (the speeds are smooth
+        on a 10 ms scale; the edge timing within a period is what a per-step
+        integration would refine).
+        """
+        dt = t - self.t
+        if dt > 0.0:
+            self.sens.advance(t, 0.5 * (self.w_prev[0] + w_engine), 0.5 * (self.w_prev[1] + w_disc), dt)
+        self.t, self.t_engine, self.w_prev = t, engine_torque_Nm, (w_engine, w_disc)
 
     def _estimate(self, x_true: float) -> None:
         """Read the sensors; update the RLS and the EKF (before the strategy uses the estimates)."""

@@ -20,10 +20,13 @@ from __future__ import annotations
 
 import math
 import random
+from bisect import bisect_right
 from dataclasses import dataclass
 from typing import Iterable
 
 from ..config import Checked
+
+TWO_PI = 2.0 * math.pi
 
 
 @dataclass(frozen=True)
@@ -84,8 +87,8 @@ class ToothedWheel:
         Draws each tooth's position error once.
     """
 
-    __slots__ = ("pitch", "present", "nominal", "actual", "timer", "timeout", "phi", "tooth", "next_edge",
-                 "t_last", "a_last", "t_ref", "a_ref", "n_new", "speed", "turns")
+    __slots__ = ("pitch", "present", "nominal", "actual", "timer", "timeout", "phi", "next_edge",
+                 "t_last", "a_last", "t_ref", "a_ref", "n_new", "speed")
 
     def __init__(self, teeth: int, missing: int, pitch_error_rad: float, timer_s: float, timeout_s: float,
                  rng: random.Random):
@@ -95,9 +98,7 @@ class ToothedWheel:
         self.actual = [a + (rng.gauss(0.0, pitch_error_rad) if pitch_error_rad > 0 and k else 0.0)
                        for k, a in enumerate(self.nominal)]
         self.timer, self.timeout = timer_s, timeout_s
-        self.phi = 0.0                 # shaft angle within the current turn, rad
-        self.turns = 0
-        self.tooth = 1                 # index of the next edge
+        self.phi = 0.0                 # unwrapped shaft angle, rad (edge 0 at 0)
         self.next_edge = self.actual[1]
         self.t_last = self.t_ref = -math.inf
         self.a_last = self.a_ref = 0.0  # nominal (believed) unwrapped angle of an edge, rad
@@ -105,22 +106,25 @@ class ToothedWheel:
         self.speed = 0.0
 
     def advance(self, t_end: float, w: float, dt: float) -> None:
-        """Turn the shaft at ``w`` (rad/s, magnitude used) over the step ``dt`` ending at ``t_end`` (s)."""
+        """Turn the shaft at the mean speed ``w`` (rad/s, magnitude used) over ``dt`` ending at ``t_end`` (s).
+
+        Only the last edge passed matters to :meth:`read`: it is found by
+        bisection, its time interpolated with the mean speed.
+        """
         dphi = abs(w) * dt
-        self.phi += dphi
-        while self.phi >= self.next_edge:
-            t_edge = t_end - (self.phi - self.next_edge) / (dphi / dt)
-            if self.timer > 0.0:
-                t_edge = self.timer * math.floor(t_edge / self.timer)
-            self.t_last = t_edge
-            self.a_last = self.turns * 2.0 * math.pi + self.nominal[self.tooth]
-            self.n_new += 1
-            self.tooth += 1
-            if self.tooth == self.present:
-                self.tooth = 0
-                self.turns += 1
-                self.phi -= 2.0 * math.pi
-            self.next_edge = self.actual[self.tooth]
+        phi = self.phi + dphi
+        self.phi = phi
+        if phi < self.next_edge:
+            return
+        turns, rem = divmod(phi, TWO_PI)
+        k = bisect_right(self.actual, rem) - 1          # actual[0] = 0: k >= 0
+        base = turns * TWO_PI
+        t_edge = t_end - (phi - (base + self.actual[k])) * dt / dphi
+        if self.timer > 0.0:
+            t_edge = self.timer * math.floor(t_edge / self.timer)
+        self.t_last, self.a_last = t_edge, base + self.nominal[k]
+        self.n_new += 1
+        self.next_edge = base + self.actual[k + 1] if k + 1 < self.present else base + TWO_PI
 
     def read(self, t: float) -> float:
         """The measured speed at time ``t`` (s), rad/s."""

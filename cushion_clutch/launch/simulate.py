@@ -135,6 +135,8 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
             cycled = countdown == 0
             if cycled:                                           # -- TCU cycle
                 countdown = tcu_every
+                if sense is not None:                             # production TCU: its own sensors
+                    sense(t, dl.w_e, dl.v * r_to_disc, t_e)
                 ctl.cycle(n + 1, tl, slot_end - slot_start, n + 1 < len(starts), rec.lock_time is not None,
                           sensors.read(dl.w_e), sensors.read(dl.v * r_to_disc), x_act, theta_cm)
                 engaged = ctl.phase != OPEN
@@ -151,8 +153,6 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
             if cycled and launching and rec.lock_time is None:
                 rec.characteristic(ctl.model_torque(x_act), t_cap)
             t_e = engine_torque(w_e, engaged, stalled)
-            if sense is not None:
-                sense(t + h, w_e, v * r_to_disc, h, t_e)
             ev = dl_step(t_e, t_cap, engaged, braking)
             if ev:
                 events.append((n + 1, "lock" if ev > 0 else "unlock", t + h if ev > 0 else t))

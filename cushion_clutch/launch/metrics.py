@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import math
 
-from ..fmu_src.clutch_model import KELVIN
+from ..model import KELVIN
 
 METRIC_COLUMNS = ("tcu", "launch", "demand_level", "theta_cs_start_degC", "characteristic_error_rms_Nm",
                   "characteristic_error_max_Nm", "tracking_error_rms_Nm", "tracking_error_max_Nm",

@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 from cushion_clutch.errors import ParameterError
-from cushion_clutch.fmu.model import load_table
-from cushion_clutch.fmu_src.clutch_model import ClutchParameters, outputs, thermal_step, x_to_for_torque
+from cushion_clutch.model import load_table
+from cushion_clutch.model import ClutchParameters, outputs, thermal_step, x_to_for_torque
 from cushion_clutch.launch.ekf import ClutchEkf, EkfParams, TcuNetworkParams
 from cushion_clutch.launch.thermal_network import NetworkParams, ThermalNetwork
 

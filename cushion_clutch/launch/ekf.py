@@ -49,7 +49,7 @@ from typing import Iterable
 import numpy as np
 
 from ..config import Checked
-from ..fmu_src.clutch_model import ClutchParameters, SpringTable, outputs
+from ..model import ClutchParameters, SpringTable, outputs
 from .thermal_network import NetworkParams, ThermalNetwork
 
 IX_CS, IX_DX, IX_MU = 4, 5, 6   #: state indices

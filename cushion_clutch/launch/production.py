@@ -31,7 +31,7 @@ from __future__ import annotations
 import copy
 from collections import deque
 
-from ..fmu_src.clutch_model import KELVIN, ClutchParameters, SpringTable, x_to_for_torque
+from ..model import KELVIN, ClutchParameters, SpringTable, x_to_for_torque
 from .ekf import ClutchEkf, EkfParams, TcuNetworkParams
 from .mass_grade import MassGrade, MassGradeEstimator
 from .sensors import ProductionSensors, TcuSensors

@@ -91,9 +91,9 @@ class EkfParams(Checked):
     theta_walk_K2_per_s: float = 0.01
     kiss_sd_m: float = 0.4e-3
     """prior sd of the touch-point offset"""
-    kiss_walk_m2_per_s: float = 1e-10
+    kiss_walk_m2_per_s: float = 1e-12
     mu_sd: float = 0.1
-    mu_walk_per_s: float = 1e-4
+    mu_walk_per_s: float = 1e-6
     torque_sd_Nm: float = 8.0
     """measurement noise of the engine-side clutch torque"""
     slip_min_rad_s: float = 10.0
@@ -101,6 +101,8 @@ class EkfParams(Checked):
     touch_torque_max_Nm: float = 80.0
     mu_torque_min_Nm: float = 40.0
     gate_sd: float = 4.0
+    mu_deadband: float = 0.05
+    """the engine torque estimate's stated gain accuracy: a learned mu_scale within 1 +- this is not applied"""
     temperature_update: bool = True
 
     _section = "ekf"
@@ -111,7 +113,8 @@ class EkfParams(Checked):
             "theta_walk_K2_per_s": (0.0, 1e4), "kiss_sd_m": (0.0, 0.01), "kiss_walk_m2_per_s": (0.0, 1e-3),
             "mu_sd": (0.0, 1.0), "mu_walk_per_s": (0.0, 1.0), "torque_sd_Nm": (1e-3, 1e3),
             "slip_min_rad_s": (0.0, 1e3), "touch_torque_min_Nm": (0.0, 1e4), "touch_torque_max_Nm": (0.0, 1e4),
-            "mu_torque_min_Nm": (0.0, 1e4), "gate_sd": (1.0, 100.0, True)})
+            "mu_torque_min_Nm": (0.0, 1e4), "gate_sd": (1.0, 100.0, True),
+            "mu_deadband": (0.0, 0.5)})
         if self.touch_torque_max_Nm <= self.touch_torque_min_Nm:
             yield "ekf.touch_torque_max_Nm: must exceed ekf.touch_torque_min_Nm"
 
@@ -166,11 +169,26 @@ class ClutchEkf:
         """Learned friction relative to the nominal mu, 1."""
         return float(self.s[IX_MU])
 
-    def model_torque(self, x_m: float, s: np.ndarray | None = None) -> float:
-        """The TCU's torque at bearing position ``x_m`` (m) with state ``s`` (default: the estimate), N.m."""
+    @property
+    def mu_used(self) -> float:
+        """The friction scale the TCU applies: ``mu_scale`` outside a dead band of ``mu_deadband`` around 1.
+
+        ``mu_scale`` is learned against the engine control unit's torque
+        estimate, so it carries that estimate's gain error; a deviation within
+        the estimate's stated accuracy is not attributed to the clutch.
+        """
+        d = self.s[IX_MU] - 1.0
+        band = self.e.mu_deadband
+        return 1.0 + (d - band if d > band else (d + band if d < -band else 0.0))
+
+    def model_torque(self, x_m: float, s: np.ndarray | None = None, mu: float | None = None) -> float:
+        """The TCU's torque at bearing position ``x_m`` (m) with state ``s`` (default: the estimate), N.m.
+
+        ``mu`` replaces the state's friction scale (e.g. :attr:`mu_used`).
+        """
         s = self.s if s is None else s
         th = min(max(float(s[IX_CS]), self.table.theta_min_K), self.table.theta_max_K)
-        return float(s[IX_MU]) * outputs(x_m - float(s[IX_DX]), th, self.table, self.p).torque
+        return (float(s[IX_MU]) if mu is None else mu) * outputs(x_m - float(s[IX_DX]), th, self.table, self.p).torque
 
     # --- prediction ----------------------------------------------------------------------------
     def _jacobian_f(self, w_engine: float, w_disc: float, clamped: bool) -> tuple[np.ndarray, np.ndarray]:

@@ -91,13 +91,13 @@ class ProductionTcu(TcuController):
     def command(self, torque_Nm: float) -> float:
         """True bearing position the servo reaches for ``torque_Nm`` (N.m), m."""
         th = min(max(self.ekf.theta_cs, self.table.theta_min_K), self.table.theta_max_K)
-        x_meas = x_to_for_torque(torque_Nm / max(self.ekf.mu_scale, 1e-3), th, self.table, self.p) \
+        x_meas = x_to_for_torque(torque_Nm / max(self.ekf.mu_used, 1e-3), th, self.table, self.p) \
             + self.ekf.dx_kiss
         return x_meas - self.x_offset
 
     def model_torque(self, x_m: float) -> float:
         """Torque the TCU believes at the true bearing position ``x_m`` (it sees it through its sensor), N.m."""
-        return self.ekf.model_torque(x_m + self.x_offset)
+        return self.ekf.model_torque(x_m + self.x_offset, mu=self.ekf.mu_used)
 
     # --- sensing -------------------------------------------------------------------------------------
     def sense(self, t: float, w_engine: float, w_disc: float, engine_torque_Nm: float) -> None:

@@ -1,9 +1,12 @@
 """Kiss-point (touch-point) learning from the onset of torque transfer in a launch.
 
 During the first launch phase the clutch torque rises until the car starts
-to move. Once the measured disc speed has stayed above the onset speed for a
-window, the disc's speed rise over the window gives the mean clutch torque,
-``T = J_d (w_d,end - w_d,start) / window + T_load`` (``J_d`` the vehicle's
+to move. Once the measured wheel speed (stated at the disc: ``v i / r``) has
+stayed above the onset speed for a window, its rise over the window gives the
+mean clutch torque, ``T = J_d (w_end - w_start) / window + T_load`` (wheel
+speeds rather than the disc speed: the disc alone spins up as the drive
+shafts wind up; the window should span a shuffle period to average the
+shafts' oscillation out; ``J_d`` the vehicle's
 inertia at the disc, ``T_load`` grade and rolling resistance at the clutch:
 the TCU is assumed to know mass and grade, as from the vehicle controller's
 estimates; here they are exact). The learner inverts its own characteristic

@@ -16,9 +16,11 @@ Each metric measures one cause (SI units unless a name says otherwise):
     Mean signed ``delivered - demanded`` while the demand is at most
     :data:`CREEP_NM` (negative: the car creeps with less torque than asked).
 ``lockup_accel_step_m_s2``
-    Vehicle acceleration averaged over one first-mode period after lock-up
-    minus the average over one period before (signed; a full period averages
-    the driveline oscillation out).
+    Vehicle acceleration averaged over the :data:`LOCKUP_WINDOW_S` after
+    lock-up minus the average over the window before (signed). The window is
+    a quarter of a 5 Hz shuffle period: short enough not to count the
+    planned fall of the acceleration during the sync as a step, long enough
+    to average out the disc-against-vehicle mode (13 Hz) and step noise.
 ``shuffle_amplitude_m_s2``
     Peak-to-peak vehicle acceleration in the :data:`SHUFFLE_WINDOW_S` after
     lock-up (driveline shuffle; it includes any acceleration trend there).
@@ -40,6 +42,8 @@ METRIC_COLUMNS = ("tcu", "launch", "demand_level", "theta_cs_start_degC", "chara
                   "hot", "phase")
 #: demand up to which the creep error is taken, N.m
 CREEP_NM = 30.0
+#: windows before and after lock-up for the acceleration step, s
+LOCKUP_WINDOW_S = 0.05
 #: window after lock-up for the shuffle amplitude, s
 SHUFFLE_WINDOW_S = 1.0
 JERK_FILTER_S = 0.02
@@ -63,8 +67,6 @@ class LaunchRecord:
         A cool-down launch.
     h : float
         Step, s.
-    mode_period_s : float
-        Period of the locked driveline's first mode, s (the lock-up step window).
     level : str
         The driver's demand level of this launch.
     """
@@ -73,9 +75,9 @@ class LaunchRecord:
                  "n_ch", "sq_ch", "max_ch", "n_creep", "sum_creep", "kiss_err", "theta_cs", "theta_err",
                  "a_filt", "alpha", "h", "started", "acc", "t_first", "window", "level")
 
-    def __init__(self, launch: int, cool: bool, h: float, mode_period_s: float = 0.2, level: str = ""):
+    def __init__(self, launch: int, cool: bool, h: float, level: str = ""):
         self.launch, self.cool, self.h, self.level = launch, cool, h, level
-        self.window = mode_period_s
+        self.window = LOCKUP_WINDOW_S
         self.lock_time = None
         self.stall = False
         self.slip_J = 0.0

@@ -31,7 +31,7 @@ from __future__ import annotations
 import copy
 from collections import deque
 
-from ..model import KELVIN, ClutchParameters, SpringTable, x_to_for_torque
+from ..model import ClutchParameters, SpringTable, x_to_for_torque
 from .ekf import ClutchEkf, EkfParams, TcuNetworkParams
 from .mass_grade import MassGrade, MassGradeEstimator
 from .sensors import ProductionSensors, TcuSensors
@@ -48,19 +48,19 @@ class ProductionTcu(TcuController):
 
     Parameters
     ----------
-    variant, sc, table, p, theta0
-        As :class:`~.tcu.TcuController`.
+    variant, sc, table, p, theta0, j_d_kg_m2, t_load_Nm, j_e_kg_m2, w_idle_rad_s
+        As :class:`~.tcu.TcuController`; ``j_d_kg_m2`` and ``t_load_Nm`` (the truth) are
+        not used: the TCU starts from its mass prior on level ground and then uses its estimates.
     sensors, net, ekf, mass_grade
         The TCU's sensors, own thermal network, EKF and RLS settings.
-    engine_inertia_kg_m2 : float
-        ``J_e`` the TCU uses (its nominal value).
     ratios : tuple of float
         ``(i_tot, r_m, eta, j_disc_kg_m2, rolling, air_N_s2_per_m2)`` of the launch gear, nominal.
     """
 
     def __init__(self, variant: Variant, sc, table: SpringTable, p: ClutchParameters, theta0: float,
+                 j_d_kg_m2: float, t_load_Nm: float, j_e_kg_m2: float, w_idle_rad_s: float,
                  sensors: ProductionSensors, net: TcuNetworkParams, ekf: EkfParams, mass_grade: MassGrade,
-                 engine_inertia_kg_m2: float, ratios: tuple[float, ...]):
+                 ratios: tuple[float, ...]):
         if table.friction is not None:          # the TCU's model has the nominal, constant mu
             table = copy.copy(table)
             table.friction = None
@@ -69,13 +69,13 @@ class ProductionTcu(TcuController):
         self.ekf = ClutchEkf(net, ekf, table, p, theta_a_meas, theta0)
         self.rls = MassGradeEstimator(mass_grade, *ratios)
         self.i_tot, self.r = ratios[0], ratios[1]
-        self.j_e = engine_inertia_kg_m2
         self.t = 0.0
         self.t_engine = 0.0
         self.w_prev = (0.0, 0.0)
-        self.hist: deque = deque(maxlen=WINDOW + 1)     # (w_e, w_d, T_est, x_meas)
+        self.hist: deque = deque(maxlen=WINDOW + 1)     # (w_e, w_v, T_est, x_meas)
         self.x_offset = sensors.position_offset_m
-        super().__init__(variant, sc, table, p, theta0, 0.0, 0.0)
+        super().__init__(variant, sc, table, p, theta0, self.rls.inertia_at_disc_kg_m2(),
+                         self.rls.holding_torque_Nm(), j_e_kg_m2, w_idle_rad_s)
 
     # --- what the TCU believes ---------------------------------------------------------------------
     def theta_used(self) -> float:
@@ -89,11 +89,9 @@ class ProductionTcu(TcuController):
         return self.model_kiss(self.ekf.theta_cs) + self.ekf.dx_kiss - self.x_offset
 
     def command(self, torque_Nm: float) -> float:
-        """True bearing position the servo reaches for ``torque_Nm`` (N.m), m."""
+        """Bearing position for ``torque_Nm`` (N.m) as the position sensor reads it, m."""
         th = min(max(self.ekf.theta_cs, self.table.theta_min_K), self.table.theta_max_K)
-        x_meas = x_to_for_torque(torque_Nm / max(self.ekf.mu_used, 1e-3), th, self.table, self.p) \
-            + self.ekf.dx_kiss
-        return x_meas - self.x_offset
+        return x_to_for_torque(torque_Nm / max(self.ekf.mu_used, 1e-3), th, self.table, self.p) + self.ekf.dx_kiss
 
     def model_torque(self, x_m: float) -> float:
         """Torque the TCU believes at the true bearing position ``x_m`` (it sees it through its sensor), N.m."""
@@ -113,23 +111,25 @@ class ProductionTcu(TcuController):
             self.sens.advance(t, 0.5 * (self.w_prev[0] + w_engine), 0.5 * (self.w_prev[1] + w_disc), dt)
         self.t, self.t_engine, self.w_prev = t, engine_torque_Nm, (w_engine, w_disc)
 
-    def _estimate(self, x_true: float) -> None:
-        """Read the sensors; update the RLS and the EKF (before the strategy uses the estimates)."""
+    def _estimate(self, x_true: float, w_v: float) -> tuple[float, float, float, float]:
+        """Read the sensors, update the RLS and the EKF; the readings ``(w_e, w_d, x, T_est)``."""
         s, e = self.sens, self.ekf
         w_e, w_d = s.crank.read(self.t), s.shaft.read(self.t)
         x_meas = s.position(x_true)
-        self.hist.append((w_e, w_d, s.engine_torque(self.t_engine), x_meas))
+        t_est = s.engine_torque(self.t_engine)
+        self.hist.append((w_e, w_v, t_est, x_meas))
+        readings = (w_e, w_d, x_meas, t_est)
         launching = self.phase == LAUNCH
         slip = w_e - w_d
         if len(self.hist) <= WINDOW:
-            return
+            return readings
         span = WINDOW * self.period
         h0, h1 = self.hist[0], self.hist[-1]
         items = list(self.hist)[1:]
         t_est = sum(i[2] for i in items) / WINDOW
         x_mean = sum(i[3] for i in items) / WINDOW
         t_c = t_est - self.j_e * (h1[0] - h0[0]) / span if self.phase != OPEN else 0.0
-        v = w_d * self.r / self.i_tot
+        v = h1[1] * self.r / self.i_tot               # wheel speed at the disc (ABS sensors)
         a = (h1[1] - h0[1]) / span * self.r / self.i_tot
         if self.phase != OPEN:
             self.rls.update(t_c, v, a)
@@ -138,13 +138,23 @@ class ProductionTcu(TcuController):
             e.predict(w_e, w_d, self.phase != OPEN)
             if launching:
                 e.correct(t_c, x_mean, slip, True)
-                if self.rls.ready()[1] and w_d > 0.0 and h0[1] > 0.0:
+                if self.rls.ready()[1] and h1[1] > 0.0 and h0[1] > 0.0:
                     t_vehicle = self.rls.inertia_at_disc_kg_m2() * (h1[1] - h0[1]) / span \
                         + self.rls.holding_torque_Nm()
                     e.correct(t_vehicle, x_mean, slip, True, VEHICLE_TORQUE_SD_NM)
+        return readings
 
-    def cycle(self, launch: int, tl: float, slot_s: float, has_next: bool, locked_once: bool,
-              w_e: float, w_d: float, x_meas: float, theta_cm_true: float) -> None:
-        """As :meth:`TcuController.cycle`; the speeds given are ignored (the TCU reads its own sensors)."""
-        self._estimate(x_meas)
-        super().cycle(launch, tl, slot_s, has_next, locked_once, w_e, w_d, x_meas, theta_cm_true)
+    def cycle(self, launch: int, tl: float, locked_once: bool, w_e: float, w_d: float, x_meas: float,
+              theta_cm_true: float, t_e: float = 0.0, level: str = "hard", w_v: float | None = None) -> None:
+        """As :meth:`TcuController.cycle`, on the TCU's own readings.
+
+        The speeds, the torque signal and the true ``x_meas`` given are replaced
+        by the sensors' readings (:meth:`sense` fed the truth); the strategy runs
+        in the position sensor's frame and the servo's target is shifted back by
+        the sensor's offset (the servo drives the measured position).
+        """
+        w_e_m, w_d_m, x_m, t_est = self._estimate(x_meas, w_d if w_v is None else w_v)
+        self.j_d, self.t_load = self.rls.inertia_at_disc_kg_m2(), self.rls.holding_torque_Nm()
+        super().cycle(launch, tl, locked_once, w_e_m, w_d_m, x_m, theta_cm_true, t_est, level, w_d_m)
+        if self.x_cmd != 0.0:
+            self.x_cmd -= self.x_offset

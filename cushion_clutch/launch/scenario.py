@@ -23,9 +23,9 @@ from .thermal_network import PlantThermal
 class Engine(Checked):
     """Engine and flywheel: ``T = throttle T_max(w) - drag_Nm_per_rad_s w``.
 
-    The engine control's speed governor (PI, anti-windup) sets the throttle to
-    hold ``launch_speed_rpm`` while the clutch is engaged or closed, and
-    ``idle_speed_rpm`` while it is open.
+    The throttle is the driver's pedal or, when that is less, the engine
+    control's idle governor (PI on the speed, anti-windup), which holds
+    ``idle_speed_rpm``; no fuel above ``max_speed_rpm`` or after a stall.
     """
 
     inertia_kg_m2: float = 0.25
@@ -33,7 +33,6 @@ class Engine(Checked):
     torque_curve_Nm: tuple[float, ...] = (130.0, 190.0, 230.0, 240.0, 210.0, 170.0)
     drag_Nm_per_rad_s: float = 0.05
     idle_speed_rpm: float = 800.0
-    launch_speed_rpm: float = 1800.0
     governor_kp_Nm_per_rad_s: float = 3.0
     governor_ki_Nm_per_rad: float = 15.0
     stall_speed_rpm: float = 400.0
@@ -44,7 +43,7 @@ class Engine(Checked):
     def _problems(self) -> Iterable[str]:
         yield from self._ranges({
             "inertia_kg_m2": (0.0, 10.0, True), "drag_Nm_per_rad_s": (0.0, 10.0),
-            "idle_speed_rpm": (100.0, 3000.0), "launch_speed_rpm": (500.0, 8000.0), "governor_kp_Nm_per_rad_s": (0.0, 1e3),
+            "idle_speed_rpm": (100.0, 3000.0), "governor_kp_Nm_per_rad_s": (0.0, 1e3),
             "governor_ki_Nm_per_rad": (0.0, 1e4), "stall_speed_rpm": (0.0, 3000.0),
             "max_speed_rpm": (1000.0, 20000.0)})
         if len(self.torque_curve_rpm) < 2 or len(self.torque_curve_rpm) != len(self.torque_curve_Nm):
@@ -59,20 +58,28 @@ class Engine(Checked):
 
 @dataclass(frozen=True)
 class Driveline(Checked):
-    """Clutch disc side: gearbox in launch gear, final drive, wheels."""
+    """Clutch disc side: gearbox in launch gear, final drive, compliant shafts and tyres, wheels.
+
+    The torsional stiffness and damping of the drive shafts and tyres are
+    lumped between the gearbox output and the vehicle, stated at the wheels
+    (both wheels together).
+    """
 
     disc_inertia_kg_m2: float = 0.03
     gear_ratio: float = 3.8
     final_drive_ratio: float = 4.1
     efficiency: float = 0.95
     wheel_radius_m: float = 0.31
+    stiffness_Nm_per_rad: float = 50000.0
+    damping_Nm_s_per_rad: float = 300.0
 
     _section = "driveline"
 
     def _problems(self) -> Iterable[str]:
         yield from self._ranges({
             "disc_inertia_kg_m2": (0.0, 10.0, True), "gear_ratio": (0.1, 20.0),
-            "final_drive_ratio": (0.5, 20.0), "efficiency": (0.5, 1.0), "wheel_radius_m": (0.1, 1.0)})
+            "final_drive_ratio": (0.5, 20.0), "efficiency": (0.5, 1.0), "wheel_radius_m": (0.1, 1.0),
+            "stiffness_Nm_per_rad": (100.0, 1e7), "damping_Nm_s_per_rad": (0.0, 1e5)})
 
 
 @dataclass(frozen=True)
@@ -122,18 +129,31 @@ class Facing(Checked):
 
 @dataclass(frozen=True)
 class Tcu(Checked):
-    """Launch strategy shared by both TCUs: the same clutch-torque demand profile.
+    """The launch controller shared by every TCU variant (see :mod:`.tcu`).
 
-    The demand ramps at ``torque_ramp_Nm_per_s`` to ``torque_target_Nm`` and is
-    held until lock-up; then the bearing closes at ``close_rate_m_per_s`` to
-    ``x_to_closed_m``. ``prefill_s`` before each launch the bearing is moved to
-    the TCU's believed first contact (zero torque). The actuator follows the
-    command with a first-order lag.
+    Every ``period_s``: before a launch (``prefill_s``) the bearing goes to
+    the believed first contact; in the launch the clutch-torque demand is the
+    engine torque minus the engine inertia times the reference's acceleration
+    plus a PI on the engine speed against a reference that rises with time
+    constant ``engine_speed_time_constant_s`` from the speed at the start to
+    ``idle + pedal (engine_speed_full_pedal_rpm - idle)`` (a creep launch: the
+    driver's creep torque instead); below ``sync_slip_rad_s`` of slip the PI
+    follows a slip trajectory that meets zero at ``lockup_slip_rate_rad_s2``
+    around the locked-driveline torque;
+    the demand rises at most at ``torque_ramp_Nm_per_s``. The believed
+    characteristic is inverted and the actuator's first-order lag
+    (``actuator_time_constant_s``, known to the TCU) inverted over one period.
+    After lock-up the bearing closes at ``close_rate_m_per_s`` to ``x_to_closed_m``.
     """
 
     period_s: float = 0.01
-    torque_ramp_Nm_per_s: float = 150.0
-    torque_target_Nm: float = 150.0
+    torque_ramp_Nm_per_s: float = 400.0
+    engine_speed_full_pedal_rpm: float = 2200.0
+    engine_speed_time_constant_s: float = 0.3
+    speed_kp_Nm_per_rad_s: float = 1.0
+    speed_ki_Nm_per_rad: float = 5.0
+    sync_slip_rad_s: float = 30.0
+    lockup_slip_rate_rad_s2: float = 10.0
     x_to_closed_m: float = 0.009
     close_rate_m_per_s: float = 0.01
     actuator_time_constant_s: float = 0.02
@@ -144,10 +164,53 @@ class Tcu(Checked):
 
     def _problems(self) -> Iterable[str]:
         yield from self._ranges({
-            "period_s": (1e-4, 1.0), "torque_ramp_Nm_per_s": (1.0, 1e4), "torque_target_Nm": (1.0, 2000.0),
-"x_to_closed_m": (0.0, 0.05),
+            "period_s": (1e-4, 1.0), "torque_ramp_Nm_per_s": (1.0, 1e5),
+            "engine_speed_full_pedal_rpm": (500.0, 8000.0), "engine_speed_time_constant_s": (1e-3, 10.0),
+            "speed_kp_Nm_per_rad_s": (0.0, 100.0), "speed_ki_Nm_per_rad": (0.0, 1e4),
+            "sync_slip_rad_s": (1.0, 500.0), "lockup_slip_rate_rad_s2": (0.1, 1000.0),
+            "x_to_closed_m": (0.0, 0.05),
             "close_rate_m_per_s": (1e-4, 1.0), "actuator_time_constant_s": (0.0, 1.0),
             "drive_time_s": (0.5, 100.0), "prefill_s": (0.0, 5.0)})
+
+
+#: the driver's demand levels
+LEVELS = ("creep", "moderate", "hard")
+
+
+@dataclass(frozen=True)
+class Driver(Checked):
+    """The driver's pedal: one demand level per launch, ``levels`` cycled over the launches.
+
+    ``creep``: pedal 0 (the idle governor runs the engine), the TCU gives
+    ``creep_torque_Nm``; ``moderate`` and ``hard``: throttle ``moderate_pedal``
+    and ``hard_pedal``. The driver lifts off when the engine passes
+    ``lift_off_speed_rpm`` after lock-up.
+    """
+
+    levels: tuple[str, ...] = ("moderate", "hard")
+    creep_torque_Nm: float = 20.0
+    moderate_pedal: float = 0.5
+    hard_pedal: float = 0.75
+    lift_off_speed_rpm: float = 4000.0
+
+    _section = "driver"
+
+    def _problems(self) -> Iterable[str]:
+        yield from self._ranges({"creep_torque_Nm": (0.5, 30.0), "moderate_pedal": (0.05, 1.0),
+                                 "hard_pedal": (0.05, 1.0), "lift_off_speed_rpm": (500.0, 20000.0)})
+        if not self.levels:
+            yield "driver.levels: need at least one level (" + ", ".join(LEVELS) + ")"
+        for i, lv in enumerate(self.levels):
+            if lv not in LEVELS:
+                yield f"driver.levels[{i}] = {lv!r}: allowed " + ", ".join(LEVELS)
+
+    def level(self, launch: int) -> str:
+        """The demand level of launch ``launch`` (1-based)."""
+        return self.levels[(launch - 1) % len(self.levels)]
+
+    def pedal(self, level: str) -> float:
+        """Throttle of a level (0 for creep)."""
+        return {"creep": 0.0, "moderate": self.moderate_pedal, "hard": self.hard_pedal}[level]
 
 
 @dataclass(frozen=True)
@@ -217,6 +280,7 @@ class Scenario(Checked):
     vehicle: Vehicle = field(default_factory=Vehicle)
     facing: Facing = field(default_factory=Facing)
     tcu: Tcu = field(default_factory=Tcu)
+    driver: Driver = field(default_factory=Driver)
     run: Run = field(default_factory=Run)
     clutch: Clutch = field(default_factory=Clutch)
     observer: Observer = field(default_factory=Observer)
@@ -232,8 +296,8 @@ class Scenario(Checked):
 
     def _problems(self) -> Iterable[str]:
         for key, period in (("period_s", self.run.period_s), ("cool_period_s", self.run.cool_period_s)):
-            if period <= self.tcu.drive_time_s + 5.0:
-                yield (f"run.{key} = {period!r}: must exceed tcu.drive_time_s + 5 s "
+            if period <= self.tcu.prefill_s + self.tcu.drive_time_s + 5.0:
+                yield (f"run.{key} = {period!r}: must exceed tcu.prefill_s + tcu.drive_time_s + 5 s "
                        "(time to brake to a stop)")
 
     def friction_path(self) -> Path | None:
@@ -245,7 +309,7 @@ class Scenario(Checked):
 
 
 def scenario_path(name: str | Path) -> Path:
-    """A scenario file: ``name`` itself, or the shipped ``<name>.toml`` (default, cooldown, fade)."""
+    """A scenario file: ``name`` itself, or the shipped ``<name>.toml`` (default, creep, cooldown, fade)."""
     path = Path(name)
     shipped = DEFAULT_SCENARIO.parent / f"{name}.toml"
     return shipped if not path.exists() and path.suffix == "" and shipped.is_file() else path
@@ -254,7 +318,7 @@ def scenario_path(name: str | Path) -> Path:
 def load_scenario(path: str | Path = DEFAULT_SCENARIO) -> Scenario:
     """Load and check a scenario TOML file (unknown keys and bad ranges rejected)."""
     if not Path(path).is_file():
-        raise ParameterError([f"scenario file {path} not found (shipped: default, cooldown, fade)"])
+        raise ParameterError([f"scenario file {path} not found (shipped: default, creep, cooldown, fade)"])
     data = load_toml(path)
     if "folder" in data:
         raise ParameterError(["folder: unknown key"], str(path))

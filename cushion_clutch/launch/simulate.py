@@ -1,13 +1,17 @@
 """Repeated vehicle launches: a Python driveline and a TCU around the clutch FMU.
 
-Fixed communication step ``run.step_s``. Per step: the TCU (every
-``tcu.period_s``, :mod:`.tcu`) commands a bearing position from measured
-speeds (:mod:`.observer`), a first-order actuator moves the bearing, the
-clutch FMU (:mod:`.fmu_client`) returns the transmissible torque for the
-bearing position, facing temperature and slip speed held over the step, the
-engine (:mod:`.engine`) and the driveline (:mod:`.driveline`) advance, the
-facings heat up (:mod:`.thermal`) and the metrics are collected
-(:mod:`.metrics`).
+Fixed communication step ``run.step_s``. Each launch slot starts with the
+pre-fill, then the driver presses the pedal (the slot's demand level,
+``[driver]``) for ``tcu.drive_time_s`` (lifting off above
+``driver.lift_off_speed_rpm`` once locked), then the clutch opens and the
+brake stops the car. Per step: the TCU (every ``tcu.period_s``,
+:mod:`.tcu`) commands a bearing position from measured speeds
+(:mod:`.observer`) and the engine's torque signal, a first-order actuator
+moves the bearing, the clutch FMU (:mod:`.fmu_client`) returns the
+transmissible torque for the bearing position, facing temperature and slip
+speed held over the step, the engine (:mod:`.engine`) and the compliant
+driveline (:mod:`.driveline`) advance, the facings heat up
+(:mod:`.thermal`) and the metrics are collected (:mod:`.metrics`).
 """
 from __future__ import annotations
 
@@ -26,8 +30,9 @@ from .fmu_client import ClutchFmu
 from .metrics import LaunchRecord
 from .observer import SpeedSensors
 from .scenario import Scenario
+from .engine import RPM
 from .production import ProductionTcu
-from .tcu import OPEN, LAUNCH, VARIANTS, TcuController
+from .tcu import CLOSE, LAUNCH, PREFILL, VARIANTS, TcuController
 from .thermal import FacingModel
 from .thermal_network import ThermalNetwork
 
@@ -36,7 +41,8 @@ __all__ = ["COLUMNS", "Energy", "LaunchResult", "simulate_launches"]
 #: columns of the time series (SI; recorded every ``record_every`` steps)
 COLUMNS = ("time_s", "launch", "w_engine_rad_s", "w_disc_rad_s", "v_m_s", "accel_m_s2", "x_cmd_m",
            "x_to_m", "torque_demand_Nm", "torque_capacity_Nm", "torque_clutch_Nm", "theta_cm_K",
-           "theta_cs_K", "theta_cs_tcu_K", "x_kiss_m", "x_kiss_tcu_m", "throttle", "locked", "theta_cm_tcu_K")
+           "theta_cs_K", "theta_cs_tcu_K", "x_kiss_m", "x_kiss_tcu_m", "throttle", "locked", "theta_cm_tcu_K",
+           "torque_believed_Nm", "torque_shaft_Nm")
 
 
 @dataclass
@@ -72,20 +78,20 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
     name = {True: "aware", False: "naive"}.get(tcu, tcu) if isinstance(tcu, bool) else tcu
     if name not in VARIANTS:
         raise ValueError(f"tcu = {tcu!r}: allowed {', '.join(VARIANTS)}")
-    fac, tc, run = sc.facing, sc.tcu, sc.run
+    fac, tc, run, drv = sc.facing, sc.tcu, sc.run, sc.driver
     h = run.step_s
     theta_a, theta0 = fac.ambient_degC + KELVIN, fac.initial_degC + KELVIN
     p = ClutchParameters(theta_a=theta_a, theta_cs_start=theta0)
     engine = EngineGovernor(sc.engine, h)
     dl = Driveline(sc, engine.w_idle)
     if name == "production":
-        ctl = ProductionTcu(VARIANTS[name], sc, table, p, theta0, sc.tcu_sensors, sc.tcu_thermal, sc.ekf,
-                            sc.mass_grade, sc.engine.inertia_kg_m2,
+        ctl = ProductionTcu(VARIANTS[name], sc, table, p, theta0, dl.j_d, dl.t_load_rest, dl.j_e, engine.w_idle,
+                            sc.tcu_sensors, sc.tcu_thermal, sc.ekf, sc.mass_grade,
                             (dl.i_tot, dl.r, dl.eta, sc.driveline.disc_inertia_kg_m2, sc.vehicle.rolling_resistance,
                              dl.air))
         sense = ctl.sense
     else:
-        ctl = TcuController(VARIANTS[name], sc, table, p, theta0, dl.j_d, dl.t_load_rest)
+        ctl = TcuController(VARIANTS[name], sc, table, p, theta0, dl.j_d, dl.t_load_rest, dl.j_e, engine.w_idle)
         sense = None
     net = ThermalNetwork(sc.plant_thermal, theta_a, theta0) if sc.plant_thermal.enabled else None
     net_every = max(1, int(round(tc.period_s / h)))     # the network's time constants are seconds: 10 ms steps
@@ -96,24 +102,28 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
     starts = run.starts()
     total = run.duration()
     ends = starts[1:] + [total]
-    recs = [LaunchRecord(i + 1, i >= run.launches, h) for i in range(len(starts))]
+    levels = [drv.level(i + 1) for i in range(len(starts))]
+    recs = [LaunchRecord(i + 1, i >= run.launches, h, levels[i]) for i in range(len(starts))]
     tcu_every = max(1, int(round(tc.period_s / h)))
     act = math.exp(-h / tc.actuator_time_constant_s) if tc.actuator_time_constant_s > 0 else 0.0
     w_idle, w_stall = engine.w_idle, engine.w_stall
+    w_lift = drv.lift_off_speed_rpm * RPM
     r_to_disc = dl.i_tot / dl.r
+    prefill, drive_end = tc.prefill_s, tc.prefill_s + tc.drive_time_s
 
     clutch = ClutchFmu(fmu, {"theta_a": theta_a, "theta_cs_start": theta0,
                              "x_kiss_ref": p.x_kiss_ref + sc.clutch.x_kiss_offset_m})
     theta_cm = theta0
     x_act = 0.0
     theta_cs, x_kiss = theta0, p.x_kiss_ref
-    t_cap = t_e = 0.0
-    ke0 = dl.kinetic(dl.w_e, dl.v)
+    t_cap = t_e = believed = 0.0
+    ke0 = dl.kinetic()
     n_steps = int(round(total / h))
     rows = []
     events: list[tuple[int, str, float]] = []
     n, rec, slot_start, slot_end = 0, recs[0], starts[0], ends[0]
-    engaged = braking = launching = False
+    pedal_level = drv.pedal(levels[0])
+    engaged = braking = launching = sampling = lifted = False
     countdown = 0
     clutch_step, engine_torque, dl_step, facing_step = clutch.step, engine.torque, dl.step, facing.step
     n_slots = len(starts)
@@ -130,34 +140,41 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
                 n += 1
                 rec, slot_start, slot_end = recs[n], starts[n], ends[n]
                 next_switch = slot_end - 0.5 * h if n + 1 < n_slots else math.inf
-                stalled = False
+                stalled = lifted = False
+                pedal_level = drv.pedal(levels[n])
             tl = t - slot_start
             cycled = countdown == 0
             if cycled:                                           # -- TCU cycle
                 countdown = tcu_every
                 if sense is not None:                             # production TCU: its own sensors
-                    sense(t, dl.w_e, dl.v * r_to_disc, t_e)
-                ctl.cycle(n + 1, tl, slot_end - slot_start, n + 1 < len(starts), rec.lock_time is not None,
-                          sensors.read(dl.w_e), sensors.read(dl.v * r_to_disc), x_act, theta_cm)
-                engaged = ctl.phase != OPEN
-                launching = ctl.phase == LAUNCH
-                braking = not engaged and tl >= tc.drive_time_s
+                    sense(t, dl.w_e, dl.w_d, t_e)
+                ctl.cycle(n + 1, tl, rec.lock_time is not None, sensors.read(dl.w_e), sensors.read(dl.w_d),
+                          x_act, theta_cm, t_e, levels[n], sensors.read(dl.v * r_to_disc))
+                phase = ctl.phase
+                engaged = phase == LAUNCH or phase == CLOSE
+                launching = phase == LAUNCH
+                sampling = (launching or phase == PREFILL) and rec.lock_time is None
+                braking = not engaged and tl >= drive_end
             countdown -= 1
             x_cmd = ctl.x_cmd
             x_act = x_cmd + (x_act - x_cmd) * act
-            w_e, v = dl.w_e, dl.v
+            w_e = dl.w_e
             # -- clutch FMU, inputs held over the step
-            t_cap, theta_cs, x_kiss = clutch_step(t, h, x_act, theta_cm, w_e - v * r_to_disc)
+            t_cap, theta_cs, x_kiss = clutch_step(t, h, x_act, theta_cm, w_e - dl.w_d)
             if engaged and not rec.started:
                 rec.start(ctl.kiss_now - x_kiss, theta_cs, ctl.theta_now - theta_cs)
-            if cycled and launching and rec.lock_time is None:
-                rec.characteristic(ctl.model_torque(x_act), t_cap)
-            t_e = engine_torque(w_e, engaged, stalled)
+            if cycled and sampling:
+                believed = ctl.model_torque(x_act)
+                rec.characteristic(believed, t_cap)
+            if engaged and not lifted and rec.lock_time is not None and w_e > w_lift:
+                lifted = True
+            t_e = engine_torque(w_e, pedal_level if engaged and not lifted else 0.0, stalled)
+            v = dl.v
             ev = dl_step(t_e, t_cap, engaged, braking)
             if ev:
                 events.append((n + 1, "lock" if ev > 0 else "unlock", t + h if ev > 0 else t))
                 if ev > 0 and rec.lock_time is None:
-                    rec.lock_time = tl + h
+                    rec.lock_time = tl + h - prefill
             slip_J = dl.slip_J
             theta_cm_step = theta_cm
             if net is not None:
@@ -165,7 +182,7 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
                 net_e += slip_J
                 net_n += 1
                 if net_n == net_every:
-                    net.step(net_n * h, net_e / (net_n * h), dl.w_e, dl.v * r_to_disc, engaged)
+                    net.step(net_n * h, net_e / (net_n * h), dl.w_e, dl.w_d, engaged)
                     theta_cm, net_n, net_e = net.theta_cm, 0, 0.0
             elif slip_J != 0.0:
                 rec.slip_J += slip_J
@@ -176,7 +193,8 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
                 theta_cm = profile(t + h) if profile is not None else facing_step(theta_cm, 0.0)
             accel = (dl.v - v) / h
             if engaged:
-                rec.step(accel, tl + h, ctl.t_dem, t_cap, launching)
+                rec.step(accel, tl + h - prefill, ctl.t_dem + ctl.t_rate * (tcu_every - countdown) * h, t_cap,
+                         launching)
                 if dl.w_e <= w_stall:
                     rec.stall = stalled = True
             elif dl.locked:
@@ -186,16 +204,19 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
                 dl.restart_engine(w_idle)
             if rec_countdown == 0:
                 rec_countdown = record_every
-                rows.append((t, n + 1, dl.w_e, dl.v * r_to_disc, dl.v, accel, x_cmd, x_act, ctl.t_dem, t_cap,
-                             dl.t_c, theta_cm_step, theta_cs, ctl.theta_now, x_kiss, ctl.kiss_now,
-                             engine.throttle, float(dl.locked), ctl.theta_cm_estimate()))
+                rows.append((t, n + 1, dl.w_e, dl.w_d, dl.v, accel, x_cmd, x_act,
+                             ctl.t_dem + ctl.t_rate * (tcu_every - countdown) * h, t_cap, dl.t_c, theta_cm_step,
+                             theta_cs, ctl.theta_now, x_kiss, ctl.kiss_now, engine.throttle, float(dl.locked),
+                             ctl.theta_cm_estimate(), believed if sampling else math.nan,
+                             dl.k * dl.phi + dl.c * (dl.w_d - dl.v * dl.i_tot / dl.r)))
                 if progress is not None and k % 10000 == 0:
                     progress(t)
             rec_countdown -= 1
     finally:
         clutch.close()
     wall, cpu = time.perf_counter() - wall0, time.process_time() - cpu0
-    dl.en.kinetic = dl.kinetic(dl.w_e, dl.v) - ke0
+    dl.en.kinetic = dl.kinetic() - ke0
+    dl.en.elastic = dl.elastic()
     series = np.array(rows, dtype=[(c, float) for c in COLUMNS])
     metrics = [r.metrics(run.hot_degC) for r in recs]
     learned = ctl.learner.estimates if ctl.learner is not None else []

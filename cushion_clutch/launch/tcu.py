@@ -1,11 +1,33 @@
-"""The TCU variants: one launch strategy, five ways of knowing the clutch.
+"""The TCU variants: one production-like launch controller, five ways of knowing the clutch.
 
-All variants share the clutch-torque demand (ramp to the target, hold to
-lock-up, then close the bearing) and command the bearing every
-``tcu.period_s`` through the inverse of their model of the characteristic
-(nominal mu, the shipped cushion-spring table), pre-filling to their believed
-first contact before each launch. They differ in the cushion-spring
-temperature they assume and in whether they learn the kiss point:
+Every ``tcu.period_s`` the controller (shared by all variants):
+
+1. **pre-fill** (the first ``prefill_s`` of every launch slot, the first
+   launch included): bearing to the believed first contact;
+2. **launch**, from the driver's pedal (``[driver]``): the clutch-torque
+   demand is a feed-forward plus a PI (its integral corrects what the
+   characteristic gets wrong):
+
+   * pedal launches: engine-speed trajectory control,
+     ``T = T_e - J_e w_ref' + PI(w_e - w_ref)``, ``w_ref`` rising with a
+     first-order lag to the pedal's engine speed (``T_e`` is the engine's
+     torque signal);
+   * creep: the driver's creep torque (the idle governor holds the engine);
+   * sync, once the slip is below ``sync_slip_rad_s``: slip-speed trajectory
+     whose rate falls linearly from the rate the present demand gives to
+     ``lockup_slip_rate_rad_s2`` as the slip reaches zero, ``T = T_lock - s_ref' / K + PI(s - s_ref)`` with the
+     locked-driveline torque ``T_lock = (J_d T_e + J_e T_load) / (J_e + J_d)``
+     and ``K = 1/J_e + 1/J_d``: at the meeting the clutch torque is within
+     ``lockup_slip_rate_rad_s2 / K`` of the torque it carries once locked (no lurch);
+
+   the demand rises at most at ``torque_ramp_Nm_per_s``; it is extrapolated
+   one period ahead, turned into a bearing position through the believed
+   characteristic and the actuator's first-order lag is inverted over the
+   period (the command that brings the bearing there at the period's end);
+3. **close** after lock-up: the bearing ramps to ``x_to_closed_m``.
+
+The variants differ only in the cushion-spring temperature they assume and
+in whether they learn the kiss point:
 
 ============================  ===============================================  ==========
 variant                        theta_cs used                                    kiss point
@@ -15,6 +37,8 @@ variant                        theta_cs used                                    
 ``aware_estimated``            observer (:mod:`.observer`), mismatched          model
 ``adaptive``                   table reference                                  learned
 ``adaptive_aware_estimated``   observer                                         learned, shifted by delta_kiss(theta estimate)
+``production``                 EKF on its own thermal network (:mod:`.production`:   EKF state, with mu
+                               its own sensors, ECU torque, estimated mass/grade)
 ============================  ===============================================  ==========
 
 The learned kiss point is kept as an offset to the model's kiss point at the
@@ -25,6 +49,7 @@ uncompensated one keeps it fixed.
 from __future__ import annotations
 
 import copy
+import math
 from dataclasses import dataclass
 
 from ..model import KELVIN, ClutchParameters, SpringTable, outputs, thermal_step, x_to_for_torque
@@ -51,7 +76,7 @@ VARIANTS = {v.name: v for v in (
     Variant("production", "ekf", False),     # see .production: sensors, EKF, adaptations, mass and grade
 )}
 
-OPEN, LAUNCH, CLOSE = 0, 1, 2     #: TCU phases
+OPEN, LAUNCH, CLOSE, PREFILL = 0, 1, 2, 3     #: TCU phases
 
 
 class TcuController:
@@ -68,11 +93,14 @@ class TcuController:
     theta0 : float
         Temperature at the start, K (the car is thermally soaked).
     j_d_kg_m2, t_load_Nm : float
-        For the kiss-point learner (see :mod:`.adaptation`).
+        Disc and vehicle inertia as the clutch feels it (kg m2) and the clutch torque
+        holding the car (N.m): known to the TCU (lock-up torque, kiss-point learner).
+    j_e_kg_m2, w_idle_rad_s : float
+        Engine inertia (kg m2) and idle speed (rad/s).
     """
 
     def __init__(self, variant: Variant, sc: Scenario, table: SpringTable, p: ClutchParameters, theta0: float,
-                 j_d_kg_m2: float, t_load_Nm: float):
+                 j_d_kg_m2: float, t_load_Nm: float, j_e_kg_m2: float = 0.25, w_idle_rad_s: float = 83.78):
         if table.friction is not None:          # the TCU's model has the nominal, constant mu
             table = copy.copy(table)
             table.friction = None
@@ -86,7 +114,17 @@ class TcuController:
                         if variant.adaptive else None)
         self.offset = 0.0               #: learned kiss point minus the model's at the assumed temperature, m
         self.phase, self.t_dem, self.x_cmd = OPEN, 0.0, 0.0
+        #: demand rate over the coming period (the TCU's extrapolation), N.m/s
+        self.t_rate = 0.0
         self.launch = 0
+        self.j_d, self.t_load, self.j_e, self.w_idle = j_d_kg_m2, t_load_Nm, j_e_kg_m2, w_idle_rad_s
+        tc = sc.tcu
+        self.act = math.exp(-tc.period_s / tc.actuator_time_constant_s) if tc.actuator_time_constant_s > 0 else 0.0
+        self.w_ref = self.s_ref = self.integral = 0.0
+        self.sync = False
+        self.rate = self.t_sync = self.jerk = 0.0
+        self.x_close = 0.0
+        self.t_closed = math.inf
         #: the assumed theta_cs (K) and believed kiss point (m) after the last cycle
         self.theta_now, self.kiss_now = self.theta_used(), self.kiss()
 
@@ -129,14 +167,57 @@ class TcuController:
         self.learner.estimates.append((self.launch, estimate))
         self.offset += self.learner.gain * (estimate - self.kiss())
 
-    def cycle(self, launch: int, tl: float, slot_s: float, has_next: bool, locked_once: bool,
-              w_e: float, w_d: float, x_meas: float, theta_cm_true: float) -> None:
-        """One TCU period: update estimates, learn, set ``phase``, ``t_dem`` (N.m) and ``x_cmd`` (m).
+    def _to_actuator(self, x_target: float, x_meas: float) -> float:
+        """Command that brings a first-order actuator from ``x_meas`` to ``x_target`` in one period, m
+        (within the actuator's travel)."""
+        u = (x_target - self.act * x_meas) / (1.0 - self.act)
+        hi = self.sc.tcu.x_to_closed_m
+        return 0.0 if u < 0.0 else (hi if u > hi else u)
 
-        ``launch`` (1-based) and ``tl`` (s since its start, slot length
-        ``slot_s``); ``locked_once``: lock-up reached in this launch;
-        ``w_e``, ``w_d`` measured speeds (rad/s); ``x_meas`` measured bearing
-        position (m); ``theta_cm_true`` is used by the ideal ``aware`` TCU only.
+    def _demand(self, level: str, w_e: float, w_d: float, t_e: float) -> float:
+        """The launch's clutch-torque demand for this period, N.m (updates references and integral)."""
+        tc, drv, dt = self.sc.tcu, self.sc.driver, self.period
+        slip = w_e - w_d
+        kp, ki = tc.speed_kp_Nm_per_rad_s, tc.speed_ki_Nm_per_rad
+        k = 1.0 / self.j_e + 1.0 / self.j_d
+        t_lock = (self.j_d * t_e + self.j_e * self.t_load) / (self.j_e + self.j_d)
+        if not self.sync and slip <= tc.sync_slip_rad_s and self.t_dem > 0.0:
+            # the slip rate falls linearly from the one the present demand gives (no torque step) to the
+            # lock-up rate, over the time that closes the slip: a parabolic landing
+            r_end = tc.lockup_slip_rate_rad_s2
+            r0 = max(r_end, k * (self.t_dem - t_lock))
+            self.sync, self.s_ref, self.rate, self.t_sync = True, slip, r0, 2.0 * slip / (r0 + r_end)
+            self.jerk = (r0 - r_end) / self.t_sync
+        if self.sync:
+            if self.t_sync > 0.0:
+                self.rate -= self.jerk * dt
+                self.t_sync -= dt
+            ds = -self.rate
+            self.s_ref += ds * dt
+            e = slip - self.s_ref
+            self.integral += ki * e * dt
+            return t_lock - ds / k + kp * e + self.integral
+        if level == "creep":
+            return drv.creep_torque_Nm
+        w_t = self.w_idle + drv.pedal(level) * (tc.engine_speed_full_pedal_rpm * math.pi / 30.0 - self.w_idle)
+        dw = (w_t - self.w_ref) / tc.engine_speed_time_constant_s
+        self.w_ref += dw * dt
+        e = w_e - self.w_ref
+        demand = t_e - self.j_e * dw + kp * e + self.integral
+        if demand < min(self.t_dem + tc.torque_ramp_Nm_per_s * dt, self.t_closed):
+            self.integral += ki * e * dt                     # anti-windup: not while rate- or capacity-limited
+        return demand
+
+    def cycle(self, launch: int, tl: float, locked_once: bool, w_e: float, w_d: float, x_meas: float,
+              theta_cm_true: float, t_e: float = 0.0, level: str = "hard", w_v: float | None = None) -> None:
+        """One TCU period: update estimates, learn, set ``phase``, ``t_dem`` (N.m), ``t_rate`` and ``x_cmd`` (m).
+
+        ``launch`` (1-based) and ``tl`` (s since its slot started, pre-fill
+        first); ``locked_once``: lock-up reached in this launch; ``w_e``,
+        ``w_d`` measured speeds (rad/s); ``x_meas`` measured bearing position
+        (m); ``theta_cm_true`` is used by the ideal ``aware`` TCU only;
+        ``t_e`` the engine's torque signal (N.m); ``level`` the driver's demand level; ``w_v`` the
+        measured wheel speed at the disc (rad/s, the kiss-point learner's input; default ``w_d``).
         """
         tc = self.sc.tcu
         if self.v.temperature == "ideal":
@@ -146,22 +227,35 @@ class TcuController:
             self.observer.update(self.model_torque(x_meas) * slip if self.phase == LAUNCH else 0.0)
         if launch != self.launch:
             self.launch = launch
+            self.sync, self.integral, self.t_dem, self.w_ref = False, 0.0, 0.0, w_e
+            self.t_closed = math.inf
             if self.learner is not None:
                 self.learner.start_launch()
-        if tl < tc.drive_time_s:
-            if not locked_once:
-                self.phase = LAUNCH
-                self.t_dem = min(tc.torque_target_Nm, tc.torque_ramp_Nm_per_s * tl)
-                if self.learner is not None:
-                    torque = self.learner.sample(w_d, x_meas)
-                    if torque is not None:
-                        self._learn(torque, self.learner.mean_position())
-                self.x_cmd = self.command(self.t_dem)
-            else:
-                self.phase = CLOSE
-                self.x_cmd = min(tc.x_to_closed_m, self.x_cmd + tc.close_rate_m_per_s * self.period)
-        elif has_next and tl >= slot_s - tc.prefill_s:
-            self.phase, self.t_dem, self.x_cmd = OPEN, 0.0, self.command(0.0)    # pre-fill to first contact
+        t_launch = tl - tc.prefill_s
+        t_prev = self.t_dem
+        if 0.0 <= t_launch < tc.drive_time_s and not locked_once:
+            self.t_closed = self.model_torque(tc.x_to_closed_m)      # the largest torque it believes it has
+        if t_launch < 0.0:
+            self.phase, self.t_dem, self.w_ref = PREFILL, 0.0, w_e                 # pre-fill to first contact
+            self.x_cmd = self._to_actuator(self.command(0.0), x_meas)
+        elif t_launch < tc.drive_time_s and not locked_once:
+            self.phase = LAUNCH
+            demand = self._demand(level, w_e, w_d, t_e)
+            limit = min(t_prev + tc.torque_ramp_Nm_per_s * self.period, self.t_closed)
+            self.t_dem = 0.0 if demand < 0.0 else (limit if demand > limit else demand)
+            if self.learner is not None:
+                torque = self.learner.sample(w_d if w_v is None else w_v, x_meas)
+                if torque is not None:
+                    self._learn(torque, self.learner.mean_position())
+            self.t_rate = (self.t_dem - t_prev) / self.period
+            self.x_cmd = self._to_actuator(self.command(max(0.0, self.t_dem + self.t_rate * self.period)), x_meas)
+            self.x_close = x_meas
+        elif t_launch < tc.drive_time_s:
+            self.phase, self.t_rate = CLOSE, 0.0
+            self.x_close = min(tc.x_to_closed_m, self.x_close + tc.close_rate_m_per_s * self.period)
+            self.x_cmd = self.x_close
         else:
-            self.phase, self.t_dem, self.x_cmd = OPEN, 0.0, 0.0
+            self.phase, self.t_dem, self.t_rate, self.x_cmd = OPEN, 0.0, 0.0, 0.0
+        if self.phase != LAUNCH:
+            self.t_rate = 0.0
         self.theta_now, self.kiss_now = self.theta_used(), self.kiss()

@@ -59,16 +59,17 @@ class Sensors(Checked):
 class Adaptation(Checked):
     """Kiss-point learning from the onset of torque transfer in each launch.
 
-    Once the measured disc speed has exceeded ``onset_speed_rad_s`` for
-    ``window_s``, the mean clutch torque over that window follows from the
-    disc's acceleration, ``J_d dw_d/dt + T_load``; the learner compares it with
+    Once the measured wheel speed (at the disc) has exceeded ``onset_speed_rad_s``
+    for ``window_s``, the mean clutch torque over that window follows from its
+    rise, ``J_d dw/dt + T_load`` (a window of a shuffle period averages the
+    drive shafts' oscillation out); the learner compares it with
     its model's torque at the measured bearing positions and moves its kiss
     point by ``gain`` times the difference (in bearing travel).
     """
 
     gain: float = 0.7
     onset_speed_rad_s: float = 0.5
-    window_s: float = 0.05
+    window_s: float = 0.2
 
     _section = "adaptation"
 

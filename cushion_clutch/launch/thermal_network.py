@@ -38,8 +38,8 @@ from typing import Iterable
 import numpy as np
 
 from ..config import Checked
+from ..model import KELVIN
 
-KELVIN = 273.15
 #: node order of every state vector
 NODES = ("flywheel", "facing_flywheel_side", "facing_plate_side", "pressure_plate")
 

@@ -162,7 +162,7 @@ def _launch(args: argparse.Namespace) -> int:
 
     sc = load_scenario(scenario_path(args.scenario))
     out = _guard_out(Path(args.out), args.force)
-    table = load_table(args.tables)
+    table = load_table(sc.tables_path("tcu") or args.tables)     # a scenario may name the TCUs' table set
     with OutputSet(out, "launch") as stage:                # checks --out before the simulation
         fmu = (check_fmu(args.fmu) if args.fmu else
                build_plant_fmu(Path(args.tables), sc, stage / "CushionClutch.fmu", backend=args.backend))

@@ -22,7 +22,7 @@ def test_summary_has_a_row_per_variant(tmp_path):
     sc = short(load_scenario(), launches=2, initial_degC=200.0)
     results = run_all(fmu, sc, load_table())
     assert list(results) == list(VARIANTS) == ["naive", "aware", "aware_estimated", "adaptive",
-                                              "adaptive_aware_estimated"]
+                                              "adaptive_aware_estimated", "production"]
     for group in ("hot", "all"):
         assert [r["tcu"] for r in summary_rows(results) if r["group"] == group] == list(VARIANTS)
     table = summary_table(results)
@@ -30,7 +30,7 @@ def test_summary_has_a_row_per_variant(tmp_path):
     paths = write_outputs(results, tmp_path / "out")
     with open(tmp_path / "out" / "launch_metrics.csv") as fh:
         rows = list(csv.DictReader(fh))
-    assert tuple(rows[0]) == METRIC_COLUMNS and {r["tcu"] for r in rows} == set(VARIANTS) and len(rows) == 10
+    assert tuple(rows[0]) == METRIC_COLUMNS and {r["tcu"] for r in rows} == set(VARIANTS) and len(rows) == 12
     assert all(p.exists() and p.stat().st_size > 0 for p in paths)
 
 

@@ -17,7 +17,9 @@ SPRING_FILES = (FORCE_DEFLECTION, KISS_POINT, METADATA)
 
 
 def plant_tables(tables: Path, sc: Scenario, work: Path) -> Path:
-    """Folder of the plant's tables: ``tables`` itself, or a copy in ``work`` with the scenario's friction table."""
+    """Folder of the plant's tables: ``tables`` (or the scenario's ``clutch.plant_tables``), or a copy in
+    ``work`` with the scenario's friction table."""
+    tables = sc.tables_path("plant") or tables
     friction = sc.friction_path()
     if friction is None:
         return Path(tables)

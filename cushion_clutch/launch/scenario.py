@@ -11,7 +11,11 @@ from typing import Iterable
 from ..config import Checked, build_checked, load_toml, range_problem
 from ..data import DEFAULT_SCENARIO
 from ..errors import ParameterError
+from .ekf import EkfParams, TcuNetworkParams
+from .mass_grade import MassGrade
+from .sensors import ProductionSensors
 from .tcu_params import Adaptation, Observer, Sensors
+from .thermal_network import PlantThermal
 
 
 
@@ -221,13 +225,18 @@ class Clutch(Checked):
     friction_csv: str = ""
     x_kiss_offset_m: float = 0.0
     """the plant's kiss point minus the TCU's nominal one, at the bearing (tolerances, wear), m"""
+    plant_tables: str = ""
+    """table-set folder of the plant (relative to the scenario's folder); "" = the command's --tables"""
+    tcu_tables: str = ""
+    """table-set folder the TCUs believe; "" = the command's --tables"""
 
     _section = "clutch"
 
     def _problems(self) -> Iterable[str]:
         yield from self._ranges({"x_kiss_offset_m": (-0.005, 0.005)})
-        if not isinstance(self.friction_csv, str):
-            yield f"clutch.friction_csv = {self.friction_csv!r}: must be a file name or \"\""
+        for key in ("friction_csv", "plant_tables", "tcu_tables"):
+            if not isinstance(getattr(self, key), str):
+                yield f"clutch.{key} = {getattr(self, key)!r}: must be a file or folder name or \"\""
 
 
 @dataclass(frozen=True)
@@ -282,6 +291,11 @@ class Scenario(Checked):
     observer: Observer = field(default_factory=Observer)
     sensors: Sensors = field(default_factory=Sensors)
     adaptation: Adaptation = field(default_factory=Adaptation)
+    plant_thermal: PlantThermal = field(default_factory=PlantThermal)
+    tcu_sensors: ProductionSensors = field(default_factory=ProductionSensors)
+    tcu_thermal: TcuNetworkParams = field(default_factory=TcuNetworkParams)
+    ekf: EkfParams = field(default_factory=EkfParams)
+    mass_grade: MassGrade = field(default_factory=MassGrade)
     folder: str = ""
     """folder of the scenario file (set by :func:`load_scenario`), for relative file names"""
 
@@ -290,6 +304,14 @@ class Scenario(Checked):
             if period <= self.tcu.prefill_s + self.tcu.drive_time_s + 5.0:
                 yield (f"run.{key} = {period!r}: must exceed tcu.prefill_s + tcu.drive_time_s + 5 s "
                        "(time to brake to a stop)")
+
+    def tables_path(self, which: str) -> Path | None:
+        """``clutch.plant_tables`` or ``clutch.tcu_tables`` (``which`` = "plant" | "tcu") as a folder, or None."""
+        name = getattr(self.clutch, f"{which}_tables")
+        if not name:
+            return None
+        path = Path(name)
+        return path if path.is_absolute() else Path(self.folder or ".") / path
 
     def friction_path(self) -> Path | None:
         """The plant's friction table file, or None (mu constant)."""
@@ -300,7 +322,7 @@ class Scenario(Checked):
 
 
 def scenario_path(name: str | Path) -> Path:
-    """A scenario file: ``name`` itself, or the shipped ``<name>.toml`` (default, creep, cooldown, fade)."""
+    """A scenario file: ``name`` itself, or the shipped ``<name>.toml`` (default, creep, cooldown, fade, wear, tolerance)."""
     path = Path(name)
     shipped = DEFAULT_SCENARIO.parent / f"{name}.toml"
     return shipped if not path.exists() and path.suffix == "" and shipped.is_file() else path
@@ -309,7 +331,7 @@ def scenario_path(name: str | Path) -> Path:
 def load_scenario(path: str | Path = DEFAULT_SCENARIO) -> Scenario:
     """Load and check a scenario TOML file (unknown keys and bad ranges rejected)."""
     if not Path(path).is_file():
-        raise ParameterError([f"scenario file {path} not found (shipped: default, creep, cooldown, fade)"])
+        raise ParameterError([f"scenario file {path} not found (shipped: default, creep, cooldown, fade, wear, tolerance)"])
     data = load_toml(path)
     if "folder" in data:
         raise ParameterError(["folder: unknown key"], str(path))
@@ -318,4 +340,9 @@ def load_scenario(path: str | Path = DEFAULT_SCENARIO) -> Scenario:
     fr = sc.friction_path()
     if fr is not None and not fr.is_file():
         raise ParameterError([f"clutch.friction_csv = {sc.clutch.friction_csv!r}: file {fr} not found"], str(path))
+    for which in ("plant", "tcu"):
+        folder = sc.tables_path(which)
+        if folder is not None and not folder.is_dir():
+            raise ParameterError([f"clutch.{which}_tables = {getattr(sc.clutch, which + '_tables')!r}: "
+                                  f"folder {folder} not found"], str(path))
     return sc

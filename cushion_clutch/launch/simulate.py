@@ -31,8 +31,10 @@ from .metrics import LaunchRecord
 from .observer import SpeedSensors
 from .scenario import Scenario
 from .engine import RPM
+from .production import ProductionTcu
 from .tcu import CLOSE, LAUNCH, PREFILL, VARIANTS, TcuController
 from .thermal import FacingModel
+from .thermal_network import ThermalNetwork
 
 __all__ = ["COLUMNS", "Energy", "LaunchResult", "simulate_launches"]
 
@@ -82,7 +84,18 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
     p = ClutchParameters(theta_a=theta_a, theta_cs_start=theta0)
     engine = EngineGovernor(sc.engine, h)
     dl = Driveline(sc, engine.w_idle)
-    ctl = TcuController(VARIANTS[name], sc, table, p, theta0, dl.j_d, dl.t_load_rest, dl.j_e, engine.w_idle)
+    if name == "production":
+        ctl = ProductionTcu(VARIANTS[name], sc, table, p, theta0, dl.j_d, dl.t_load_rest, dl.j_e, engine.w_idle,
+                            sc.tcu_sensors, sc.tcu_thermal, sc.ekf, sc.mass_grade,
+                            (dl.i_tot, dl.r, dl.eta, sc.driveline.disc_inertia_kg_m2, sc.vehicle.rolling_resistance,
+                             dl.air))
+        sense = ctl.sense
+    else:
+        ctl = TcuController(VARIANTS[name], sc, table, p, theta0, dl.j_d, dl.t_load_rest, dl.j_e, engine.w_idle)
+        sense = None
+    net = ThermalNetwork(sc.plant_thermal, theta_a, theta0) if sc.plant_thermal.enabled else None
+    net_every = max(1, int(round(tc.period_s / h)))     # the network's time constants are seconds: 10 ms steps
+    net_n, net_e = 0, 0.0
     sensors = SpeedSensors(sc.sensors)
     facing = FacingModel(fac.capacity_J_per_K, fac.loss_W_per_K, fac.heat_share, theta_a, h)
     profile = _facing_profile(fac.profile_csv) if fac.profile_csv else None
@@ -133,6 +146,8 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
             cycled = countdown == 0
             if cycled:                                           # -- TCU cycle
                 countdown = tcu_every
+                if sense is not None:                             # production TCU: its own sensors
+                    sense(t, dl.w_e, dl.w_d, t_e)
                 ctl.cycle(n + 1, tl, rec.lock_time is not None, sensors.read(dl.w_e), sensors.read(dl.w_d),
                           x_act, theta_cm, t_e, levels[n], sensors.read(dl.v * r_to_disc))
                 phase = ctl.phase
@@ -162,7 +177,14 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
                     rec.lock_time = tl + h - prefill
             slip_J = dl.slip_J
             theta_cm_step = theta_cm
-            if slip_J != 0.0:
+            if net is not None:
+                rec.slip_J += slip_J
+                net_e += slip_J
+                net_n += 1
+                if net_n == net_every:
+                    net.step(net_n * h, net_e / (net_n * h), dl.w_e, dl.w_d, engaged)
+                    theta_cm, net_n, net_e = net.theta_cm, 0, 0.0
+            elif slip_J != 0.0:
                 rec.slip_J += slip_J
                 theta_cm = profile(t + h) if profile is not None else facing_step(theta_cm, dl.slip_W)
             elif cool_free:

@@ -37,6 +37,8 @@ variant                        theta_cs used                                    
 ``aware_estimated``            observer (:mod:`.observer`), mismatched          model
 ``adaptive``                   table reference                                  learned
 ``adaptive_aware_estimated``   observer                                         learned, shifted by delta_kiss(theta estimate)
+``production``                 EKF on its own thermal network (:mod:`.production`:   EKF state, with mu
+                               its own sensors, ECU torque, estimated mass/grade)
 ============================  ===============================================  ==========
 
 The learned kiss point is kept as an offset to the model's kiss point at the
@@ -71,6 +73,7 @@ VARIANTS = {v.name: v for v in (
     Variant("aware_estimated", "estimated", False),
     Variant("adaptive", "none", True),
     Variant("adaptive_aware_estimated", "estimated", True),
+    Variant("production", "ekf", False),     # see .production: sensors, EKF, adaptations, mass and grade
 )}
 
 OPEN, LAUNCH, CLOSE, PREFILL = 0, 1, 2, 3     #: TCU phases

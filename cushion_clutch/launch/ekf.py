@@ -1,0 +1,289 @@
+"""The production TCU's estimator: an extended Kalman filter on its own thermal network, with touch-point and mu adaptation.
+
+State (K, K, K, K, K, m, 1)::
+
+    s = [theta_fw, theta_f1, theta_f2, theta_pp, theta_cs, dx_kiss, mu_scale]
+
+* **Prediction**: the TCU's own :class:`~.thermal_network.ThermalNetwork`
+  (parameters ``[tcu_thermal]``, deliberately not the plant's) heated by
+  ``P = T_est w_slip``, the engine control unit's torque estimate times the
+  measured slip speed, plus the cushion-spring ODE with the TCU's U, H, C
+  (``C dtheta_cs/dt = U (theta_cm - theta_cs) + H (theta_a - theta_cs)``,
+  ``theta_cm`` the mean of the facings). ``dx_kiss`` (touch-point offset at the
+  bearing) and ``mu_scale`` (friction relative to the nominal mu) are random
+  walks. Process noise: ``heat_share_sd`` of each node's slip heat, plus the
+  random walks.
+* **Measurement** (during slip): the clutch torque from the engine side,
+  ``T_c = T_est - J_e dw_e/dt``, against the model
+  ``h(s) = mu_scale T_model(x_meas - dx_kiss, theta_cs)`` (the TCU's
+  characteristic, nominal mu); the Jacobian is taken numerically.
+* **Excitation conditions** (each parameter is corrected only while its own
+  condition holds; the others' gains are set to zero and the covariance
+  update uses the Joseph form, which stays valid for any gain):
+
+  - all: slip speed above ``slip_min_rad_s`` and the TCU in its launch phase;
+  - touch point ``dx_kiss``: model torque in ``[touch_torque_min_Nm, touch_torque_max_Nm]``
+    (near the kiss point the torque is most sensitive to the position, and a
+    friction error matters least);
+  - friction ``mu_scale``: model torque above ``mu_torque_min_Nm`` (there a
+    relative friction error is large in N.m and the position error small).
+
+  The bands overlap by default (8-80 and above 40 N.m): on a progressive
+  characteristic ``dT/dx`` grows almost in proportion to ``T``, so a kiss
+  offset and a friction scale look alike (their Jacobian columns are nearly
+  collinear) and are separated only by the curve's shape over the whole
+  ramp. Disjoint bands make the two parameters trade errors and converge
+  slowly over many launches; the characteristic itself (what the TCU
+  commands through) converges within a launch either way;
+  - temperatures: all of the above (``temperature_update = false`` leaves the
+    thermal states to the prediction alone).
+
+A torque residual larger than ``gate_sd`` standard deviations is rejected.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Iterable
+
+import numpy as np
+
+from ..config import Checked
+from ..model import ClutchParameters, SpringTable, outputs
+from .thermal_network import NetworkParams, ThermalNetwork
+
+IX_CS, IX_DX, IX_MU = 4, 5, 6   #: state indices
+#: speed band of the cached discretisation (convection), rad/s
+SPEED_BAND = 10.0
+
+
+@dataclass(frozen=True)
+class TcuNetworkParams(NetworkParams):
+    """Section ``[tcu_thermal]``: the TCU's own thermal network, mismatched with the plant's by default."""
+
+    flywheel_capacity_J_per_K: float = 2900.0
+    pressure_plate_capacity_J_per_K: float = 1700.0
+    facing_capacity_J_per_K: float = 220.0
+    contact_W_per_K: float = 6.5
+    engine_W_per_K: float = 1.6
+    spring_U_W_per_K: float = 0.1
+    spring_H_W_per_K: float = 0.04
+    spring_C_J_per_K: float = 1.0
+
+    _section = "tcu_thermal"
+
+    def _problems(self) -> Iterable[str]:
+        yield from super()._problems()
+        yield from self._ranges({"spring_U_W_per_K": (0.0, 1e4), "spring_H_W_per_K": (0.0, 1e4),
+                                 "spring_C_J_per_K": (0.0, 1e6, True)})
+        if self.spring_U_W_per_K + self.spring_H_W_per_K <= 0.0:
+            yield "tcu_thermal.spring_U_W_per_K + spring_H_W_per_K: must be > 0"
+
+
+@dataclass(frozen=True)
+class EkfParams(Checked):
+    """Section ``[ekf]``: noise, excitation conditions and the update period (SI)."""
+
+    period_s: float = 0.1
+    theta0_sd_K: float = 5.0
+    heat_share_sd: float = 0.3
+    """relative uncertainty of each node's slip heat"""
+    theta_walk_K2_per_s: float = 0.01
+    kiss_sd_m: float = 0.4e-3
+    """prior sd of the touch-point offset"""
+    kiss_walk_m2_per_s: float = 1e-12
+    mu_sd: float = 0.1
+    mu_walk_per_s: float = 1e-6
+    torque_sd_Nm: float = 8.0
+    """measurement noise of the engine-side clutch torque"""
+    slip_min_rad_s: float = 10.0
+    touch_torque_min_Nm: float = 8.0
+    touch_torque_max_Nm: float = 80.0
+    mu_torque_min_Nm: float = 40.0
+    gate_sd: float = 4.0
+    mu_deadband: float = 0.05
+    """the engine torque estimate's stated gain accuracy: a learned mu_scale within 1 +- this is not applied"""
+    temperature_update: bool = True
+
+    _section = "ekf"
+
+    def _problems(self) -> Iterable[str]:
+        yield from self._ranges({
+            "period_s": (1e-3, 10.0), "theta0_sd_K": (0.0, 500.0), "heat_share_sd": (0.0, 10.0),
+            "theta_walk_K2_per_s": (0.0, 1e4), "kiss_sd_m": (0.0, 0.01), "kiss_walk_m2_per_s": (0.0, 1e-3),
+            "mu_sd": (0.0, 1.0), "mu_walk_per_s": (0.0, 1.0), "torque_sd_Nm": (1e-3, 1e3),
+            "slip_min_rad_s": (0.0, 1e3), "touch_torque_min_Nm": (0.0, 1e4), "touch_torque_max_Nm": (0.0, 1e4),
+            "mu_torque_min_Nm": (0.0, 1e4), "gate_sd": (1.0, 100.0, True),
+            "mu_deadband": (0.0, 0.5)})
+        if self.touch_torque_max_Nm <= self.touch_torque_min_Nm:
+            yield "ekf.touch_torque_max_Nm: must exceed ekf.touch_torque_min_Nm"
+
+
+class ClutchEkf:
+    """EKF of the production TCU.
+
+    Parameters
+    ----------
+    net : TcuNetworkParams
+    e : EkfParams
+    table : SpringTable
+        The TCU's characteristic (nominal; its friction table is ignored).
+    p : ClutchParameters
+        The TCU's clutch parameters (nominal mu, lever ratio, kiss point at reference).
+    theta_a, theta0 : float
+        Measured ambient and starting temperature, K.
+    """
+
+    def __init__(self, net: TcuNetworkParams, e: EkfParams, table: SpringTable, p: ClutchParameters,
+                 theta_a: float, theta0: float):
+        self.net, self.e, self.table, self.p = net, e, table, p
+        self.model = ThermalNetwork(net, theta_a, theta0)
+        self.theta_a = theta_a
+        self.s = np.array([theta0] * 5 + [0.0, 1.0])
+        self.P = np.diag([e.theta0_sd_K ** 2] * 5 + [e.kiss_sd_m ** 2, e.mu_sd ** 2])
+        self.q_rw = np.array([e.theta_walk_K2_per_s] * 5 + [e.kiss_walk_m2_per_s, e.mu_walk_per_s])
+        self.energy_J = 0.0
+        self.t_acc = 0.0
+        self._cache: dict = {}
+        #: count of accepted measurement updates, and of rejected ones (gate)
+        self.accepted = self.rejected = 0
+
+    # --- estimates -----------------------------------------------------------------------------
+    @property
+    def theta_cs(self) -> float:
+        """Estimated cushion-spring temperature, K."""
+        return float(self.s[IX_CS])
+
+    @property
+    def theta_cm(self) -> float:
+        """Estimated facing temperature (mean of both facings), K."""
+        return float(0.5 * (self.s[1] + self.s[2]))
+
+    @property
+    def dx_kiss(self) -> float:
+        """Learned touch-point offset at the bearing, m."""
+        return float(self.s[IX_DX])
+
+    @property
+    def mu_scale(self) -> float:
+        """Learned friction relative to the nominal mu, 1."""
+        return float(self.s[IX_MU])
+
+    @property
+    def mu_used(self) -> float:
+        """The friction scale the TCU applies: ``mu_scale`` outside a dead band of ``mu_deadband`` around 1.
+
+        ``mu_scale`` is learned against the engine control unit's torque
+        estimate, so it carries that estimate's gain error; a deviation within
+        the estimate's stated accuracy is not attributed to the clutch.
+        """
+        d = self.s[IX_MU] - 1.0
+        band = self.e.mu_deadband
+        return 1.0 + (d - band if d > band else (d + band if d < -band else 0.0))
+
+    def model_torque(self, x_m: float, s: np.ndarray | None = None, mu: float | None = None) -> float:
+        """The TCU's torque at bearing position ``x_m`` (m) with state ``s`` (default: the estimate), N.m.
+
+        ``mu`` replaces the state's friction scale (e.g. :attr:`mu_used`).
+        """
+        s = self.s if s is None else s
+        th = min(max(float(s[IX_CS]), self.table.theta_min_K), self.table.theta_max_K)
+        return (float(s[IX_MU]) if mu is None else mu) * outputs(x_m - float(s[IX_DX]), th, self.table, self.p).torque
+
+    # --- prediction ----------------------------------------------------------------------------
+    def _jacobian_f(self, w_engine: float, w_disc: float, clamped: bool) -> tuple[np.ndarray, np.ndarray]:
+        a4, b4 = self.model.matrices(w_engine, w_disc, clamped)
+        n = self.net
+        a = np.zeros((7, 7))
+        b = np.zeros(7)
+        a[:4, :4], b[:4] = a4, b4
+        c = n.spring_C_J_per_K
+        a[IX_CS, 1] = a[IX_CS, 2] = 0.5 * n.spring_U_W_per_K / c
+        a[IX_CS, IX_CS] = -(n.spring_U_W_per_K + n.spring_H_W_per_K) / c
+        b[IX_CS] = n.spring_H_W_per_K * self.theta_a / c
+        return a, b
+
+    def accumulate(self, dt: float, p_slip_W: float) -> None:
+        """Add one TCU period ``dt`` (s) of slip power (W) to the heat of the next prediction."""
+        self.energy_J += p_slip_W * dt
+        self.t_acc += dt
+
+    def due(self) -> bool:
+        """True once a full EKF period has accumulated."""
+        return self.t_acc >= self.e.period_s - 1e-12
+
+    def _discrete(self, w_engine: float, w_disc: float, clamped: bool, dt: float) -> tuple:
+        """``(F, G, b)``: ``s+ = F s + G (b + q)`` for the held inputs; cached per speed band.
+
+        The convection's speed is taken at the centre of a ``SPEED_BAND`` (rad/s) band.
+        """
+        key = (clamped, round(w_engine / SPEED_BAND), round(w_disc / SPEED_BAND), round(dt * 1e4))
+        hit = self._cache.get(key)
+        if hit is None:
+            a, b = self._jacobian_f(key[1] * SPEED_BAND, key[2] * SPEED_BAND, clamped)
+            # exp(A dt) and int_0^dt exp(A s) ds by their series to (A dt)^5: the EKF period is far
+            # below the network's time constants (a test checks the prediction against the plant network)
+            ad, term, f, g = a * dt, np.eye(7), np.eye(7), np.eye(7) * dt
+            for k in range(1, 6):
+                term = term @ ad / k
+                f = f + term
+                g = g + term * dt / (k + 1)
+            hit = self._cache[key] = (f, g, b)
+        return hit
+
+    def predict(self, w_engine: float, w_disc: float, clamped: bool) -> None:
+        """Advance the accumulated time with its mean slip power (the speeds and clamp state held)."""
+        dt = self.t_acc
+        if dt <= 0.0:
+            return
+        p_mean = self.energy_J / dt
+        f, g, b = self._discrete(w_engine, w_disc, clamped, dt)
+        q_heat = np.zeros(7)
+        if p_mean != 0.0:
+            q_heat[:4] = np.array(self.model.heat_inputs(p_mean)) / self.model.caps
+        self.s = f @ self.s + g @ (b + q_heat)
+        qn = (self.e.heat_share_sd * q_heat * dt) ** 2 + self.q_rw * dt
+        self.P = f @ self.P @ f.T + np.diag(qn)
+        self.energy_J = self.t_acc = 0.0
+
+    # --- measurement ---------------------------------------------------------------------------
+    def correct(self, torque_meas_Nm: float, x_meas_m: float, w_slip_rad_s: float, launching: bool,
+                torque_sd_Nm: float | None = None) -> bool:
+        """Measurement update with a clutch torque (N.m) at the measured position (m); True if accepted.
+
+        Applies the excitation conditions of the module docstring; ``torque_sd_Nm``
+        overrides the measurement noise (another source of the torque).
+        """
+        e = self.e
+        if not launching or abs(w_slip_rad_s) < e.slip_min_rad_s:
+            return False
+        h0 = self.model_torque(x_meas_m)
+        mask = np.zeros(7, dtype=bool)
+        if e.touch_torque_min_Nm <= h0 <= e.touch_torque_max_Nm:
+            mask[IX_DX] = True
+        if h0 >= e.mu_torque_min_Nm:
+            mask[IX_MU] = True
+        if not mask.any():
+            return False
+        if e.temperature_update:
+            mask[:5] = True
+        hrow = np.zeros(7)
+        for i, d in ((IX_CS, 1.0), (IX_DX, 1e-6)):
+            sp = self.s.copy()
+            sp[i] += d
+            hrow[i] = (self.model_torque(x_meas_m, sp) - h0) / d
+        hrow[IX_MU] = h0 / max(self.mu_scale, 1e-6)
+        # h has no direct facing term: the facings are corrected through their covariance with theta_cs
+        r = (e.torque_sd_Nm if torque_sd_Nm is None else torque_sd_Nm) ** 2
+        s_inn = float(hrow @ self.P @ hrow) + r
+        nu = torque_meas_Nm - h0
+        if nu * nu > e.gate_sd ** 2 * s_inn:
+            self.rejected += 1
+            return False
+        k = self.P @ hrow / s_inn
+        k[~mask] = 0.0
+        self.s = self.s + k * nu
+        ikh = np.eye(7) - np.outer(k, hrow)
+        self.P = ikh @ self.P @ ikh.T + r * np.outer(k, k)
+        self.accepted += 1
+        return True

@@ -1,0 +1,160 @@
+"""The ``production`` TCU: only what a production TCU has.
+
+It shares the launch strategy of the other variants (:class:`~.tcu.TcuController`)
+and differs in what it knows:
+
+* **sensors** (:mod:`.sensors`): engine speed from the 60-2 crank wheel,
+  input-shaft speed from the Hall sensor, both read every TCU period; the
+  engine control unit's torque estimate (gain error, offset, noise); the
+  bearing position sensor (offset, noise, quantisation); ambient temperature.
+  The actuator's servo drives the *measured* position to the command, so the
+  bearing sits at ``command - position offset``.
+* **clutch torque** from the engine side: ``T_c = T_est - J_e dw_e/dt`` over a
+  window of ``WINDOW`` TCU periods (speed difference of the crank readings,
+  mean torque estimate and bearing position over the same window);
+* **slip power** for the thermal model: ``T_c`` times the measured slip speed;
+* **temperatures, touch point and friction** from the EKF (:mod:`.ekf`) on
+  the TCU's own thermal network;
+* **mass and grade** from the RLS (:mod:`.mass_grade`); once the load is
+  estimated, the vehicle-side clutch torque ``(m_eq a + F_load) r / (eta i)``
+  while the car moves in slip is a second EKF measurement (its noise
+  ``vehicle_torque_sd_Nm``), independent of the engine inertia term.
+
+The characteristic the TCU believes at a bearing position ``x`` is
+``mu_scale T_model(x + offset - dx_kiss, theta_cs)``; the torque scale it
+learns is the engine control unit's, so a gain error of the torque
+estimate is a gain error of the learned characteristic (no sensor of a
+production TCU measures the clutch torque otherwise).
+"""
+from __future__ import annotations
+
+import copy
+from collections import deque
+
+from ..model import ClutchParameters, SpringTable, x_to_for_torque
+from .ekf import ClutchEkf, EkfParams, TcuNetworkParams
+from .mass_grade import MassGrade, MassGradeEstimator
+from .sensors import ProductionSensors, TcuSensors
+from .tcu import LAUNCH, OPEN, TcuController, Variant
+
+#: TCU periods over which speeds are differentiated
+WINDOW = 5
+#: noise of the vehicle-side clutch torque measurement, N.m
+VEHICLE_TORQUE_SD_NM = 6.0
+
+
+class ProductionTcu(TcuController):
+    """The ``production`` variant; call :meth:`sense` and then :meth:`cycle` every TCU period.
+
+    Parameters
+    ----------
+    variant, sc, table, p, theta0, j_d_kg_m2, t_load_Nm, j_e_kg_m2, w_idle_rad_s
+        As :class:`~.tcu.TcuController`; ``j_d_kg_m2`` and ``t_load_Nm`` (the truth) are
+        not used: the TCU starts from its mass prior on level ground and then uses its estimates.
+    sensors, net, ekf, mass_grade
+        The TCU's sensors, own thermal network, EKF and RLS settings.
+    ratios : tuple of float
+        ``(i_tot, r_m, eta, j_disc_kg_m2, rolling, air_N_s2_per_m2)`` of the launch gear, nominal.
+    """
+
+    def __init__(self, variant: Variant, sc, table: SpringTable, p: ClutchParameters, theta0: float,
+                 j_d_kg_m2: float, t_load_Nm: float, j_e_kg_m2: float, w_idle_rad_s: float,
+                 sensors: ProductionSensors, net: TcuNetworkParams, ekf: EkfParams, mass_grade: MassGrade,
+                 ratios: tuple[float, ...]):
+        if table.friction is not None:          # the TCU's model has the nominal, constant mu
+            table = copy.copy(table)
+            table.friction = None
+        self.sens = TcuSensors(sensors)
+        theta_a_meas = self.sens.ambient(p.theta_a)
+        self.ekf = ClutchEkf(net, ekf, table, p, theta_a_meas, theta0)
+        self.rls = MassGradeEstimator(mass_grade, *ratios)
+        self.i_tot, self.r = ratios[0], ratios[1]
+        self.t = 0.0
+        self.t_engine = 0.0
+        self.w_prev = (0.0, 0.0)
+        self.hist: deque = deque(maxlen=WINDOW + 1)     # (w_e, w_v, T_est, x_meas)
+        self.x_offset = sensors.position_offset_m
+        super().__init__(variant, sc, table, p, theta0, self.rls.inertia_at_disc_kg_m2(),
+                         self.rls.holding_torque_Nm(), j_e_kg_m2, w_idle_rad_s)
+
+    # --- what the TCU believes ---------------------------------------------------------------------
+    def theta_used(self) -> float:
+        return self.ekf.theta_cs
+
+    def theta_cm_estimate(self) -> float:
+        return self.ekf.theta_cm
+
+    def kiss(self) -> float:
+        """The kiss point the TCU believes, in the true bearing frame, m."""
+        return self.model_kiss(self.ekf.theta_cs) + self.ekf.dx_kiss - self.x_offset
+
+    def command(self, torque_Nm: float) -> float:
+        """Bearing position for ``torque_Nm`` (N.m) as the position sensor reads it, m."""
+        th = min(max(self.ekf.theta_cs, self.table.theta_min_K), self.table.theta_max_K)
+        return x_to_for_torque(torque_Nm / max(self.ekf.mu_used, 1e-3), th, self.table, self.p) + self.ekf.dx_kiss
+
+    def model_torque(self, x_m: float) -> float:
+        """Torque the TCU believes at the true bearing position ``x_m`` (it sees it through its sensor), N.m."""
+        return self.ekf.model_torque(x_m + self.x_offset, mu=self.ekf.mu_used)
+
+    # --- sensing -------------------------------------------------------------------------------------
+    def sense(self, t: float, w_engine: float, w_disc: float, engine_torque_Nm: float) -> None:
+        """The true speeds (rad/s) and engine torque (N.m) at time ``t`` (s), once per TCU period.
+
+        The wheels turn by the trapezoidal angle since the last call; each edge's
+        time is interpolated with the period's mean speed (the speeds are smooth
+        on a 10 ms scale; the edge timing within a period is what a per-step
+        integration would refine).
+        """
+        dt = t - self.t
+        if dt > 0.0:
+            self.sens.advance(t, 0.5 * (self.w_prev[0] + w_engine), 0.5 * (self.w_prev[1] + w_disc), dt)
+        self.t, self.t_engine, self.w_prev = t, engine_torque_Nm, (w_engine, w_disc)
+
+    def _estimate(self, x_true: float, w_v: float) -> tuple[float, float, float, float]:
+        """Read the sensors, update the RLS and the EKF; the readings ``(w_e, w_d, x, T_est)``."""
+        s, e = self.sens, self.ekf
+        w_e, w_d = s.crank.read(self.t), s.shaft.read(self.t)
+        x_meas = s.position(x_true)
+        t_est = s.engine_torque(self.t_engine)
+        self.hist.append((w_e, w_v, t_est, x_meas))
+        readings = (w_e, w_d, x_meas, t_est)
+        launching = self.phase == LAUNCH
+        slip = w_e - w_d
+        if len(self.hist) <= WINDOW:
+            return readings
+        span = WINDOW * self.period
+        h0, h1 = self.hist[0], self.hist[-1]
+        items = list(self.hist)[1:]
+        t_est = sum(i[2] for i in items) / WINDOW
+        x_mean = sum(i[3] for i in items) / WINDOW
+        t_c = t_est - self.j_e * (h1[0] - h0[0]) / span if self.phase != OPEN else 0.0
+        v = h1[1] * self.r / self.i_tot               # wheel speed at the disc (ABS sensors)
+        a = (h1[1] - h0[1]) / span * self.r / self.i_tot
+        if self.phase != OPEN:
+            self.rls.update(t_c, v, a)
+        e.accumulate(self.period, max(t_c, 0.0) * abs(slip) if launching else 0.0)
+        if e.due():
+            e.predict(w_e, w_d, self.phase != OPEN)
+            if launching:
+                e.correct(t_c, x_mean, slip, True)
+                if self.rls.ready()[1] and h1[1] > 0.0 and h0[1] > 0.0:
+                    t_vehicle = self.rls.inertia_at_disc_kg_m2() * (h1[1] - h0[1]) / span \
+                        + self.rls.holding_torque_Nm()
+                    e.correct(t_vehicle, x_mean, slip, True, VEHICLE_TORQUE_SD_NM)
+        return readings
+
+    def cycle(self, launch: int, tl: float, locked_once: bool, w_e: float, w_d: float, x_meas: float,
+              theta_cm_true: float, t_e: float = 0.0, level: str = "hard", w_v: float | None = None) -> None:
+        """As :meth:`TcuController.cycle`, on the TCU's own readings.
+
+        The speeds, the torque signal and the true ``x_meas`` given are replaced
+        by the sensors' readings (:meth:`sense` fed the truth); the strategy runs
+        in the position sensor's frame and the servo's target is shifted back by
+        the sensor's offset (the servo drives the measured position).
+        """
+        w_e_m, w_d_m, x_m, t_est = self._estimate(x_meas, w_d if w_v is None else w_v)
+        self.j_d, self.t_load = self.rls.inertia_at_disc_kg_m2(), self.rls.holding_torque_Nm()
+        super().cycle(launch, tl, locked_once, w_e_m, w_d_m, x_m, theta_cm_true, t_est, level, w_d_m)
+        if self.x_cmd != 0.0:
+            self.x_cmd -= self.x_offset

@@ -28,7 +28,6 @@ import json
 import math
 import sys
 import zlib
-from dataclasses import fields
 from pathlib import Path
 
 from pythonfmu import Fmi2Causality, Fmi2Slave, Fmi2Variability, Real
@@ -151,7 +150,7 @@ class CushionClutch(Fmi2Slave):
         problems = []
         if self._table is None:
             problems.append(self._table_error or "tables missing")
-        params = ClutchParameters(**{f.name: getattr(self, f.name) for f in fields(ClutchParameters)})
+        params = ClutchParameters.from_flat({name: getattr(self, name) for name in PARAMETERS})
         problems += [f"parameter {p}" for p in params.problems()]
         self._problems = problems
         for p in problems:
@@ -312,7 +311,7 @@ class CushionClutch(Fmi2Slave):
         if t is not None and not (isinstance(t, (int, float)) and math.isfinite(t)):
             out.append(f"time {t!r} is not finite")
         if not out and state["_phase"] in ("stepping", "terminated"):
-            params = ClutchParameters(**{p: float(state[p]) for p in PARAMETERS})
+            params = ClutchParameters.from_flat({p: float(state[p]) for p in PARAMETERS})
             out += [f"parameter {p}" for p in params.problems()]
             if not 0.0 < state["theta_cs"] < THETA_CM_LIMIT:
                 out.append(f"theta_cs = {state['theta_cs']!r} K is outside (0, {THETA_CM_LIMIT:g}) K")
@@ -331,7 +330,7 @@ class CushionClutch(Fmi2Slave):
         self._range_warned = bool(state.get("_range_warned"))
         self._problems, self._faults = list(state["_problems"]), list(state["_faults"])
         if self._phase in ("stepping", "terminated"):
-            self._params = ClutchParameters(**{p: float(state[p]) for p in PARAMETERS})
+            self._params = ClutchParameters.from_flat({p: float(state[p]) for p in PARAMETERS})
 
     @staticmethod
     def _fmu_state_to_bytes(state) -> bytes:

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy.interpolate import PchipInterpolator
 
-from cushion_clutch.fmu.model import (KELVIN, ClutchParameters, load_table, outputs, thermal_step,
+from cushion_clutch.fmu.model import (KELVIN, ClutchParameters, CoverParameters, load_table, outputs, thermal_step,
                                   thermal_system, x_to_for_torque)
 from cushion_clutch.fe.tables import read_tables
 
@@ -47,10 +47,15 @@ def test_linear_in_theta_between_tables(table, raw):
 
 
 def test_clamped_outside_table_temperatures(table):
-    hot = outputs(0.006, 400.0 + KELVIN, table, P)
-    edge = outputs(0.006, table.theta_degC[-1] + KELVIN, table, P)
+    # only the tables clamp: the cover's E(theta) and the stack's growth go on beyond them
+    table_only = ClutchParameters(cover=CoverParameters(diaphragm_modulus_drop_per_K=0.0, facing_expansion_per_K=0.0,
+                                                        pressure_plate_expansion_per_K=0.0,
+                                                        flywheel_expansion_per_K=0.0))
+    hot = outputs(0.006, 400.0 + KELVIN, table, table_only)
+    edge = outputs(0.006, table.theta_degC[-1] + KELVIN, table, table_only)
     assert hot.clamped and not edge.clamped
     assert hot.torque == edge.torque
+    assert outputs(0.006, 400.0 + KELVIN, table, P).torque != edge.torque
 
 
 def test_thermal_step_is_the_exponential_solution():

@@ -25,7 +25,7 @@ log = logging.getLogger(__name__)
 FMU_SRC = fmu_sources()
 SLAVE = "CushionClutch"
 #: the modules the pythonfmu slave imports (siblings inside the FMU): the slave class and the numpy-only model
-MODEL_MODULES = ("cushion_slave.py", "clutch_model.py", "spring_table.py", "friction.py")
+MODEL_MODULES = ("cushion_slave.py", "clutch_model.py", "spring_table.py", "friction.py", "cover.py")
 TABLE_FILES = ("force_deflection.csv", "kiss_point.csv", "metadata.json", "friction.csv")
 
 #: unit of each variable (from the shared model module); temperatures get degC as display unit

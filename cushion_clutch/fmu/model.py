@@ -9,13 +9,14 @@ Examples
 """
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 from ..data import DEFAULT_TABLES
-from ..fmu_src.clutch_model import (KELVIN, ClutchParameters, Outputs, SpringTable, outputs,
+from ..fmu_src.clutch_model import (KELVIN, ClutchParameters, CoverParameters, Outputs, SpringTable, outputs,
                                    thermal_step, x_to_for_torque)
 
-__all__ = ["KELVIN", "ClutchParameters", "Outputs", "SpringTable", "outputs", "thermal_step",
+__all__ = ["KELVIN", "ClutchParameters", "CoverParameters", "Outputs", "SpringTable", "outputs", "thermal_step",
            "x_to_for_torque", "load_table", "torque", "thermal_system", "DEFAULT_TABLES"]
 
 
@@ -39,6 +40,8 @@ def thermal_system(p: ClutchParameters | None = None):
     import control
 
     p = p or ClutchParameters()
+    if not (isinstance(p.C, (int, float)) and math.isfinite(p.C) and p.C > 0.0):
+        raise ValueError(f"C = {p.C!r}: the cushion-spring heat capacity (J/K) must be a finite number > 0")
     g = p.U + p.H
     return control.ss([[-g / p.C]], [[p.U / p.C, p.H / p.C]], [[1.0]], [[0.0, 0.0]],
                       inputs=["theta_cm", "theta_a"], outputs=["theta_cs"], states=["theta_cs"],

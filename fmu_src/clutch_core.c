@@ -32,6 +32,11 @@ static const double RANGES[CC_NVARS][4] = {
     {0.0, 1e6, 1, 0}, {0.0, 2000.0, 1, 0}, {0.0, 2000.0, 1, 0}, {-1.0, 1.0, 0, 0},
     {0.0, 100.0, 1, 0}, {0}, {0}};
 
+/* cover parameters (cover.CoverParameters defaults), in CV_* order */
+static const double COVER_DEFAULTS[CV_NPAR] = {
+    0.1125, 0.085, 0.0026, 0.0052, 206e9, 2.7e-4, 0.3, 0.111, 0.089, 0.0028, 1.0e-6, 0.007, 3.0e-5, 0.016,
+    1.1e-5, 0.010, 1.1e-5, 293.15};
+
 static int is_input(unsigned int vr) { return vr == VR_X_TO || vr == VR_THETA_CM || vr == VR_OMEGA_SLIP; }
 static int is_parameter(unsigned int vr) { return vr >= VR_N_SURFACES && vr <= VR_LEVER_RATIO; }
 
@@ -90,6 +95,7 @@ void cc_reset(CcModel *m) {
     m->terminated = 0;
     m->time = 0.0;
     m->dirty = 1;
+    m->cover_ok = 0;
     m->phase = PH_INSTANTIATED;
 }
 
@@ -97,6 +103,12 @@ void cc_reset(CcModel *m) {
 static int range_ok(int k, double v) {
     const double *g = RANGES[k];
     return isfinite(v) && (g[2] ? v > g[0] : v >= g[0]) && (g[3] ? v < g[1] : v <= g[1]);
+}
+
+/* the bearing radius r_f - lever_ratio (r_pp - r_f) must stay > 0 */
+static int cover_geometry_ok(const double *r) {
+    const double *c = COVER_DEFAULTS;
+    return r[VR_LEVER_RATIO] * (c[CV_RPP] - c[CV_RF]) < c[CV_RF];
 }
 
 /* every parameter problem is logged (prefix names the call); returns 1 if all are valid */
@@ -112,6 +124,12 @@ static int check_parameters(CcModel *m, const double *r, const char *fn) {
     }
     if (range_ok(VR_N_SURFACES, r[VR_N_SURFACES]) && r[VR_N_SURFACES] != floor(r[VR_N_SURFACES])) {
         cc_log(m, CC_ERROR, "%s: parameter n_surfaces = %g must be a whole number in [1, 16]", fn, r[VR_N_SURFACES]);
+        ok = 0;
+    }
+    if (ok && !cover_geometry_ok(r)) {
+        cc_log(m, CC_ERROR, "%s: parameter lever_ratio = %g puts the release bearing at r_b = fulcrum_radius_m - "
+               "lever_ratio (pressure_plate_radius_m - fulcrum_radius_m) = %g m; must be > 0", fn, r[VR_LEVER_RATIO],
+               COVER_DEFAULTS[CV_RF] - r[VR_LEVER_RATIO] * (COVER_DEFAULTS[CV_RPP] - COVER_DEFAULTS[CV_RF]));
         ok = 0;
     }
     if (ok && !(r[VR_U] + r[VR_H] > 0.0)) {
@@ -141,20 +159,30 @@ static void log_inputs(CcModel *m, int status, double t, const char *what) {
 }
 
 /* -------------------------------------------------------------------- model */
-static void update_outputs(CcModel *m) {
+static double facing_wear(const CcModel *m) { (void)m; return 0.0; }
+
+/* outputs of the current inputs and state; CC_DISCARD (logged) if the diaphragm cannot hold the cushion */
+static int update_outputs(CcModel *m) {
     double *r = m->r;
     const Table *tb = &m->table;
-    double theta_c = r[VR_THETA_CS] - KELVIN;
-    double x_kiss = r[VR_X_KISS_REF] - r[VR_LEVER_RATIO] * cc_table_delta(tb, theta_c);
-    double u = (r[VR_X_TO] - x_kiss) / r[VR_LEVER_RATIO];
-    double force = cc_table_force(tb, u, theta_c);
+    CcCoverState st;
     double mu = tb->f_mu ? cc_table_mu(tb, r[VR_THETA_CM] - KELVIN, r[VR_OMEGA_SLIP]) : r[VR_MU];
     double g = r[VR_U] + r[VR_H];
-    r[VR_TORQUE] = r[VR_N_SURFACES] * mu * r[VR_R_EQ] * force;
-    r[VR_FORCE] = force;
-    r[VR_U_F] = u > 0.0 ? u : 0.0;
-    r[VR_X_KISS] = x_kiss;
+    if (!m->cover_ok) {
+        cc_cover_prepare(&m->cover, COVER_DEFAULTS, r[VR_LEVER_RATIO], r[VR_X_KISS_REF], tb);
+        m->cover_ok = 1;
+    }
     r[CC_VR_DER_THETA_CS] = (r[VR_U] * r[VR_THETA_CM] + r[VR_H] * r[VR_THETA_A] - g * r[VR_THETA_CS]) / r[VR_C];
+    if (cc_cover_state(&m->cover, tb, r[VR_X_TO], r[VR_THETA_CS], r[VR_THETA_CM], facing_wear(m), &st) != 0) {
+        cc_log(m, CC_DISCARD, "t = %g s: the diaphragm cannot hold the cushion at theta_cs = %g K, theta_cm = %g K, "
+               "facing_wear = %g m (bearing force %g N < 0); outputs not updated", m->time, r[VR_THETA_CS],
+               r[VR_THETA_CM], facing_wear(m), st.bearing);
+        return CC_DISCARD;
+    }
+    r[VR_TORQUE] = r[VR_N_SURFACES] * mu * r[VR_R_EQ] * st.clamp;
+    r[VR_FORCE] = st.cushion;
+    r[VR_U_F] = st.u > 0.0 ? st.u : 0.0;
+    r[VR_X_KISS] = st.x_kiss;
     m->dirty = 0;
     if (!(tb->theta[0] + KELVIN <= r[VR_THETA_CS] && r[VR_THETA_CS] <= tb->theta[tb->nt - 1] + KELVIN) &&
         !m->range_warned) {
@@ -163,19 +191,29 @@ static void update_outputs(CcModel *m) {
                "are clamped to the nearest table temperature (warned once)", r[VR_THETA_CS],
                tb->theta[0] + KELVIN, tb->theta[tb->nt - 1] + KELVIN);
     }
+    return CC_OK;
 }
 
-/* outputs of the current inputs and state (in Initialization Mode: theta_cs = theta_cs_start);
-   with invalid inputs they keep their last values */
-static void refresh(CcModel *m) {
-    if (!m->dirty || !inputs_ok(m->r)) return;
+/* outputs of the current inputs and state (in Initialization Mode: theta_cs = theta_cs_start).
+   Invalid inputs: the outputs keep their last values and CC_DISCARD is returned (logged) */
+static int refresh(CcModel *m, const char *fn) {
+    if (!m->dirty) return CC_OK;
+    if (!inputs_ok(m->r)) {
+        char what[200];
+        snprintf(what, sizeof what, "%s: outputs not updated", fn);
+        log_inputs(m, CC_DISCARD, m->time, what);
+        return CC_DISCARD;
+    }
     if (m->phase == PH_INIT) {
-        if (!(m->r[VR_LEVER_RATIO] > 0.0 && m->r[VR_C] > 0.0)) return;
+        int k;
+        for (k = VR_N_SURFACES; k <= VR_LEVER_RATIO; ++k)
+            if (!range_ok(k, m->r[k])) return CC_OK; /* reported at fmi*ExitInitializationMode */
+        if (!cover_geometry_ok(m->r)) return CC_OK;
         m->r[VR_THETA_CS] = m->r[VR_THETA_CS_START];
     } else if (!(m->phase & (PH_STEP | PH_EVENT | PH_CONT | PH_TERMINATED))) {
-        return;
+        return CC_OK;
     }
-    update_outputs(m);
+    return update_outputs(m);
 }
 
 int cc_set_real(CcModel *m, const unsigned int vr[], size_t n, const double v[], const char *fn) {
@@ -198,7 +236,10 @@ int cc_set_real(CcModel *m, const unsigned int vr[], size_t n, const double v[],
             return CC_ERROR;
         }
     }
-    for (k = 0; k < n; ++k) m->r[vr[k]] = v[k];
+    for (k = 0; k < n; ++k) {
+        m->r[vr[k]] = v[k];
+        if (is_parameter(vr[k])) m->cover_ok = 0;
+    }
     if (n) m->dirty = 1;
     return CC_OK;
 }
@@ -212,7 +253,13 @@ int cc_get_real(CcModel *m, const unsigned int vr[], size_t n, double v[], const
             cc_log(m, CC_ERROR, "%s: unknown value reference %u", fn, vr[k]);
             return CC_ERROR;
         }
-    if (m->dirty) refresh(m);
+    if (m->dirty && refresh(m, fn) != CC_OK && m->me) {
+        /* Model Exchange: outputs of invalid inputs are refused, as the derivative is */
+        for (k = 0; k < n; ++k)
+            if (vr[k] == VR_TORQUE || vr[k] == VR_FORCE || vr[k] == VR_U_F || vr[k] == VR_X_KISS ||
+                vr[k] == CC_VR_DER_THETA_CS)
+                return CC_DISCARD;
+    }
     for (k = 0; k < n; ++k) v[k] = m->r[vr[k]];
     return CC_OK;
 }
@@ -238,7 +285,16 @@ int cc_exit_init(CcModel *m, const char *fn) {
     m->r[VR_THETA_CS] = m->r[VR_THETA_CS_START];
     m->phase = m->me ? PH_EVENT : PH_STEP;
     m->dirty = 1;
-    refresh(m);
+    m->cover_ok = 0;
+    cc_cover_prepare(&m->cover, COVER_DEFAULTS, m->r[VR_LEVER_RATIO], m->r[VR_X_KISS_REF], &m->table);
+    m->cover_ok = 1;
+    if (!(cc_cover_slope_bound(&m->cover) > 0.0)) {
+        cc_log(m, CC_ERROR, "%s: the release snaps through (x_to(s) is not monotone on the diaphragm's falling "
+               "branch): reduce release_compliance_m_per_N", fn);
+        m->phase = PH_ERROR;
+        return CC_ERROR;
+    }
+    if (inputs_ok(m->r)) update_outputs(m);
     return CC_OK;
 }
 
@@ -264,8 +320,11 @@ int cc_do_step(CcModel *m, double t, double h, const char *fn) {
     g = r[VR_U] + r[VR_H];
     theta_inf = (r[VR_U] * r[VR_THETA_CM] + r[VR_H] * r[VR_THETA_A]) / g;
     r[VR_THETA_CS] = theta_inf + (r[VR_THETA_CS] - theta_inf) * exp(-h * g / r[VR_C]);
-    update_outputs(m);
     m->time = t + h;
+    if (update_outputs(m) != CC_OK) {
+        m->terminated = 1;
+        return CC_DISCARD;
+    }
     m->terminated = 0;
     return status;
 }
@@ -275,11 +334,23 @@ int cc_derivative(CcModel *m, double *der, const char *fn) {
     double theta;
     if (!cc_allowed(m, PH_INIT | PH_EVENT | PH_CONT | PH_TERMINATED | PH_ERROR, fn)) return CC_ERROR;
     if (!inputs_ok(r)) {
-        log_inputs(m, CC_ERROR, m->time, "no derivative");
-        return CC_ERROR;
+        char what[200];
+        snprintf(what, sizeof what, "%s: no derivative", fn);
+        log_inputs(m, CC_DISCARD, m->time, what);
+        return CC_DISCARD;
     }
     theta = m->phase == PH_INIT ? r[VR_THETA_CS_START] : r[VR_THETA_CS];
     *der = (r[VR_U] * r[VR_THETA_CM] + r[VR_H] * r[VR_THETA_A] - (r[VR_U] + r[VR_H]) * theta) / r[VR_C];
+    return CC_OK;
+}
+
+int cc_set_time(CcModel *m, double t, const char *fn) {
+    if (!cc_allowed(m, PH_EVENT | PH_CONT, fn)) return CC_ERROR;
+    if (!isfinite(t)) {
+        cc_log(m, CC_ERROR, "%s: time = %g s is not finite; refused", fn, t);
+        return CC_ERROR;
+    }
+    m->time = t;
     return CC_OK;
 }
 
@@ -368,4 +439,5 @@ void cc_state_load(CcModel *m, const CcState *s) {
     m->terminated = s->terminated;
     m->time = s->time;
     m->dirty = 1;
+    m->cover_ok = 0;
 }

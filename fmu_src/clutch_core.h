@@ -55,6 +55,27 @@ typedef struct {
     double *f_theta, *f_omega, *f_mu;
 } Table;
 
+/* cover parameters, in the order of cover.CoverParameters' fields (fmu_src/cover.py) */
+enum {
+    CV_A, CV_B, CV_T, CV_H, CV_E, CV_KE, CV_NU, CV_RPP, CV_RF, CV_SINST, CV_C, CV_TF, CV_AF, CV_TPP, CV_APP,
+    CV_LFW, CV_AFW, CV_TREF, CV_NPAR
+};
+
+/* the cover's force balance, prepared once per parameter set (clutch_cover.c) */
+typedef struct {
+    double p[CV_NPAR];
+    double e, L_pp, L_b, kb, kp, fal; /* arms (m), bearing/pp travel per unit s, F_AL factor without E */
+    double u_full_ref;                /* cushion full compression at the reference temperature, m */
+    double xc;                        /* bearing-system constant X_c, m */
+    double s_last;                    /* warm start of the Newton iteration, m (NaN: none) */
+} CcCover;
+
+typedef struct {
+    double clamp, bearing, cushion; /* F_pp, F_to, F_c, N */
+    double u, s;                    /* cushion compression from its kiss point, diaphragm deflection, m */
+    double x_kiss, x_solid, x_lift; /* bearing positions, m */
+} CcCoverState;
+
 /* message sink of a front end: status, category, the finished message (never a format) */
 typedef void (*CcLogger)(void *ctx, int status, const char *category, const char *message);
 
@@ -68,6 +89,8 @@ typedef struct {
     int terminated;   /* CS: the last step was refused (fmi2Terminated / terminateSimulation) */
     int logging_on;
     Table table;
+    CcCover cover;
+    int cover_ok;     /* cover prepared from the current parameters */
     int table_ok;
     char table_error[600];
     CcLogger logger;
@@ -91,6 +114,16 @@ void cc_table_free(Table *tb);
 double cc_table_force(const Table *tb, double u, double theta_degC);
 double cc_table_delta(const Table *tb, double theta_degC);
 double cc_table_mu(const Table *tb, double theta_degC, double omega);
+double cc_table_force_slope(const Table *tb, double u, double theta_degC);
+double cc_table_full(const Table *tb, double theta_degC);
+double cc_table_first(const Table *tb, double theta_degC);
+
+/* ---- cover (clutch_cover.c) */
+void cc_cover_prepare(CcCover *cv, const double *par, double lever_ratio, double x_kiss_ref, const Table *tb);
+double cc_cover_slope_bound(const CcCover *cv);
+/* 0, or -1 if the diaphragm cannot hold the cushion (bearing force < 0); out is filled either way */
+int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, double theta_cm, double wear,
+                   CcCoverState *out);
 
 /* ---- model (clutch_core.c) */
 int cc_instantiate(CcModel *m, const char *resource_dir, int me, CcLogger logger, void *ctx, int logging_on);
@@ -108,6 +141,8 @@ int cc_enter_init(CcModel *m, double start_time, const char *fn);
 int cc_exit_init(CcModel *m, const char *fn);
 int cc_do_step(CcModel *m, double t, double h, const char *fn);
 int cc_derivative(CcModel *m, double *der, const char *fn);
+/* ME SetTime: refuses a non-finite time */
+int cc_set_time(CcModel *m, double t, const char *fn);
 int cc_set_state_value(CcModel *m, double theta_cs, const char *fn);
 /* the continuous state theta_cs, K (its start value during initialisation) */
 int cc_get_state_value(CcModel *m, double *theta_cs, const char *fn);

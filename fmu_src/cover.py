@@ -257,7 +257,7 @@ class CoverMap:
                       s_kiss - table.full_compression(theta_c) / kp, theta_cs, wear)
 
     def state(self, x_to: float, theta_cs: float, theta_cm: float, wear: float, table, x_kiss_ref: float,
-              tol: float = 1e-13) -> CoverState:
+              tol: float = 1e-15) -> CoverState:
         """Solve the force balance at bearing position ``x_to`` (m), temperatures in K, wear in m.
 
         Raises
@@ -326,7 +326,7 @@ class _Frame:
         """The diaphragm's load at the solid position, bearing lifted: the closed clamp force, N."""
         return self.g.moment(self.s_solid, self.e_mod) / self.g.L_pp
 
-    def state(self, x_to: float, tol: float = 1e-13) -> CoverState:
+    def state(self, x_to: float, tol: float = 1e-15) -> CoverState:
         g, kb, kp, comp = self.g, self.g.kb, self.g.kp, self.g.comp
         s_kiss, u_full = self.s_kiss, (self.s_kiss - self.s_solid) * kp
         if x_to >= self.x_solid:

@@ -16,7 +16,7 @@ from .build import BASE_UNITS, SLAVE
 
 #: the model core (shared) and the front end of each FMI version, as shipped in sources/
 CORE_HEADERS = ("clutch_core.h", "resource_uri.h")
-CORE_SOURCES = ("clutch_core.c", "clutch_tables.c", "resource_uri.c")
+CORE_SOURCES = ("clutch_core.c", "clutch_tables.c", "clutch_cover.c", "resource_uri.c")
 FRONT_ENDS = {2: "fmi2_frontend.c", 3: "fmi3_frontend.c"}
 #: value references beyond clutch_model.VARIABLES
 VR_DER = len(VARIABLES)

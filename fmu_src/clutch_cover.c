@@ -1,0 +1,121 @@
+/*
+ * CushionClutch model core, part 3: the cover assembly (diaphragm spring, finger lever, clamp load).
+ * The equations are those of fmu_src/cover.py (module docstring), the reference implementation:
+ *
+ *   F_AL(s) = 4 E/(1-nu^2) t^4/(K1 D_e^2) (s/t) [(h/t - s/t)(h/t - s/(2t)) + 1]   (Almen-Laszlo)
+ *   M(s) = F_AL(s) e = F_pp L_pp + F_to L_b                                       (moment balance)
+ *   u(s) = (s_kiss - s) L_pp/e,  F_pp = F_c(u, theta_cs) while s > s_solid         (cushion phase)
+ *   x_to = X_c - (L_b/e) s - c F_to(s)                                             (bearing kinematics)
+ *   x_to >= x_solid: s = s_solid, F_to = max(0, F_to(s_solid) - (x_to - x_solid)/c),
+ *                    F_pp = (M(s_solid) - F_to L_b)/L_pp                           (solid phase)
+ *
+ * The forward map is a safeguarded Newton iteration on s in [s_solid, s_rigid], warm-started from
+ * the previous solution (usually 1-3 iterations).
+ */
+#include "clutch_core.h"
+
+#include <math.h>
+#include <string.h>
+
+#define KELVIN 273.15
+#define PI 3.14159265358979323846
+
+static double k1(double a, double b) {
+    double d = a / b;
+    return ((d - 1.0) / d) * ((d - 1.0) / d) / ((d + 1.0) / (d - 1.0) - 2.0 / log(d)) / PI;
+}
+
+/* M(s) = F_AL(s) e (E folded into fal) and dM/ds */
+static double moment(const CcCover *cv, double s, double e_mod) {
+    double t = cv->p[CV_T], h = cv->p[CV_H];
+    return cv->fal * e_mod * (s / t) * ((h - s) * (h - 0.5 * s) / (t * t) + 1.0) * cv->e;
+}
+
+static double moment_slope(const CcCover *cv, double s, double e_mod) {
+    double t = cv->p[CV_T], h = cv->p[CV_H];
+    return cv->fal * e_mod / t * ((h - s) * (h - 0.5 * s) / (t * t) + 1.0 - s * (1.5 * h - s) / (t * t)) * cv->e;
+}
+
+static double youngs(const CcCover *cv, double theta_K) {
+    return cv->p[CV_E] * (1.0 - cv->p[CV_KE] * (theta_K - cv->p[CV_TREF]));
+}
+
+void cc_cover_prepare(CcCover *cv, const double *par, double lever_ratio, double x_kiss_ref, const Table *tb) {
+    double s_k0, f_to, th_ref;
+    memcpy(cv->p, par, sizeof cv->p);
+    cv->e = par[CV_A] - par[CV_B];
+    cv->L_pp = par[CV_RPP] - par[CV_RF];
+    cv->L_b = lever_ratio * cv->L_pp;
+    cv->kb = cv->L_b / cv->e;
+    cv->kp = cv->L_pp / cv->e;
+    cv->fal = 4.0 / (1.0 - par[CV_NU] * par[CV_NU]) * pow(par[CV_T], 4) / (k1(par[CV_A], par[CV_B]) * 4.0 *
+                                                                             par[CV_A] * par[CV_A]);
+    th_ref = par[CV_TREF] - KELVIN;
+    cv->u_full_ref = cc_table_full(tb, th_ref);
+    s_k0 = par[CV_SINST] + cv->u_full_ref / cv->kp;
+    f_to = (moment(cv, s_k0, par[CV_E]) - cc_table_force(tb, 0.0, th_ref) * cv->L_pp) / cv->L_b;
+    cv->xc = x_kiss_ref + cv->kb * s_k0 + par[CV_C] * f_to;
+    cv->s_last = NAN;
+}
+
+/* -(dx_to/ds) at its smallest (open phase, s = h) at the largest E: > 0 means no snap-through */
+double cc_cover_slope_bound(const CcCover *cv) {
+    double e_max = cv->p[CV_E] * (1.0 + cv->p[CV_KE] * cv->p[CV_TREF]);
+    return cv->kb + cv->p[CV_C] * moment_slope(cv, cv->p[CV_H], e_max) / cv->L_b;
+}
+
+int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, double theta_cm, double wear,
+                   CcCoverState *out) {
+    const double *p = cv->p;
+    double th = theta_cs - KELVIN, e_mod = youngs(cv, theta_cs), kb = cv->kb, kp = cv->kp, comp = p[CV_C];
+    double dT = theta_cm - p[CV_TREF];
+    double stack = cc_table_delta(tb, th) + (p[CV_TF] * p[CV_AF] + p[CV_TPP] * p[CV_APP] + p[CV_LFW] * p[CV_AFW]) * dT;
+    double s_kiss = p[CV_SINST] + (cv->u_full_ref + stack - wear) / kp;
+    double s_solid = s_kiss - cc_table_full(tb, th) / kp;
+    double fc_solid = cc_table_force(tb, (s_kiss - s_solid) * kp, th);
+    double m_solid = moment(cv, s_solid, e_mod);
+    double fto_solid = (m_solid - fc_solid * cv->L_pp) / cv->L_b;
+    double x_solid = cv->xc - kb * s_solid - comp * fto_solid;
+    double lo, hi, s, r, fc, fto;
+    int k;
+    out->x_solid = x_solid;
+    out->x_lift = x_solid + comp * (fto_solid > 0.0 ? fto_solid : 0.0);
+    fc = cc_table_force(tb, 0.0, th);
+    out->x_kiss = cv->xc - kb * s_kiss - comp * (moment(cv, s_kiss, e_mod) - fc * cv->L_pp) / cv->L_b;
+    if (fto_solid < 0.0) return -1;
+    if (x_to >= x_solid) {
+        fto = comp > 0.0 ? fto_solid - (x_to - x_solid) / comp : 0.0;
+        if (fto < 0.0) fto = 0.0;
+        out->bearing = fto;
+        out->clamp = (m_solid - fto * cv->L_b) / cv->L_pp;
+        out->cushion = fc_solid;
+        out->u = (s_kiss - s_solid) * kp;
+        out->s = s_solid;
+        return 0;
+    }
+    lo = s_solid;
+    hi = (cv->xc - x_to) / kb;
+    s = cv->s_last > lo && cv->s_last < hi ? cv->s_last : hi;
+    fc = cc_table_force(tb, (s_kiss - s) * kp, th);
+    fto = (moment(cv, s, e_mod) - fc * cv->L_pp) / cv->L_b;
+    r = cv->xc - kb * s - comp * fto - x_to;
+    for (k = 0; k < 100; ++k) {
+        double slope, s_new;
+        if (fabs(r) <= 1e-15 * (1.0 + fabs(x_to)) || hi - lo <= 1e-15 * (1.0 + hi)) break;
+        if (r > 0.0) lo = s; else hi = s;
+        slope = -kb - comp * (moment_slope(cv, s, e_mod) +
+                              cc_table_force_slope(tb, (s_kiss - s) * kp, th) * kp * cv->L_pp) / cv->L_b;
+        s_new = slope < 0.0 ? s - r / slope : 0.5 * (lo + hi);
+        s = (s_new > lo && s_new < hi) ? s_new : 0.5 * (lo + hi);
+        fc = cc_table_force(tb, (s_kiss - s) * kp, th);
+        fto = (moment(cv, s, e_mod) - fc * cv->L_pp) / cv->L_b;
+        r = cv->xc - kb * s - comp * fto - x_to;
+    }
+    cv->s_last = s;
+    out->clamp = fc;
+    out->bearing = fto;
+    out->cushion = fc;
+    out->u = (s_kiss - s) * kp;
+    out->s = s;
+    return fto < 0.0 ? -1 : 0;
+}

@@ -55,7 +55,7 @@ typedef struct {
     double *f_theta, *f_omega, *f_mu;
 } Table;
 
-/* cover parameters, in the order of cover.CoverParameters' fields (fmu_src/cover.py) */
+/* cover parameters, in the order of cover.CoverParameters' fields (cushion_clutch/model/cover.py) */
 enum {
     CV_A, CV_B, CV_T, CV_H, CV_E, CV_KE, CV_NU, CV_RPP, CV_RF, CV_SINST, CV_C, CV_TF, CV_AF, CV_TPP, CV_APP,
     CV_LFW, CV_AFW, CV_TREF, CV_NPAR

@@ -1,6 +1,6 @@
 /*
  * CushionClutch model core, part 3: the cover assembly (diaphragm spring, finger lever, clamp load).
- * The equations are those of fmu_src/cover.py (module docstring), the reference implementation:
+ * The equations are those of cushion_clutch/model/cover.py (module docstring), the reference implementation:
  *
  *   F_AL(s) = 4 E/(1-nu^2) t^4/(K1 D_e^2) (s/t) [(h/t - s/t)(h/t - s/(2t)) + 1]   (Almen-Laszlo)
  *   M(s) = F_AL(s) e = F_pp L_pp + F_to L_b                                       (moment balance)

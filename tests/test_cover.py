@@ -1,12 +1,12 @@
-"""The cover assembly (fmu_src/cover.py): Almen-Laszlo diaphragm, lever balance, clamp load, kiss budget."""
+"""The cover assembly (cushion_clutch/model/cover.py): Almen-Laszlo diaphragm, lever balance, clamp load, kiss budget."""
 import math
 
 import numpy as np
 import pytest
 
 from cushion_clutch.errors import ParameterError
-from cushion_clutch.fmu.model import KELVIN, ClutchParameters, load_table, outputs, x_to_for_torque
-from cushion_clutch.fmu_src.cover import (CoverMap, CoverParameters, almen_laszlo_force, almen_laszlo_slope, k1)
+from cushion_clutch.model import KELVIN, ClutchParameters, load_table, outputs, x_to_for_torque
+from cushion_clutch.model.cover import (CoverMap, CoverParameters, almen_laszlo_force, almen_laszlo_slope, k1)
 from cushion_clutch.model.cover_file import cover_from_dict, load_cover
 
 C = CoverParameters()

@@ -14,8 +14,9 @@ from scipy.io import loadmat
 
 from cushion_clutch.fmu.exports import export_mat, export_modelica, read_modelica
 from cushion_clutch.fmu.build import build_fmu
-from cushion_clutch.fmu.model import DEFAULT_TABLES, load_table
-from cushion_clutch.fmu_src.cover import CoverMap, CoverParameters
+from cushion_clutch.data import DEFAULT_TABLES
+from cushion_clutch.model import load_table
+from cushion_clutch.model.cover import CoverMap, CoverParameters
 from cushion_clutch.fe.tables import read_tables
 
 pytestmark = pytest.mark.fmu

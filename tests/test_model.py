@@ -1,4 +1,4 @@
-"""The shared pure model (fmu_src/clutch_model.py) through the Python API."""
+"""The shared pure model (cushion_clutch/model/clutch_model.py) through the Python API."""
 import math
 
 import control
@@ -6,8 +6,9 @@ import numpy as np
 import pytest
 from scipy.interpolate import PchipInterpolator
 
-from cushion_clutch.fmu.model import (KELVIN, ClutchParameters, CoverParameters, load_table, outputs, thermal_step,
-                                  thermal_system, x_to_for_torque)
+from cushion_clutch.data import DEFAULT_TABLES
+from cushion_clutch.model import (KELVIN, ClutchParameters, CoverParameters, load_table, outputs, thermal_step, thermal_system,
+                                  x_to_for_torque)
 from cushion_clutch.fe.tables import read_tables
 
 P = ClutchParameters()
@@ -20,7 +21,7 @@ def table():
 
 @pytest.fixture(scope="module")
 def raw():
-    return read_tables(load_table.__defaults__[0])
+    return read_tables(DEFAULT_TABLES)
 
 
 def test_interpolation_is_scipy_pchip(table, raw):
@@ -117,3 +118,15 @@ def test_malformed_table_is_a_clear_error(tmp_path):
     (tmp_path / "kiss_point.csv").write_text("theta_degC,delta_kiss_m\n20,0\n")
     with pytest.raises(ValueError, match="force_deflection.csv"):
         load_table(tmp_path)
+
+
+def test_negative_table_force_is_refused_with_its_row(tmp_path):
+    (tmp_path / "force_deflection.csv").write_text("theta_degC,u_m,force_N\n20,0,-5\n20,1e-4,-1\n20,2e-4,3\n")
+    (tmp_path / "kiss_point.csv").write_text("theta_degC,delta_kiss_m\n20,0\n")
+    with pytest.raises(ValueError, match=r"force_deflection.csv: row 1 \(line 2\): force_N = -5.0 < 0"):
+        load_table(tmp_path)
+
+
+def test_thermal_system_names_a_zero_heat_capacity():
+    with pytest.raises(ValueError, match="^C = 0"):
+        thermal_system(ClutchParameters(C=0))

@@ -6,7 +6,7 @@ Example::
     diaphragm_thickness_m = 0.0026
     installed_deflection_m = 0.0028
 
-Keys are the fields of :class:`~cushion_clutch.fmu_src.cover.CoverParameters` (SI, units in the
+Keys are the fields of :class:`~cushion_clutch.model.cover.CoverParameters` (SI, units in the
 names); missing keys keep the default cover. Unknown keys are rejected; every problem (range,
 type, geometry, snap-through) is collected and raised at once as
 :class:`~cushion_clutch.errors.ParameterError`.
@@ -16,9 +16,7 @@ from __future__ import annotations
 from dataclasses import fields
 from pathlib import Path
 
-from ..config import load_toml
-from ..errors import ParameterError
-from ..fmu_src.cover import CoverParameters
+from .cover import CoverParameters
 
 __all__ = ["load_cover", "cover_from_dict"]
 
@@ -32,6 +30,8 @@ def cover_from_dict(section: dict, lever_ratio: float = 3.0, source: str | None 
         Naming every unknown key, every value of the wrong type or out of range, and every
         inconsistent geometry.
     """
+    from ..errors import ParameterError     # the package's error classes: not needed inside the FMU
+
     allowed = {f.name for f in fields(CoverParameters)}
     problems = [f"cover.{k}: unknown key (allowed: {', '.join(sorted(allowed))})" for k in sorted(set(section) - allowed)]
     values = {}
@@ -51,6 +51,9 @@ def cover_from_dict(section: dict, lever_ratio: float = 3.0, source: str | None 
 
 def load_cover(path: str | Path, lever_ratio: float = 3.0) -> CoverParameters:
     """The checked ``[cover]`` section of the TOML file ``path`` (other sections are not read here)."""
+    from ..config import load_toml
+    from ..errors import ParameterError
+
     data = load_toml(path, required=("cover",))
     section = data["cover"]
     if not isinstance(section, dict):

@@ -151,7 +151,7 @@ class SpringTable:
         negative = np.flatnonzero(fd[:, 2] < 0.0)
         if negative.size:
             k = int(negative[0])
-            raise ValueError(f"{folder / FORCE_DEFLECTION}: row {k + 1} (line {k + 2}): force_N = {fd[k, 2]!r} "
+            raise ValueError(f"{folder / FORCE_DEFLECTION}: row {k + 1} (line {k + 2}): force_N = {float(fd[k, 2])!r} "
                              f"< 0 (a clamp force cannot be negative; {negative.size} such row(s))")
         thetas = np.unique(fd[:, 0])
         if not np.array_equal(np.sort(kp[:, 0]), thetas):

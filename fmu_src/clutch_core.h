@@ -68,6 +68,11 @@ typedef struct {
     double u_full_ref;                /* cushion full compression at the reference temperature, m */
     double xc;                        /* bearing-system constant X_c, m */
     double s_last;                    /* warm start of the Newton iteration, m (NaN: none) */
+    int hint[2], hint_k[2];           /* last table intervals (Newton; kiss and solid points) */
+    /* the frame of the last (theta_cs K, theta_cm K, wear m): bracket, E, positions and forces */
+    double f_theta_cs, f_theta_cm, f_wear, f_e, f_w;
+    const Curve *f_c0, *f_c1;
+    double s_kiss, s_solid, fc_solid, m_solid, fto_solid, x_solid, x_kiss;
 } CcCover;
 
 typedef struct {
@@ -114,9 +119,9 @@ void cc_table_free(Table *tb);
 double cc_table_force(const Table *tb, double u, double theta_degC);
 double cc_table_delta(const Table *tb, double theta_degC);
 double cc_table_mu(const Table *tb, double theta_degC, double omega);
-double cc_table_force_slope(const Table *tb, double u, double theta_degC);
 double cc_table_full(const Table *tb, double theta_degC);
-double cc_table_first(const Table *tb, double theta_degC);
+/* table temperatures i and i+1 around theta with weight w of i+1 (clamped: w = 0 or 1) */
+void cc_table_bracket(const Table *tb, double theta_degC, int *i, double *w);
 
 /* ---- cover (clutch_cover.c) */
 void cc_cover_prepare(CcCover *cv, const double *par, double lever_ratio, double x_kiss_ref, const Table *tb);

@@ -56,6 +56,8 @@ void cc_cover_prepare(CcCover *cv, const double *par, double lever_ratio, double
     f_to = (moment(cv, s_k0, par[CV_E]) - cc_table_force(tb, 0.0, th_ref) * cv->L_pp) / cv->L_b;
     cv->xc = x_kiss_ref + cv->kb * s_k0 + par[CV_C] * f_to;
     cv->s_last = NAN;
+    cv->f_theta_cs = NAN; /* no frame yet */
+    cv->hint[0] = cv->hint[1] = cv->hint_k[0] = cv->hint_k[1] = 0;
 }
 
 /* -(dx_to/ds) at its smallest (open phase, s = h) at the largest E: > 0 means no snap-through */
@@ -64,58 +66,119 @@ double cc_cover_slope_bound(const CcCover *cv) {
     return cv->kb + cv->p[CV_C] * moment_slope(cv, cv->p[CV_H], e_max) / cv->L_b;
 }
 
+/* F(u) and dF/du of one curve (PCHIP, as clutch_tables.c); *hint: the last interval, checked before use */
+static double curve_vd(const Curve *c, double u, double *dfdu, int *hint) {
+    int n = c->n, i = *hint;
+    double h, t, t2;
+    if (u <= c->x[0]) { *dfdu = 0.0; return c->y[0]; }
+    if (u >= c->x[n - 1]) { *dfdu = 0.0; return c->y[n - 1]; }
+    if (!(i >= 0 && i < n - 1 && c->x[i] <= u && u < c->x[i + 1])) {
+        int lo = 0, hi = n - 1;
+        while (hi - lo > 1) { /* x[lo] <= u < x[hi] */
+            int mid = (lo + hi) / 2;
+            if (c->x[mid] <= u) lo = mid; else hi = mid;
+        }
+        i = *hint = lo;
+    }
+    h = c->x[i + 1] - c->x[i];
+    t = (u - c->x[i]) / h;
+    t2 = t * t;
+    *dfdu = (6 * t2 - 6 * t) * (c->y[i] - c->y[i + 1]) / h + (3 * t2 - 4 * t + 1) * c->d[i] +
+            (3 * t2 - 2 * t) * c->d[i + 1];
+    return (2 * t2 * t - 3 * t2 + 1) * c->y[i] + (t2 * t - 2 * t2 + t) * h * c->d[i] + (-2 * t2 * t + 3 * t2) *
+           c->y[i + 1] + (t2 * t - t2) * h * c->d[i + 1];
+}
+
+/* the cushion force at one temperature bracket: curves i and i+1 with weight w (as cc_table_force) */
+typedef struct { const Curve *c0, *c1; double w; } Bracket;
+
+static double cushion(const Bracket *b, double u, double *dfdu, int *hint) {
+    double d0, d1, f0 = curve_vd(b->c0, u, &d0, &hint[0]), f1;
+    if (b->w == 0.0) { *dfdu = d0; return f0; }
+    f1 = curve_vd(b->c1, u, &d1, &hint[1]);
+    *dfdu = (1.0 - b->w) * d0 + b->w * d1;
+    return (1.0 - b->w) * f0 + b->w * f1;
+}
+
 int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, double theta_cm, double wear,
                    CcCoverState *out) {
     const double *p = cv->p;
-    double th = theta_cs - KELVIN, e_mod = youngs(cv, theta_cs), kb = cv->kb, kp = cv->kp, comp = p[CV_C];
-    double dT = theta_cm - p[CV_TREF];
-    double stack = cc_table_delta(tb, th) + (p[CV_TF] * p[CV_AF] + p[CV_TPP] * p[CV_APP] + p[CV_LFW] * p[CV_AFW]) * dT;
-    double s_kiss = p[CV_SINST] + (cv->u_full_ref + stack - wear) / kp;
-    double s_solid = s_kiss - cc_table_full(tb, th) / kp;
-    double fc_solid = cc_table_force(tb, (s_kiss - s_solid) * kp, th);
-    double m_solid = moment(cv, s_solid, e_mod);
-    double fto_solid = (m_solid - fc_solid * cv->L_pp) / cv->L_b;
-    double x_solid = cv->xc - kb * s_solid - comp * fto_solid;
-    double lo, hi, s, r, fc, fto;
+    double th = theta_cs - KELVIN, kb = cv->kb, kp = cv->kp, comp = p[CV_C];
+    double lo, hi, s, r, fc, fto, dfc, e_mod;
     int k;
-    out->x_solid = x_solid;
-    out->x_lift = x_solid + comp * (fto_solid > 0.0 ? fto_solid : 0.0);
-    fc = cc_table_force(tb, 0.0, th);
-    out->x_kiss = cv->xc - kb * s_kiss - comp * (moment(cv, s_kiss, e_mod) - fc * cv->L_pp) / cv->L_b;
-    if (fto_solid < 0.0) return -1;
-    if (x_to >= x_solid) {
-        fto = comp > 0.0 ? fto_solid - (x_to - x_solid) / comp : 0.0;
+    if (!(theta_cs == cv->f_theta_cs && theta_cm == cv->f_theta_cm && wear == cv->f_wear)) {
+        /* the frame: everything that depends on temperature and wear, not on x_to */
+        int i;
+        double w, stack, m_solid, dummy;
+        Bracket b;
+        e_mod = youngs(cv, theta_cs);
+        cc_table_bracket(tb, th, &i, &w);
+        b.c0 = &tb->curves[i];
+        b.c1 = w == 0.0 ? b.c0 : &tb->curves[i + 1];
+        b.w = w;
+        stack = (w == 0.0 ? tb->delta[i] : (1.0 - w) * tb->delta[i] + w * tb->delta[i + 1]) +
+                (p[CV_TF] * p[CV_AF] + p[CV_TPP] * p[CV_APP] + p[CV_LFW] * p[CV_AFW]) * (theta_cm - p[CV_TREF]);
+        cv->f_e = e_mod;
+        cv->f_c0 = b.c0;
+        cv->f_c1 = b.c1;
+        cv->f_w = w;
+        cv->s_kiss = p[CV_SINST] + (cv->u_full_ref + stack - wear) / kp;
+        cv->s_solid = cv->s_kiss - cc_table_full(tb, th) / kp;
+        cv->fc_solid = cushion(&b, (cv->s_kiss - cv->s_solid) * kp, &dummy, cv->hint_k);
+        m_solid = moment(cv, cv->s_solid, e_mod);
+        cv->m_solid = m_solid;
+        cv->fto_solid = (m_solid - cv->fc_solid * cv->L_pp) / cv->L_b;
+        cv->x_solid = cv->xc - kb * cv->s_solid - comp * cv->fto_solid;
+        fc = cushion(&b, 0.0, &dummy, cv->hint_k);
+        cv->x_kiss = cv->xc - kb * cv->s_kiss - comp * (moment(cv, cv->s_kiss, e_mod) - fc * cv->L_pp) / cv->L_b;
+        cv->f_theta_cs = theta_cs;
+        cv->f_theta_cm = theta_cm;
+        cv->f_wear = wear;
+    }
+    e_mod = cv->f_e;
+    out->x_solid = cv->x_solid;
+    out->x_lift = cv->x_solid + comp * (cv->fto_solid > 0.0 ? cv->fto_solid : 0.0);
+    out->x_kiss = cv->x_kiss;
+    if (cv->fto_solid < 0.0) { out->bearing = cv->fto_solid; return -1; }
+    if (x_to >= cv->x_solid) {
+        fto = comp > 0.0 ? cv->fto_solid - (x_to - cv->x_solid) / comp : 0.0;
         if (fto < 0.0) fto = 0.0;
         out->bearing = fto;
-        out->clamp = (m_solid - fto * cv->L_b) / cv->L_pp;
-        out->cushion = fc_solid;
-        out->u = (s_kiss - s_solid) * kp;
-        out->s = s_solid;
+        out->clamp = (cv->m_solid - fto * cv->L_b) / cv->L_pp;
+        out->cushion = cv->fc_solid;
+        out->u = (cv->s_kiss - cv->s_solid) * kp;
+        out->s = cv->s_solid;
         return 0;
     }
-    lo = s_solid;
-    hi = (cv->xc - x_to) / kb;
-    s = cv->s_last > lo && cv->s_last < hi ? cv->s_last : hi;
-    fc = cc_table_force(tb, (s_kiss - s) * kp, th);
-    fto = (moment(cv, s, e_mod) - fc * cv->L_pp) / cv->L_b;
-    r = cv->xc - kb * s - comp * fto - x_to;
-    for (k = 0; k < 100; ++k) {
-        double slope, s_new;
-        if (fabs(r) <= 1e-15 * (1.0 + fabs(x_to)) || hi - lo <= 1e-15 * (1.0 + hi)) break;
-        if (r > 0.0) lo = s; else hi = s;
-        slope = -kb - comp * (moment_slope(cv, s, e_mod) +
-                              cc_table_force_slope(tb, (s_kiss - s) * kp, th) * kp * cv->L_pp) / cv->L_b;
-        s_new = slope < 0.0 ? s - r / slope : 0.5 * (lo + hi);
-        s = (s_new > lo && s_new < hi) ? s_new : 0.5 * (lo + hi);
-        fc = cc_table_force(tb, (s_kiss - s) * kp, th);
+    {
+        Bracket b;
+        double s_kiss = cv->s_kiss;
+        b.c0 = cv->f_c0;
+        b.c1 = cv->f_c1;
+        b.w = cv->f_w;
+        lo = cv->s_solid;
+        hi = (cv->xc - x_to) / kb;
+        s = cv->s_last > lo && cv->s_last < hi ? cv->s_last : hi;
+        fc = cushion(&b, (s_kiss - s) * kp, &dfc, cv->hint);
         fto = (moment(cv, s, e_mod) - fc * cv->L_pp) / cv->L_b;
         r = cv->xc - kb * s - comp * fto - x_to;
+        for (k = 0; k < 100; ++k) {
+            double slope, s_new;
+            if (fabs(r) <= 1e-15 * (1.0 + fabs(x_to)) || hi - lo <= 1e-15 * (1.0 + hi)) break;
+            if (r > 0.0) lo = s; else hi = s;
+            slope = -kb - comp * (moment_slope(cv, s, e_mod) + dfc * kp * cv->L_pp) / cv->L_b;
+            s_new = slope < 0.0 ? s - r / slope : 0.5 * (lo + hi);
+            s = (s_new > lo && s_new < hi) ? s_new : 0.5 * (lo + hi);
+            fc = cushion(&b, (s_kiss - s) * kp, &dfc, cv->hint);
+            fto = (moment(cv, s, e_mod) - fc * cv->L_pp) / cv->L_b;
+            r = cv->xc - kb * s - comp * fto - x_to;
+        }
+        cv->s_last = s;
+        out->clamp = fc;
+        out->bearing = fto;
+        out->cushion = fc;
+        out->u = (s_kiss - s) * kp;
+        out->s = s;
     }
-    cv->s_last = s;
-    out->clamp = fc;
-    out->bearing = fto;
-    out->cushion = fc;
-    out->u = (s_kiss - s) * kp;
-    out->s = s;
     return fto < 0.0 ? -1 : 0;
 }

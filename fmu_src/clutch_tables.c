@@ -71,31 +71,9 @@ static void grid_bracket(const double *g, int n, double v, int *i, double *w) {
     *w = (v - g[lo]) / (g[lo + 1] - g[lo]);
 }
 
-/* dF/du of the interpolant (0 outside the table) */
-static double curve_slope(const Curve *c, double u) {
-    int lo = 0, hi = c->n - 1, i;
-    double h, t, t2;
-    if (u <= c->x[0] || u >= c->x[c->n - 1]) return 0.0;
-    while (hi - lo > 1) {
-        int mid = (lo + hi) / 2;
-        if (c->x[mid] <= u) lo = mid; else hi = mid;
-    }
-    i = lo;
-    h = c->x[i + 1] - c->x[i];
-    t = (u - c->x[i]) / h;
-    t2 = t * t;
-    return (6 * t2 - 6 * t) * (c->y[i] - c->y[i + 1]) / h + (3 * t2 - 4 * t + 1) * c->d[i] +
-           (3 * t2 - 2 * t) * c->d[i + 1];
-}
+void cc_table_bracket(const Table *tb, double theta, int *i, double *w) { grid_bracket(tb->theta, tb->nt, theta, i, w); }
 
-double cc_table_force_slope(const Table *tb, double u, double theta) {
-    int i; double w, d0;
-    grid_bracket(tb->theta, tb->nt, theta, &i, &w);
-    d0 = curve_slope(&tb->curves[i], u);
-    return w == 0.0 ? d0 : (1.0 - w) * d0 + w * curve_slope(&tb->curves[i + 1], u);
-}
-
-/* compression from which F no longer grows / below which F is its first value (the active curves) */
+/* compression from which F no longer grows at theta (the longest active curve) */
 double cc_table_full(const Table *tb, double theta) {
     int i; double w, a, b;
     grid_bracket(tb->theta, tb->nt, theta, &i, &w);
@@ -105,14 +83,6 @@ double cc_table_full(const Table *tb, double theta) {
     return w == 1.0 ? b : (a > b ? a : b);
 }
 
-double cc_table_first(const Table *tb, double theta) {
-    int i; double w, a, b;
-    grid_bracket(tb->theta, tb->nt, theta, &i, &w);
-    a = tb->curves[i].x[0];
-    if (w == 0.0) return a;
-    b = tb->curves[i + 1].x[0];
-    return w == 1.0 ? b : (a < b ? a : b);
-}
 
 double cc_table_force(const Table *tb, double u, double theta) {
     int i; double w, f0;

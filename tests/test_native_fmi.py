@@ -387,3 +387,67 @@ def test_fmi3_sources_build_with_fmpy_compile(tmp_path):
     a, b = (simulate_fmu(str(f), stop_time=2.0, start_values={"theta_cm": 500.0}, output=["theta_cs"])
             for f in (src_only, native_fmus()[3]))
     assert a["theta_cs"][-1] == pytest.approx(b["theta_cs"][-1], rel=1e-13) and a["theta_cs"][-1] > 320.0
+
+
+# ------------------------------------------------------------ Model Exchange: bad input
+def _me_instance(version):
+    from fmpy.fmi2 import FMU2Model
+    from fmpy.fmi3 import FMU3Model
+    fmu = native_fmus()[version]
+    md = read_model_description(str(fmu))
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    cls = FMU2Model if version == 2 else FMU3Model
+    m = cls(guid=md.guid, unzipDirectory=extract(str(fmu)), modelIdentifier=md.modelExchange.modelIdentifier,
+            instanceName=f"me{version}")
+    m.instantiate(loggingOn=False)
+    if version == 2:
+        m.setupExperiment(startTime=0.0)
+        m.enterInitializationMode()
+    else:
+        m.enterInitializationMode(startTime=0.0)
+    m.exitInitializationMode()
+    if version == 2:
+        m.newDiscreteStates()
+    else:
+        m.updateDiscreteStates()
+    m.enterContinuousTimeMode()
+    return m, vr
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_me_refuses_bad_inputs_on_output_reads_and_derivatives(version, capfd):
+    m, vr = _me_instance(version)
+    get = m.getReal if version == 2 else m.getFloat64
+    put = m.setReal if version == 2 else m.setFloat64
+    from ctypes import c_double
+    buf = (c_double * 1)()
+    der = (lambda: m.getDerivatives(buf, 1)) if version == 2 else (lambda: m.getContinuousStateDerivatives(buf, 1))
+    put([vr["x_to"]], [0.006])
+    good = get([vr["torque"]])[0]
+    assert good > 0.0
+    for bad in ([vr["x_to"]], [math.nan]), ([vr["theta_cm"]], [-5.0]), ([vr["x_to"]], [2.0]):
+        put(*bad)
+        assert _status(lambda: get([vr["torque"]])) == "discard"
+        assert _status(der) == "discard"
+        out = capfd.readouterr().out
+        name = "x_to" if bad[0][0] == vr["x_to"] else "theta_cm"
+        assert f"input {name} =" in out and "outputs not updated" in out and "no derivative" in out
+        assert get([vr["x_to"], vr["mu"]])[1] == 0.28        # inputs and parameters stay readable
+        put([vr["x_to"], vr["theta_cm"]], [0.006, 293.15])
+        assert get([vr["torque"]])[0] == good
+    for t in (math.nan, math.inf):
+        assert _status(lambda: m.setTime(t)) == "error"
+        assert "is not finite" in capfd.readouterr().out
+    m.setTime(1.0)
+    m.terminate()
+    m.freeInstance()
+
+
+def test_negative_table_forces_are_refused_with_the_line(tmp_path, capfd):
+    def negative(folder):
+        lines = (folder / "force_deflection.csv").read_text().splitlines()
+        lines[1] = ",".join(lines[1].split(",")[:2] + ["-498"])
+        (folder / "force_deflection.csv").write_text("\n".join(lines) + "\n")
+    with pytest.raises(Exception, match="instantiate"):
+        _outputs_with_tables(tmp_path, "negative", negative)
+    assert "force_deflection.csv line 2: force_N = -498 < 0" in capfd.readouterr().out

@@ -34,7 +34,7 @@ static const double RANGES[CC_NVARS][4] = {
 
 /* cover parameters (cover.CoverParameters defaults), in CV_* order */
 static const double COVER_DEFAULTS[CV_NPAR] = {
-    0.1125, 0.085, 0.0026, 0.0052, 206e9, 2.7e-4, 0.3, 0.111, 0.089, 0.0028, 1.0e-6, 0.007, 3.0e-5, 0.016,
+    0.1125, 0.085, 0.0026, 0.0052, 206e9, 2.7e-4, 0.3, 0.111, 0.089, 0.0036, 1.0e-6, 0.007, 3.0e-5, 0.016,
     1.1e-5, 0.010, 1.1e-5, 293.15};
 
 static int is_input(unsigned int vr) { return vr == VR_X_TO || vr == VR_THETA_CM || vr == VR_OMEGA_SLIP; }

@@ -96,7 +96,7 @@ class CoverParameters:
     diaphragm_poisson_ratio: float = 0.3                #: nu, 1
     pressure_plate_radius_m: float = 0.111    #: load circle on the pressure plate r_pp, m
     fulcrum_radius_m: float = 0.089           #: cover fulcrum (pivot ring) radius r_f, m
-    installed_deflection_m: float = 0.0028    #: edge deflection s of the closed clutch, new facings, at theta_ref, m
+    installed_deflection_m: float = 0.0036    #: edge deflection s of the closed clutch, new facings, at theta_ref, m
     release_compliance_m_per_N: float = 1.0e-6  #: finger + bearing + release-system compliance c, m/N
     facing_thickness_m: float = 0.007         #: both facings together, m
     facing_expansion_per_K: float = 3.0e-5    #: facings' through-thickness expansion, 1/K

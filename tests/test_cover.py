@@ -127,9 +127,9 @@ def test_release_force_rises_peaks_and_falls(table):
         f = np.array([outputs(float(v), theta, table, P).bearing_force for v in x])
         k = int(np.argmax(f))
         assert 0 < k < len(x) - 1
-        assert f[0] < 0.8 * f[k]          # rises from the open position
-        assert f[-1] == 0.0               # falls to lift-off
-        assert np.all(np.diff(f[:k + 1]) >= -1e-9)
+        assert f[0] < 0.85 * f[k]         # rises from the open position ...
+        assert f[-1] == 0.0               # ... and falls, through the cushion's travel, to lift-off
+        assert np.all(np.diff(f[k:]) <= 1e-9)
 
 
 def test_wear_moves_the_kiss_point_and_the_closed_load(table):
@@ -156,7 +156,7 @@ def test_kiss_budget_adds_up(table):
 
 def test_inverse_follows_the_new_map(table):
     for theta in TEMPS_K:
-        for tq in (1.0, 50.0, 150.0, 200.0, 250.0, 290.0):
+        for tq in (1.0, 50.0, 150.0, 200.0, 250.0, 280.0):
             x = x_to_for_torque(tq, theta, table, P)
             assert outputs(x, theta, table, P).torque == pytest.approx(tq, rel=1e-8)
             assert outputs(x - 1e-7, theta, table, P).torque < tq

@@ -127,7 +127,7 @@ def test_release_force_rises_peaks_and_falls(table):
         f = np.array([outputs(float(v), theta, table, P).bearing_force for v in x])
         k = int(np.argmax(f))
         assert 0 < k < len(x) - 1
-        assert f[0] < 0.85 * f[k]         # rises from the open position ...
+        assert f[0] < 0.9 * f[k]          # rises by > 10 % from the open position ...
         assert f[-1] == 0.0               # ... and falls, through the cushion's travel, to lift-off
         assert np.all(np.diff(f[k:]) <= 1e-9)
 

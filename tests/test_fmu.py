@@ -271,3 +271,22 @@ def test_exports_read_back_equal_to_tables(tables, tmp_path):
     assert mat["delta_kiss_m"].ravel() == pytest.approx(tables.delta_kiss_m)
     assert mo["delta_kiss_m"][:, 1] == pytest.approx(tables.delta_kiss_m, rel=1e-11)
     assert "force_N [N]" in str(mat["units"])
+
+
+def test_exports_carry_the_cover_map_at_full_precision(tmp_path):
+    """clamp/bearing force tables equal the model at every node; x_to values are distinct after reading back."""
+    from cushion_clutch.model import ClutchParameters, outputs
+    mat = loadmat(export_mat(DEFAULT_TABLES, tmp_path / "t.mat"))
+    mo = read_modelica(export_modelica(DEFAULT_TABLES, tmp_path / "t.txt"))
+    table, p = load_table(), ClutchParameters()
+    x_mo, th = mo["clamp_force_N"][1:, 0], mo["clamp_force_N"][0, 1:]
+    assert np.all(np.diff(x_mo) > 0)                               # CombiTable2Ds needs strictly increasing u
+    assert np.array_equal(x_mo, mat["x_to_m"].ravel())             # %.17g round-trips exactly
+    assert np.array_equal(mo["force_N"][1:, 0], mat["u_m"].ravel())
+    for k in range(0, len(x_mo), 37):
+        for j, t in enumerate(th):
+            o = outputs(float(x_mo[k]), t + 273.15, table, p, t + 273.15)
+            assert mo["clamp_force_N"][1 + k, 1 + j] == o.clamp_force
+            assert mo["bearing_force_N"][1 + k, 1 + j] == o.bearing_force
+    assert np.all(np.diff(mat["clamp_force_N"], axis=0) >= 0)      # monotone in x_to at every temperature
+    assert "HoldLastPoint" in (tmp_path / "t.txt").read_text()

@@ -105,10 +105,45 @@ static int range_ok(int k, double v) {
     return isfinite(v) && (g[2] ? v > g[0] : v >= g[0]) && (g[3] ? v < g[1] : v <= g[1]);
 }
 
-/* the bearing radius r_f - lever_ratio (r_pp - r_f) must stay > 0 */
-static int cover_geometry_ok(const double *r) {
-    const double *c = COVER_DEFAULTS;
-    return r[VR_LEVER_RATIO] * (c[CV_RPP] - c[CV_RF]) < c[CV_RF];
+/* the cover parameters of a variable vector (CV_* order) */
+static const double *cover_params(const double *r) { (void)r; return COVER_DEFAULTS; }
+
+/* the cover's consistency rules of cover.CoverParameters.problems (ranges are checked before);
+   logs each problem when m is not NULL; returns 1 if the cover is consistent */
+static int cover_consistent(CcModel *m, const double *r, const char *fn) {
+    const double *c = cover_params(r);
+    double lever = r[VR_LEVER_RATIO];
+    int ok = 1;
+    if (!(c[CV_B] < c[CV_RF] && c[CV_RF] < c[CV_RPP] && c[CV_RPP] <= c[CV_A])) {
+        if (m) cc_log(m, CC_ERROR, "%s: radii must satisfy diaphragm_inner_radius_m < fulcrum_radius_m < "
+                      "pressure_plate_radius_m <= diaphragm_outer_radius_m (got %g < %g < %g <= %g)", fn, c[CV_B],
+                      c[CV_RF], c[CV_RPP], c[CV_A]);
+        ok = 0;
+    }
+    if (!(c[CV_H] < 2.0 * sqrt(2.0) * c[CV_T])) {
+        if (m) cc_log(m, CC_ERROR, "%s: diaphragm_cone_height_m / diaphragm_thickness_m = %g must be < 2 sqrt(2) "
+                      "(above, the diaphragm's valley force is negative: it snaps through)", fn, c[CV_H] / c[CV_T]);
+        ok = 0;
+    }
+    if (!(c[CV_KE] * (2000.0 - c[CV_TREF]) < 1.0)) {
+        if (m) cc_log(m, CC_ERROR, "%s: diaphragm_modulus_drop_per_K: E(theta) must stay > 0 up to 2000 K", fn);
+        ok = 0;
+    }
+    if (ok && !(lever * (c[CV_RPP] - c[CV_RF]) < c[CV_RF])) {
+        if (m) cc_log(m, CC_ERROR, "%s: lever_ratio = %g puts the bearing at r_b = r_f - i (r_pp - r_f) = %g m; "
+                      "must be > 0", fn, lever, c[CV_RF] - lever * (c[CV_RPP] - c[CV_RF]));
+        ok = 0;
+    }
+    if (ok && m) {
+        CcCover cv;
+        cc_cover_prepare(&cv, c, lever, r[VR_X_KISS_REF], &m->table);
+        if (!(cc_cover_slope_bound(&cv) > 0.0)) {
+            cc_log(m, CC_ERROR, "%s: release_compliance_m_per_N = %g: the release snaps through (x_to(s) not "
+                   "monotone on the diaphragm's falling branch); reduce it", fn, c[CV_C]);
+            ok = 0;
+        }
+    }
+    return ok;
 }
 
 /* every parameter problem is logged (prefix names the call); returns 1 if all are valid */
@@ -126,12 +161,7 @@ static int check_parameters(CcModel *m, const double *r, const char *fn) {
         cc_log(m, CC_ERROR, "%s: parameter n_surfaces = %g must be a whole number in [1, 16]", fn, r[VR_N_SURFACES]);
         ok = 0;
     }
-    if (ok && !cover_geometry_ok(r)) {
-        cc_log(m, CC_ERROR, "%s: parameter lever_ratio = %g puts the release bearing at r_b = fulcrum_radius_m - "
-               "lever_ratio (pressure_plate_radius_m - fulcrum_radius_m) = %g m; must be > 0", fn, r[VR_LEVER_RATIO],
-               COVER_DEFAULTS[CV_RF] - r[VR_LEVER_RATIO] * (COVER_DEFAULTS[CV_RPP] - COVER_DEFAULTS[CV_RF]));
-        ok = 0;
-    }
+    if (ok && !cover_consistent(m, r, fn)) ok = 0;
     if (ok && !(r[VR_U] + r[VR_H] > 0.0)) {
         cc_log(m, CC_ERROR, "%s: U + H must be > 0 (the cushion spring needs a heat path)", fn);
         ok = 0;
@@ -169,7 +199,7 @@ static int update_outputs(CcModel *m) {
     double mu = tb->f_mu ? cc_table_mu(tb, r[VR_THETA_CM] - KELVIN, r[VR_OMEGA_SLIP]) : r[VR_MU];
     double g = r[VR_U] + r[VR_H];
     if (!m->cover_ok) {
-        cc_cover_prepare(&m->cover, COVER_DEFAULTS, r[VR_LEVER_RATIO], r[VR_X_KISS_REF], tb);
+        cc_cover_prepare(&m->cover, cover_params(r), r[VR_LEVER_RATIO], r[VR_X_KISS_REF], tb);
         m->cover_ok = 1;
     }
     r[CC_VR_DER_THETA_CS] = (r[VR_U] * r[VR_THETA_CM] + r[VR_H] * r[VR_THETA_A] - g * r[VR_THETA_CS]) / r[VR_C];
@@ -208,7 +238,7 @@ static int refresh(CcModel *m, const char *fn) {
         int k;
         for (k = VR_N_SURFACES; k <= VR_LEVER_RATIO; ++k)
             if (!range_ok(k, m->r[k])) return CC_OK; /* reported at fmi*ExitInitializationMode */
-        if (!cover_geometry_ok(m->r)) return CC_OK;
+        if (!cover_consistent(NULL, m->r, fn)) return CC_OK;
         m->r[VR_THETA_CS] = m->r[VR_THETA_CS_START];
     } else if (!(m->phase & (PH_STEP | PH_EVENT | PH_CONT | PH_TERMINATED))) {
         return CC_OK;
@@ -286,14 +316,6 @@ int cc_exit_init(CcModel *m, const char *fn) {
     m->phase = m->me ? PH_EVENT : PH_STEP;
     m->dirty = 1;
     m->cover_ok = 0;
-    cc_cover_prepare(&m->cover, COVER_DEFAULTS, m->r[VR_LEVER_RATIO], m->r[VR_X_KISS_REF], &m->table);
-    m->cover_ok = 1;
-    if (!(cc_cover_slope_bound(&m->cover) > 0.0)) {
-        cc_log(m, CC_ERROR, "%s: the release snaps through (x_to(s) is not monotone on the diaphragm's falling "
-               "branch): reduce release_compliance_m_per_N", fn);
-        m->phase = PH_ERROR;
-        return CC_ERROR;
-    }
     if (inputs_ok(m->r)) update_outputs(m);
     return CC_OK;
 }

@@ -209,6 +209,10 @@ class CoverMap:
         self.kb = self.L_b / self.e              # bearing travel per unit of s (rigid fingers)
         self.kp = self.L_pp / self.e             # pressure-plate travel per unit of s
         self.comp = cover.release_compliance_m_per_N
+        t, nu = cover.diaphragm_thickness_m, cover.diaphragm_poisson_ratio
+        #: F_AL(s) / E / (s/t) / [...]: the Almen-Laszlo factor without E, 1/Pa * N
+        self._fal = 4.0 / (1.0 - nu * nu) * t ** 4 / (k1(self.a, self.b) * 4.0 * self.a * self.a)
+        self._xc: dict = {}
 
     # ---- pieces ---------------------------------------------------------------------------
     def youngs_modulus(self, theta_K: float) -> float:
@@ -217,14 +221,14 @@ class CoverMap:
         return c.diaphragm_youngs_modulus_Pa * (1.0 - c.diaphragm_modulus_drop_per_K * (theta_K - c.reference_temperature_K))
 
     def moment(self, s: float, e_mod: float) -> float:
-        """Elastic moment M(s) = F_AL(s) e of the diaphragm section, N.m."""
-        c = self.c
-        return almen_laszlo_force(s, self.a, self.b, c.diaphragm_thickness_m, c.diaphragm_cone_height_m, e_mod, c.diaphragm_poisson_ratio) * self.e
+        """Elastic moment M(s) = F_AL(s) e of the diaphragm section, N.m (:func:`almen_laszlo_force` times e)."""
+        t, h = self.c.diaphragm_thickness_m, self.c.diaphragm_cone_height_m
+        return self._fal * e_mod * (s / t) * ((h - s) * (h - 0.5 * s) / (t * t) + 1.0) * self.e
 
     def moment_slope(self, s: float, e_mod: float) -> float:
-        """dM/ds, N."""
-        c = self.c
-        return almen_laszlo_slope(s, self.a, self.b, c.diaphragm_thickness_m, c.diaphragm_cone_height_m, e_mod, c.diaphragm_poisson_ratio) * self.e
+        """dM/ds, N (:func:`almen_laszlo_slope` times e)."""
+        t, h = self.c.diaphragm_thickness_m, self.c.diaphragm_cone_height_m
+        return self._fal * e_mod / t * ((h - s) * (h - 0.5 * s) / (t * t) + 1.0 - s * (1.5 * h - s) / (t * t)) * self.e
 
     def x_slope_bound(self, e_mod: float) -> float:
         """-(dx_to/ds) at its largest, open phase, 1 (> 0: no snap-through)."""
@@ -239,11 +243,17 @@ class CoverMap:
 
     def x_c(self, table, x_kiss_ref: float) -> float:
         """The bearing-system constant X_c that puts the reference kiss point at ``x_kiss_ref``, m."""
+        key = (id(table), x_kiss_ref)
+        hit = self._xc.get(key)
+        if hit is not None and hit[0] is table:
+            return hit[1]
         c = self.c
         theta_ref_c = c.reference_temperature_K - 273.15
         s_k0 = c.installed_deflection_m + table.full_compression(theta_ref_c) / self.kp
         f_to = (self.moment(s_k0, c.diaphragm_youngs_modulus_Pa) - table.force(0.0, theta_ref_c) * self.L_pp) / self.L_b
-        return x_kiss_ref + self.kb * s_k0 + self.comp * f_to
+        xc = x_kiss_ref + self.kb * s_k0 + self.comp * f_to
+        self._xc[key] = (table, xc)
+        return xc
 
     # ---- the map ----------------------------------------------------------------------------
     def prepare(self, theta_cs: float, theta_cm: float, wear: float, table, x_kiss_ref: float) -> "_Frame":
@@ -300,6 +310,9 @@ class _Frame:
     def __init__(self, g: CoverMap, table, theta_c: float, e_mod: float, xc: float, s_kiss: float, s_solid: float,
                  theta_cs: float, wear: float):
         self.g, self.table, self.theta_c, self.e_mod, self.xc = g, table, theta_c, e_mod, xc
+        i, self._w = table._bracket(theta_c)        # the curves of this temperature, as table.force uses them
+        self._c0 = table.curves[i]
+        self._c1 = table.curves[i + 1] if self._w != 0.0 else None
         self.s_kiss, self.s_solid, self.theta_cs, self.wear = s_kiss, s_solid, theta_cs, wear
         self.fto_solid, self.fc_solid = self.f_to(s_solid)
         self.x_solid = xc - g.kb * s_solid - g.comp * self.fto_solid
@@ -312,10 +325,20 @@ class _Frame:
         return (f"the diaphragm cannot hold the cushion: bearing force {fto:.6g} N < 0 at {where} "
                 f"(theta_cs = {self.theta_cs:g} K, facing_wear = {self.wear:g} m)")
 
+    def cushion(self, u: float) -> float:
+        """F(u, theta_cs), N (= ``table.force``, with the temperature bracket found once)."""
+        f0 = self._c0(u)
+        return f0 if self._w == 0.0 else (1.0 - self._w) * f0 + self._w * self._c1(u)
+
+    def cushion_slope(self, u: float) -> float:
+        """dF/du at theta_cs, N/m (= ``table.force_slope``)."""
+        d0 = self._c0.slope(u)
+        return d0 if self._w == 0.0 else (1.0 - self._w) * d0 + self._w * self._c1.slope(u)
+
     def f_to(self, s: float) -> tuple[float, float]:
         """(bearing force, cushion force) at deflection ``s`` while the bearing is on the fingers, N."""
         g = self.g
-        fc = self.table.force((self.s_kiss - s) * g.kp, self.theta_c)
+        fc = self.cushion((self.s_kiss - s) * g.kp)
         return (g.moment(s, self.e_mod) - fc * g.L_pp) / g.L_b, fc
 
     def x_of(self, s: float) -> float:
@@ -345,7 +368,7 @@ class _Frame:
                 hi = s
             u = (s_kiss - s) * kp
             slope = -kb - comp * (g.moment_slope(s, self.e_mod)
-                                  + self.table.force_slope(u, self.theta_c) * kp * g.L_pp) / g.L_b
+                                  + self.cushion_slope(u) * kp * g.L_pp) / g.L_b
             s_new = s - r / slope if slope < 0.0 else 0.5 * (lo + hi)
             s = s_new if lo < s_new < hi else 0.5 * (lo + hi)
             r = self.x_of(s) - x_to

@@ -27,12 +27,12 @@ from dataclasses import dataclass, field, fields
 from functools import lru_cache
 
 try:                                    # inside the pythonfmu FMU the modules are siblings
-    from .cover import CoverMap, CoverParameters
+    from .cover import CoverMap, CoverParameters, range_problems
     from .friction import FrictionTable
     from .spring_table import KELVIN, Curve, SpringTable, pchip_slopes
     from .table_format import load_csv
 except ImportError:
-    from cover import CoverMap, CoverParameters
+    from cover import CoverMap, CoverParameters, range_problems
     from friction import FrictionTable
     from spring_table import KELVIN, Curve, SpringTable, pchip_slopes
     from table_format import load_csv
@@ -121,17 +121,7 @@ class ClutchParameters:
 
     def problems(self) -> list[str]:
         """Every parameter outside its allowed range, with the range."""
-        out = []
-        for f in fields(self):
-            if f.name == "cover":
-                continue
-            v = getattr(self, f.name)
-            lo, hi, lo_open, hi_open = self.RANGES[f.name]
-            ok = isinstance(v, (int, float)) and math.isfinite(v) and (
-                v > lo if lo_open else v >= lo) and (v < hi if hi_open else v <= hi)
-            if not ok:
-                out.append(f"{f.name} = {v!r} is out of range {'(' if lo_open else '['}{lo:g}, "
-                           f"{hi:g}{')' if hi_open else ']'}")
+        out = range_problems(self, self.RANGES)
         if not out and self.n_surfaces != int(self.n_surfaces):
             out.append(f"n_surfaces = {self.n_surfaces!r} must be a positive integer in [1, 16]")
         if not out and self.U + self.H <= 0.0:

@@ -76,7 +76,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, fields
 
-__all__ = ["CoverParameters", "CoverState", "k1", "almen_laszlo_force", "almen_laszlo_slope", "CoverMap"]
+__all__ = ["range_problems", "CoverParameters", "CoverState", "k1", "almen_laszlo_force", "almen_laszlo_slope", "CoverMap"]
 
 
 @dataclass(frozen=True)
@@ -130,15 +130,7 @@ class CoverParameters:
 
     def problems(self, lever_ratio: float | None = None) -> list[str]:
         """Every parameter outside its range and every inconsistent geometry, with the rule."""
-        out = []
-        for f in fields(self):
-            v = getattr(self, f.name)
-            lo, hi, lo_open, hi_open = self.RANGES[f.name]
-            ok = isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) and (
-                v > lo if lo_open else v >= lo) and (v < hi if hi_open else v <= hi)
-            if not ok:
-                out.append(f"{f.name} = {v!r} is out of range {'(' if lo_open else '['}{lo:g}, "
-                           f"{hi:g}{')' if hi_open else ']'}")
+        out = range_problems(self, self.RANGES)
         if out:
             return out
         a, b, r_pp, r_f = self.diaphragm_outer_radius_m, self.diaphragm_inner_radius_m, self.pressure_plate_radius_m, self.fulcrum_radius_m
@@ -160,6 +152,25 @@ class CoverParameters:
                 out.append(f"release_compliance_m_per_N = {self.release_compliance_m_per_N:g}: the release snaps "
                            "through (x_to(s) not monotone on the diaphragm's falling branch); reduce it")
         return out
+
+
+def range_problems(params, ranges: dict) -> list[str]:
+    """Every field of the dataclass ``params`` named in ``ranges`` that is not a finite number in its range.
+
+    ``ranges`` maps a field name to ``(low, high, low_open, high_open)``.
+    """
+    out = []
+    for f in fields(params):
+        if f.name not in ranges:
+            continue
+        v = getattr(params, f.name)
+        lo, hi, lo_open, hi_open = ranges[f.name]
+        ok = isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) and (
+            v > lo if lo_open else v >= lo) and (v < hi if hi_open else v <= hi)
+        if not ok:
+            out.append(f"{f.name} = {v!r} is out of range {'(' if lo_open else '['}{lo:g}, "
+                       f"{hi:g}{')' if hi_open else ']'}")
+    return out
 
 
 def k1(a: float, b: float) -> float:

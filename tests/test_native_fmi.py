@@ -291,6 +291,13 @@ def _outputs_with_tables(tmp_path, name, edit):
     return got
 
 
+def _set_force(folder, line, value):
+    """Replace the force of row ``line`` (0 = header) of force_deflection.csv with ``value``."""
+    lines = (folder / "force_deflection.csv").read_text().splitlines()
+    lines[line] = ",".join(lines[line].split(",")[:2] + [value])
+    (folder / "force_deflection.csv").write_text("\n".join(lines) + "\n")
+
+
 def _reverse_groups(folder):
     for name in ("force_deflection.csv", "kiss_point.csv"):
         lines = (folder / name).read_text().splitlines()
@@ -304,12 +311,8 @@ def test_tables_in_any_order_and_overflowing_forces(tmp_path, capfd):
     assert _outputs_with_tables(tmp_path, "reversed", _reverse_groups) == _outputs_with_tables(
         tmp_path, "as_built", lambda f: None)
 
-    def huge(folder):
-        lines = (folder / "force_deflection.csv").read_text().splitlines()
-        lines[3] = ",".join(lines[3].split(",")[:2] + ["1e308"])
-        (folder / "force_deflection.csv").write_text("\n".join(lines) + "\n")
     with pytest.raises(Exception, match="instantiate"):
-        _outputs_with_tables(tmp_path, "huge", huge)
+        _outputs_with_tables(tmp_path, "huge", lambda folder: _set_force(folder, 3, "1e308"))
     assert "force_deflection.csv line 4: force_N = 1e+308 is outside" in capfd.readouterr().out
 
 
@@ -444,10 +447,6 @@ def test_me_refuses_bad_inputs_on_output_reads_and_derivatives(version, capfd):
 
 
 def test_negative_table_forces_are_refused_with_the_line(tmp_path, capfd):
-    def negative(folder):
-        lines = (folder / "force_deflection.csv").read_text().splitlines()
-        lines[1] = ",".join(lines[1].split(",")[:2] + ["-498"])
-        (folder / "force_deflection.csv").write_text("\n".join(lines) + "\n")
     with pytest.raises(Exception, match="instantiate"):
-        _outputs_with_tables(tmp_path, "negative", negative)
+        _outputs_with_tables(tmp_path, "negative", lambda folder: _set_force(folder, 1, "-498"))
     assert "force_deflection.csv line 2: force_N = -498 < 0" in capfd.readouterr().out

@@ -55,7 +55,7 @@ void cc_cover_prepare(CcCover *cv, const double *par, double lever_ratio, double
     s_k0 = par[CV_SINST] + cv->u_full_ref / cv->kp;
     f_to = (moment(cv, s_k0, par[CV_E]) - cc_table_force(tb, 0.0, th_ref) * cv->L_pp) / cv->L_b;
     cv->xc = x_kiss_ref + cv->kb * s_k0 + par[CV_C] * f_to;
-    cv->s_last = NAN;
+    cv->s_last = cv->x_last = NAN;
     cv->f_theta_cs = NAN; /* no frame yet */
     cv->hint[0] = cv->hint[1] = cv->hint_k[0] = cv->hint_k[1] = 0;
 }
@@ -130,7 +130,8 @@ int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
         cv->fto_solid = (m_solid - cv->fc_solid * cv->L_pp) / cv->L_b;
         cv->x_solid = cv->xc - kb * cv->s_solid - comp * cv->fto_solid;
         fc = cushion(&b, 0.0, &dummy, cv->hint_k);
-        cv->x_kiss = cv->xc - kb * cv->s_kiss - comp * (moment(cv, cv->s_kiss, e_mod) - fc * cv->L_pp) / cv->L_b;
+        cv->fto_kiss = (moment(cv, cv->s_kiss, e_mod) - fc * cv->L_pp) / cv->L_b;
+        cv->x_kiss = cv->xc - kb * cv->s_kiss - comp * cv->fto_kiss;
         cv->f_theta_cs = theta_cs;
         cv->f_theta_cm = theta_cm;
         cv->f_wear = wear;
@@ -158,7 +159,13 @@ int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
         b.w = cv->f_w;
         lo = cv->s_solid;
         hi = (cv->xc - x_to) / kb;
-        s = cv->s_last > lo && cv->s_last < hi ? cv->s_last : hi;
+        /* start: the last solution for a small move, else the chord of x(s) between the solid and kiss
+           points (cushion phase) or the rigid lever shifted by the kiss-point compliance (open) */
+        if (fabs(x_to - cv->x_last) < 1e-5 && cv->s_last > lo && cv->s_last < hi) s = cv->s_last;
+        else if (x_to >= cv->x_kiss)
+            s = cv->s_solid + (cv->s_kiss - cv->s_solid) * (cv->x_solid - x_to) / (cv->x_solid - cv->x_kiss);
+        else s = (cv->xc - x_to - comp * cv->fto_kiss) / kb;
+        if (!(s > lo && s < hi)) s = hi;
         fc = cushion(&b, (s_kiss - s) * kp, &dfc, cv->hint);
         fto = (moment(cv, s, e_mod) - fc * cv->L_pp) / cv->L_b;
         r = cv->xc - kb * s - comp * fto - x_to;
@@ -174,6 +181,7 @@ int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
             r = cv->xc - kb * s - comp * fto - x_to;
         }
         cv->s_last = s;
+        cv->x_last = x_to;
         out->clamp = fc;
         out->bearing = fto;
         out->cushion = fc;

@@ -82,10 +82,11 @@ class CushionClutch(Fmi2Slave):
         self.x_to = 0.0
         self.theta_cm = defaults.theta_a
         self.omega_slip = OMEGA_SLIP_START
+        flat = defaults.flat()
         for name in PARAMETERS:
-            setattr(self, name, float(getattr(defaults, name)))
+            setattr(self, name, float(flat[name]))
         self.theta_cs = defaults.theta_cs_start
-        self.torque = self.force = self.u_f = 0.0
+        self.torque = self.force = self.u_f = self.clamp_force = self.bearing_force = 0.0
         self.x_kiss = defaults.x_kiss_ref
         self._range_warned = False
         self._params = defaults
@@ -157,7 +158,7 @@ class CushionClutch(Fmi2Slave):
             self.log(p, Fmi2Status.error)
         self.theta_cs = params.theta_cs_start
         if problems:
-            self.torque = self.force = self.u_f = 0.0
+            self.torque = self.force = self.u_f = self.clamp_force = self.bearing_force = 0.0
             return
         self._params = params
         if not self._input_problems():
@@ -281,6 +282,7 @@ class CushionClutch(Fmi2Slave):
 
     def _set_outputs(self, out) -> None:
         self.torque, self.force, self.u_f, self.x_kiss = out.torque, out.force, out.u_f, out.x_kiss
+        self.clamp_force, self.bearing_force = out.clamp_force, out.bearing_force
         if out.clamped and not self._range_warned:
             self._range_warned = True
             self.log(f"theta_cs = {self.theta_cs:.2f} K is outside the table range "

@@ -3,6 +3,7 @@
  * step (Co-Simulation) and derivative (Model Exchange), the state machine checks shared by both
  * FMI versions, and the saved state (versioned, checksummed, validated).
  */
+#define CC_DEFINE_VARIABLE_TABLE /* CC_VARIABLES (cushion_variables.h) is defined in this file */
 #include "clutch_core.h"
 
 #include <math.h>
@@ -11,34 +12,23 @@
 #include <string.h>
 
 #define KELVIN 273.15
-#define X_TO_LIMIT 1.0
-#define THETA_CM_LIMIT 2000.0
-#define OMEGA_SLIP_LIMIT 1e4
+/* X_TO_LIMIT, THETA_CM_LIMIT, OMEGA_SLIP_LIMIT and the variable table CC_VARIABLES (names, causalities,
+   start values, parameter ranges) come from cushion_variables.h, generated from clutch_model */
+#define VAR_NAME(vr) (CC_VARIABLES[vr].name)
 
-static const char *VAR_NAMES[CC_NVARS] = {
-    "x_to", "theta_cm", "torque", "force", "theta_cs", "u_f", "x_kiss", "n_surfaces", "mu",
-    "R_eq", "U", "H", "C", "theta_a", "theta_cs_start", "x_kiss_ref", "lever_ratio", "omega_slip",
-    "der(theta_cs)"};
+static int is_input(unsigned int vr) { return vr < CC_NVARS && CC_VARIABLES[vr].causality == CC_INPUT; }
+static int is_parameter(unsigned int vr) { return vr < CC_NVARS && CC_VARIABLES[vr].causality == CC_PARAMETER; }
 
-/* defaults: inputs, outputs (start), parameters (clutch_model.ClutchParameters) */
-static const double DEFAULTS[CC_NVARS] = {
-    0.0, 293.15, 0.0, 0.0, 293.15, 0.0, 0.004, 2.0, 0.28, 0.089, 0.1, 0.04, 1.0, 293.15, 293.15,
-    0.004, 3.0, 0.0, 0.0};
-
-/* allowed parameter ranges: low, high, low open, high open (clutch_model.ClutchParameters.RANGES) */
-static const double RANGES[CC_NVARS][4] = {
-    {0}, {0}, {0}, {0}, {0}, {0}, {0},
-    {1.0, 16.0, 0, 0}, {0.0, 2.0, 0, 0}, {0.0, 1.0, 1, 0}, {0.0, 1e4, 0, 0}, {0.0, 1e4, 0, 0},
-    {0.0, 1e6, 1, 0}, {0.0, 2000.0, 1, 0}, {0.0, 2000.0, 1, 0}, {-1.0, 1.0, 0, 0},
-    {0.0, 100.0, 1, 0}, {0}, {0}};
+/* every variable at its start value (parameters: their defaults) */
+static void set_starts(double *r) {
+    int k;
+    for (k = 0; k < CC_NVARS; ++k) r[k] = CC_VARIABLES[k].start;
+}
 
 /* cover parameters (cover.CoverParameters defaults), in CV_* order */
 static const double COVER_DEFAULTS[CV_NPAR] = {
     0.1125, 0.085, 0.0026, 0.0052, 206e9, 2.7e-4, 0.3, 0.111, 0.089, 0.0036, 1.0e-6, 0.007, 3.0e-5, 0.016,
     1.1e-5, 0.010, 1.1e-5, 293.15};
-
-static int is_input(unsigned int vr) { return vr == VR_X_TO || vr == VR_THETA_CM || vr == VR_OMEGA_SLIP; }
-static int is_parameter(unsigned int vr) { return vr >= VR_N_SURFACES && vr <= VR_LEVER_RATIO; }
 
 static const char *phase_name(int phase) {
     switch (phase) {
@@ -79,7 +69,7 @@ int cc_instantiate(CcModel *m, const char *dir, int me, CcLogger logger, void *c
     m->log_ctx = ctx;
     m->logging_on = logging_on;
     m->me = me;
-    memcpy(m->r, DEFAULTS, sizeof m->r);
+    set_starts(m->r);
     m->phase = PH_INSTANTIATED;
     m->dirty = 1;
     m->table_ok = cc_table_load(&m->table, dir, m->table_error, sizeof m->table_error) == 0;
@@ -90,7 +80,7 @@ int cc_instantiate(CcModel *m, const char *dir, int me, CcLogger logger, void *c
 void cc_free(CcModel *m) { cc_table_free(&m->table); }
 
 void cc_reset(CcModel *m) {
-    memcpy(m->r, DEFAULTS, sizeof m->r);
+    set_starts(m->r);
     m->range_warned = 0;
     m->terminated = 0;
     m->time = 0.0;
@@ -101,7 +91,7 @@ void cc_reset(CcModel *m) {
 
 /* ------------------------------------------------------------------- checks */
 static int range_ok(int k, double v) {
-    const double *g = RANGES[k];
+    const double *g = CC_VARIABLES[k].range;
     return isfinite(v) && (g[2] ? v > g[0] : v >= g[0]) && (g[3] ? v < g[1] : v <= g[1]);
 }
 
@@ -149,10 +139,10 @@ static int cover_consistent(CcModel *m, const double *r, const char *fn) {
 /* every parameter problem is logged (prefix names the call); returns 1 if all are valid */
 static int check_parameters(CcModel *m, const double *r, const char *fn) {
     int k, ok = 1;
-    for (k = VR_N_SURFACES; k <= VR_LEVER_RATIO; ++k) {
-        const double *g = RANGES[k];
-        if (!range_ok(k, r[k])) {
-            cc_log(m, CC_ERROR, "%s: parameter %s = %g is out of range %c%g, %g%c", fn, VAR_NAMES[k], r[k],
+    for (k = 0; k < CC_NVARS; ++k) {
+        const double *g = CC_VARIABLES[k].range;
+        if (is_parameter((unsigned int)k) && !range_ok(k, r[k])) {
+            cc_log(m, CC_ERROR, "%s: parameter %s = %g is out of range %c%g, %g%c", fn, VAR_NAME(k), r[k],
                    g[2] ? '(' : '[', g[0], g[1], g[3] ? ')' : ']');
             ok = 0;
         }
@@ -236,8 +226,8 @@ static int refresh(CcModel *m, const char *fn) {
     }
     if (m->phase == PH_INIT) {
         int k;
-        for (k = VR_N_SURFACES; k <= VR_LEVER_RATIO; ++k)
-            if (!range_ok(k, m->r[k])) return CC_OK; /* reported at fmi*ExitInitializationMode */
+        for (k = 0; k < CC_NVARS; ++k)
+            if (is_parameter((unsigned int)k) && !range_ok(k, m->r[k])) return CC_OK; /* reported at ExitInit */
         if (!cover_consistent(NULL, m->r, fn)) return CC_OK;
         m->r[VR_THETA_CS] = m->r[VR_THETA_CS_START];
     } else if (!(m->phase & (PH_STEP | PH_EVENT | PH_CONT | PH_TERMINATED))) {
@@ -258,11 +248,11 @@ int cc_set_real(CcModel *m, const unsigned int vr[], size_t n, const double v[],
         }
         if (!is_input(vr[k]) && !is_parameter(vr[k])) {
             cc_log(m, CC_ERROR, "%s: %s (value reference %u) is not an input or parameter and cannot be set", fn,
-                   VAR_NAMES[vr[k]], vr[k]);
+                   VAR_NAME(vr[k]), vr[k]);
             return CC_ERROR;
         }
         if (is_parameter(vr[k]) && after_init) {
-            cc_log(m, CC_ERROR, "%s: parameter %s is fixed after initialization", fn, VAR_NAMES[vr[k]]);
+            cc_log(m, CC_ERROR, "%s: parameter %s is fixed after initialization", fn, VAR_NAME(vr[k]));
             return CC_ERROR;
         }
     }
@@ -441,7 +431,7 @@ int cc_state_check(CcModel *m, const void *bytes, size_t size, const char *fn) {
     }
     for (k = 0; k < CC_NVARS; ++k)
         if (!isfinite(s.r[k])) {
-            cc_log(m, CC_ERROR, "%s: the state's %s = %g is not finite", fn, VAR_NAMES[k], s.r[k]);
+            cc_log(m, CC_ERROR, "%s: the state's %s = %g is not finite", fn, VAR_NAME(k), s.r[k]);
             return 0;
         }
     if (!isfinite(s.time) || !(s.r[VR_THETA_CS] > 0.0 && s.r[VR_THETA_CS] < THETA_CM_LIMIT) ||

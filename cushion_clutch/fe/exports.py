@@ -25,8 +25,8 @@ from pathlib import Path
 import numpy as np
 
 from ..model import ClutchParameters, SpringTable, outputs
-from ..fe.tables import read_tables
 from ..model.cover import CoverMap
+from .tables import read_tables
 
 UNITS_NOTE = "u_m [m] compression from the kiss point; theta_degC [degC]; force_N [N] whole spring; delta_kiss_m [m]"
 

@@ -25,10 +25,9 @@ static void set_starts(double *r) {
     for (k = 0; k < CC_NVARS; ++k) r[k] = CC_VARIABLES[k].start;
 }
 
-/* cover parameters (cover.CoverParameters defaults), in CV_* order */
-static const double COVER_DEFAULTS[CV_NPAR] = {
-    0.1125, 0.085, 0.0026, 0.0052, 206e9, 2.7e-4, 0.3, 0.111, 0.089, 0.0036, 1.0e-6, 0.007, 3.0e-5, 0.016,
-    1.1e-5, 0.010, 1.1e-5, 293.15};
+/* the cover's parameters are one block of variables in CV_* order (clutch_model.VARIABLES lists them so) */
+typedef char cover_block_is_contiguous[(VR_REFERENCE_TEMPERATURE_K - VR_DIAPHRAGM_OUTER_RADIUS_M == CV_NPAR - 1 &&
+                                        VR_FULCRUM_RADIUS_M - VR_DIAPHRAGM_OUTER_RADIUS_M == CV_RF) ? 1 : -1];
 
 static const char *phase_name(int phase) {
     switch (phase) {
@@ -96,7 +95,7 @@ static int range_ok(int k, double v) {
 }
 
 /* the cover parameters of a variable vector (CV_* order) */
-static const double *cover_params(const double *r) { (void)r; return COVER_DEFAULTS; }
+static const double *cover_params(const double *r) { return r + VR_DIAPHRAGM_OUTER_RADIUS_M; }
 
 /* the cover's consistency rules of cover.CoverParameters.problems (ranges are checked before);
    logs each problem when m is not NULL; returns 1 if the cover is consistent */
@@ -179,7 +178,7 @@ static void log_inputs(CcModel *m, int status, double t, const char *what) {
 }
 
 /* -------------------------------------------------------------------- model */
-static double facing_wear(const CcModel *m) { (void)m; return 0.0; }
+static double facing_wear(const CcModel *m) { return m->r[VR_FACING_WEAR]; }
 
 /* outputs of the current inputs and state; CC_DISCARD (logged) if the diaphragm cannot hold the cushion */
 static int update_outputs(CcModel *m) {
@@ -203,6 +202,8 @@ static int update_outputs(CcModel *m) {
     r[VR_FORCE] = st.cushion;
     r[VR_U_F] = st.u > 0.0 ? st.u : 0.0;
     r[VR_X_KISS] = st.x_kiss;
+    r[VR_CLAMP_FORCE] = st.clamp;
+    r[VR_BEARING_FORCE] = st.bearing;
     m->dirty = 0;
     if (!(tb->theta[0] + KELVIN <= r[VR_THETA_CS] && r[VR_THETA_CS] <= tb->theta[tb->nt - 1] + KELVIN) &&
         !m->range_warned) {
@@ -276,8 +277,7 @@ int cc_get_real(CcModel *m, const unsigned int vr[], size_t n, double v[], const
     if (m->dirty && refresh(m, fn) != CC_OK && m->me) {
         /* Model Exchange: outputs of invalid inputs are refused, as the derivative is */
         for (k = 0; k < n; ++k)
-            if (vr[k] == VR_TORQUE || vr[k] == VR_FORCE || vr[k] == VR_U_F || vr[k] == VR_X_KISS ||
-                vr[k] == CC_VR_DER_THETA_CS)
+            if ((CC_VARIABLES[vr[k]].causality == CC_OUTPUT && vr[k] != VR_THETA_CS) || vr[k] == CC_VR_DER_THETA_CS)
                 return CC_DISCARD;
     }
     for (k = 0; k < n; ++k) v[k] = m->r[vr[k]];
@@ -298,7 +298,7 @@ int cc_enter_init(CcModel *m, double start_time, const char *fn) {
 int cc_exit_init(CcModel *m, const char *fn) {
     if (!cc_allowed(m, PH_INIT, fn)) return CC_ERROR;
     if (!check_parameters(m, m->r, fn)) {
-        m->r[VR_TORQUE] = m->r[VR_FORCE] = m->r[VR_U_F] = 0.0;
+        m->r[VR_TORQUE] = m->r[VR_FORCE] = m->r[VR_U_F] = m->r[VR_CLAMP_FORCE] = m->r[VR_BEARING_FORCE] = 0.0;
         m->phase = PH_ERROR;
         return CC_ERROR;
     }

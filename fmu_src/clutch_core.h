@@ -102,7 +102,7 @@ typedef struct {
 
 /* the serialized (and saved) FMU state: versioned, checksummed, validated before use */
 #define CC_STATE_MAGIC 0x43434653u /* "CCFS" */
-#define CC_STATE_VERSION 2u
+#define CC_STATE_VERSION 3u /* 3: the cover variables */
 typedef struct {
     uint32_t magic, version, size;
     int32_t phase, me, range_warned, terminated, reserved;

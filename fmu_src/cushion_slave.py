@@ -43,7 +43,7 @@ PARAMETERS = [name for name, causality, _, _ in VARIABLES if causality == "param
 #: the outputs that clutch_model.outputs() returns (fields of Outputs): every output but the state theta_cs
 OUTPUTS = [name for name, causality, _, _ in VARIABLES if causality == "output" and name != "theta_cs"]
 #: tag of a serialized state; bump when the state's content changes
-STATE_FORMAT = "cushion_clutch.pythonfmu.state/1"
+STATE_FORMAT = "cushion_clutch.pythonfmu.state/2"
 PHASES = ("instantiated", "initialization", "stepping", "terminated")
 
 

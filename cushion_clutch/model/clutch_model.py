@@ -63,6 +63,30 @@ VARIABLES = (
     ("x_kiss_ref", "parameter", "m", "kiss point at the bearing at the table reference temperature"),
     ("lever_ratio", "parameter", "1", "diaphragm-spring lever ratio, bearing / pressure-plate travel"),
     ("omega_slip", "input", "rad/s", "clutch slip speed; selects mu from the friction table, if any"),
+    ("clamp_force", "output", "N", "pressure-plate (clamp) force F_pp from the cover's force balance"),
+    ("bearing_force", "output", "N", "release-bearing force F_to on the diaphragm fingers (0: lifted off)"),
+    ("facing_wear", "parameter", "m", "axial wear of both facings since new (moves the kiss point and the "
+                                      "diaphragm's installed deflection)"),
+    # the cover (cover.CoverParameters, in its field order: the native core reads them as one block)
+    ("diaphragm_outer_radius_m", "parameter", "m", "diaphragm spring outer radius a"),
+    ("diaphragm_inner_radius_m", "parameter", "m", "diaphragm spring inner radius b (finger roots)"),
+    ("diaphragm_thickness_m", "parameter", "m", "diaphragm spring sheet thickness t"),
+    ("diaphragm_cone_height_m", "parameter", "m", "diaphragm spring free cone height h between the edges"),
+    ("diaphragm_youngs_modulus_Pa", "parameter", "Pa", "diaphragm Young's modulus at reference_temperature_K"),
+    ("diaphragm_modulus_drop_per_K", "parameter", "1/K", "E(theta_cs) = E_ref (1 - k (theta_cs - theta_ref))"),
+    ("diaphragm_poisson_ratio", "parameter", "1", "diaphragm Poisson ratio"),
+    ("pressure_plate_radius_m", "parameter", "m", "diaphragm load circle on the pressure plate r_pp"),
+    ("fulcrum_radius_m", "parameter", "m", "cover fulcrum (pivot ring) radius r_f"),
+    ("installed_deflection_m", "parameter", "m", "diaphragm edge deflection of the closed clutch, new facings, "
+                                                 "reference temperature"),
+    ("release_compliance_m_per_N", "parameter", "m/N", "finger + bearing + release-system compliance"),
+    ("facing_thickness_m", "parameter", "m", "both facings together (thermal growth)"),
+    ("facing_expansion_per_K", "parameter", "1/K", "facings' through-thickness expansion coefficient"),
+    ("pressure_plate_thickness_m", "parameter", "m", "pressure plate, friction face to diaphragm contact"),
+    ("pressure_plate_expansion_per_K", "parameter", "1/K", "pressure plate expansion coefficient"),
+    ("flywheel_length_m", "parameter", "m", "flywheel, cover mounting face to friction face"),
+    ("flywheel_expansion_per_K", "parameter", "1/K", "flywheel expansion coefficient"),
+    ("reference_temperature_K", "parameter", "K", "temperature of E_ref and of zero thermal growth"),
 )
 #: start value of the optional slip-speed input, rad/s (mu does not depend on it without a friction table)
 OMEGA_SLIP_START = 0.0
@@ -104,6 +128,7 @@ class ClutchParameters:
         "x_kiss_ref": (-1.0, 1.0, False, False),
         "lever_ratio": (0.0, 100.0, True, False),
         "facing_wear": (0.0, 0.004, False, False),
+        **CoverParameters.RANGES,
     }
 
     def flat(self) -> dict[str, float]:
@@ -148,7 +173,7 @@ def start_values(p: ClutchParameters | None = None) -> dict[str, float]:
     out = {}
     for name, causality, _, _ in VARIABLES:
         if causality == "parameter":
-            out[name] = float(getattr(p, name))
+            out[name] = float(p.flat()[name])
         elif causality == "input":
             if name not in inputs:
                 raise KeyError(f"input {name!r} has no start value in clutch_model.start_values")

@@ -65,7 +65,6 @@ typedef struct {
     double e, L_pp, L_b, kb, kp, fal; /* arms (m), bearing/pp travel per unit s, F_AL factor without E */
     double u_full_ref;                /* cushion full compression at the reference temperature, m */
     double xc;                        /* bearing-system constant X_c, m */
-    double s_last, x_last;            /* warm start of the Newton iteration: last s and x_to, m (NaN: none) */
     int hint[2], hint_k[2];           /* last table intervals (Newton; kiss and solid points) */
     /* the frame of the last (theta_cs K, theta_cm K, wear m): bracket, E, positions and forces */
     double f_theta_cs, f_theta_cm, f_wear, f_e, f_w;

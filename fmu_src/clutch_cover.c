@@ -9,8 +9,9 @@
  *   x_to >= x_solid: s = s_solid, F_to = max(0, F_to(s_solid) - (x_to - x_solid)/c),
  *                    F_pp = (M(s_solid) - F_to L_b)/L_pp                           (solid phase)
  *
- * The forward map is a safeguarded Newton iteration on s in [s_solid, s_rigid], warm-started from
- * the previous solution (usually 1-3 iterations).
+ * The forward map is a safeguarded Newton iteration on s in [s_solid, s_rigid] from a chord start
+ * (3-4 iterations); the start depends on the inputs only, so results are reproducible bit for bit
+ * (saved and restored states, any call history).
  */
 #include "clutch_core.h"
 
@@ -55,7 +56,6 @@ void cc_cover_prepare(CcCover *cv, const double *par, double lever_ratio, double
     s_k0 = par[CV_SINST] + cv->u_full_ref / cv->kp;
     f_to = (moment(cv, s_k0, par[CV_E]) - cc_table_force(tb, 0.0, th_ref) * cv->L_pp) / cv->L_b;
     cv->xc = x_kiss_ref + cv->kb * s_k0 + par[CV_C] * f_to;
-    cv->s_last = cv->x_last = NAN;
     cv->f_theta_cs = NAN; /* no frame yet */
     cv->hint[0] = cv->hint[1] = cv->hint_k[0] = cv->hint_k[1] = 0;
 }
@@ -159,10 +159,10 @@ int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
         b.w = cv->f_w;
         lo = cv->s_solid;
         hi = (cv->xc - x_to) / kb;
-        /* start: the last solution for a small move, else the chord of x(s) between the solid and kiss
-           points (cushion phase) or the rigid lever shifted by the kiss-point compliance (open) */
-        if (fabs(x_to - cv->x_last) < 1e-5 && cv->s_last > lo && cv->s_last < hi) s = cv->s_last;
-        else if (x_to >= cv->x_kiss)
+        /* start (from the inputs only, so the result never depends on the call history): the chord of
+           x(s) between the solid and kiss points (cushion phase) or the rigid lever shifted by the
+           kiss-point compliance (open) */
+        if (x_to >= cv->x_kiss)
             s = cv->s_solid + (cv->s_kiss - cv->s_solid) * (cv->x_solid - x_to) / (cv->x_solid - cv->x_kiss);
         else s = (cv->xc - x_to - comp * cv->fto_kiss) / kb;
         if (!(s > lo && s < hi)) s = hi;
@@ -180,8 +180,6 @@ int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
             fto = (moment(cv, s, e_mod) - fc * cv->L_pp) / cv->L_b;
             r = cv->xc - kb * s - comp * fto - x_to;
         }
-        cv->s_last = s;
-        cv->x_last = x_to;
         out->clamp = fc;
         out->bearing = fto;
         out->cushion = fc;

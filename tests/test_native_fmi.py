@@ -15,7 +15,7 @@ from fmpy.fmi2 import FMU2Slave, fmi2LastSuccessfulTime, fmi2Terminated
 from fmpy.fmi3 import FMU3Slave
 
 from cushion_clutch.data import fmu_sources
-from cushion_clutch.model import ClutchParameters, load_table, outputs, thermal_step
+from cushion_clutch.model import VARIABLES, ClutchParameters, load_table, outputs, thermal_step
 from native_builds import native_fmus
 
 pytestmark = pytest.mark.fmu
@@ -80,12 +80,15 @@ def test_me_and_cs_match_each_other_and_the_closed_form(runs):
     assert np.max(np.abs(cs["theta_cs"] - exact) / exact) < 1e-12        # CS: exact step solution
     assert np.max(np.abs(me["theta_cs"] - exact) / exact) < 1e-8         # ME: CVode
     master = _cs_master(native_fmus()[2])
+    # at the theta_cm step (t = 2 s) ME keeps the pre-event output, the CS master the post-event one:
+    # the outputs depend directly on theta_cm (the stack's thermal growth), so that one instant differs
+    keep = cs["time"] != 2.0
     for j, name in enumerate(OUT):
         scale = max(np.max(np.abs(master[:, j])), 1e-12)
-        assert np.max(np.abs(me[name] - master[:, j])) / scale < 1e-6, name
+        assert np.max(np.abs(me[name][keep] - master[keep, j])) / scale < 1e-6, name
     table, p = load_table(), ClutchParameters()
     for k in (400, 750, 1000):                                           # engaged; ME vs the Python model
-        ref = outputs(0.003 + 0.0005 * me["time"][k], exact[k], table, p)
+        ref = outputs(0.003 + 0.0005 * me["time"][k], exact[k], table, p, 600.0)
         assert me["torque"][k] > 5.0     # engaged, so not 0 = 0
         assert me["torque"][k] == pytest.approx(ref.torque, rel=1e-6)
         assert master[k, 1] == pytest.approx(ref.torque, rel=1e-11)
@@ -108,7 +111,8 @@ def test_model_descriptions_declare_both_interfaces_and_dependencies():
         names = {sv.name: sv for sv in md.modelVariables}
         assert names["der(theta_cs)"].derivative is names["theta_cs"]
         deps = {u.variable.name: sorted(d.name for d in u.dependencies) for u in md.outputs}
-        assert deps["torque"] == ["theta_cs", "x_to"] and deps["x_kiss"] == ["theta_cs"]
+        assert deps["torque"] == ["theta_cm", "theta_cs", "x_to"] and deps["x_kiss"] == ["theta_cm", "theta_cs"]
+        assert deps["clamp_force"] == deps["bearing_force"] == ["theta_cm", "theta_cs", "x_to"]
         assert [d.name for d in md.derivatives[0].dependencies] == ["theta_cm", "theta_cs"]
     assert "sources/buildDescription.xml" in zipfile.ZipFile(native_fmus()[3]).namelist()
 
@@ -218,7 +222,7 @@ def test_corrupted_states_are_refused_and_change_nothing(capfd):
     for k in range(100):
         s.doStep(k * 0.1, 0.1)
     blob = bytearray(s.serializeFMUstate(s.getFMUstate()))
-    assert len(blob) == 200 and blob[:4] == b"SFCC"
+    assert len(blob) == 40 + 8 * (len(VARIABLES) + 1) + 8 and blob[:4] == b"SFCC"   # header, r[], checksum
     before = s.getReal(list(range(19)))
     c_at = 40 + 8 * vr["C"]
     nan_c = bytearray(blob)
@@ -227,7 +231,8 @@ def test_corrupted_states_are_refused_and_change_nothing(capfd):
     bad_phase[12:16] = struct.pack("<i", 12345)
     flipped = bytearray(blob)
     flipped[100] ^= 1
-    cases = {"truncated": (bytes(blob[:-1]), "199 bytes, expected 200"), "checksum": (bytes(flipped), "checksum"),
+    cases = {"truncated": (bytes(blob[:-1]), f"{len(blob) - 1} bytes, expected {len(blob)}"),
+             "checksum": (bytes(flipped), "checksum"),
              "nan C": (_seal(nan_c), "C = nan"), "phase": (_seal(bad_phase), "phase 12345")}
     for name, (data, message) in cases.items():
         with pytest.raises(FMICallException):

@@ -79,6 +79,7 @@ class TcuController:
         self.period = sc.tcu.period_s
         self.theta_ref = table.theta_degC[0] + KELVIN
         self.theta_ideal = theta0
+        self.theta_cm_ideal = theta0      # the ideal TCU's facing temperature (it is told the true one), K
         self.observer = (FacingObserver(sc.observer, p.theta_a, theta0, self.period)
                          if variant.temperature == "estimated" else None)
         self.learner = (KissLearner(sc.adaptation, self.period, j_d_kg_m2, t_load_Nm)
@@ -107,6 +108,8 @@ class TcuController:
 
     def theta_cm_used(self) -> float | None:
         """The facing temperature the TCU's clutch model assumes (the stack's growth), K; None: theta_cs."""
+        if self.v.temperature == "ideal":
+            return self.theta_cm_ideal
         return self.observer.theta_cm if self.observer is not None else None
 
     def model_kiss(self, theta: float) -> float:
@@ -146,6 +149,7 @@ class TcuController:
         tc = self.sc.tcu
         if self.v.temperature == "ideal":
             self.theta_ideal = thermal_step(self.theta_ideal, theta_cm_true, self.period, self.p)
+            self.theta_cm_ideal = theta_cm_true
         elif self.observer is not None:
             slip = abs(w_e - w_d)
             self.observer.update(self.model_torque(x_meas) * slip if self.phase == LAUNCH else 0.0)

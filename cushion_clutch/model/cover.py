@@ -223,7 +223,7 @@ class CoverMap:
         t, nu = cover.diaphragm_thickness_m, cover.diaphragm_poisson_ratio
         #: F_AL(s) / E / (s/t) / [...]: the Almen-Laszlo factor without E, 1/Pa * N
         self._fal = 4.0 / (1.0 - nu * nu) * t ** 4 / (k1(self.a, self.b) * 4.0 * self.a * self.a)
-        self._xc: dict = {}
+        self._xc: tuple = (None, None, None)     # (table, x_kiss_ref, X_c) of the last call: holds one table only
 
     # ---- pieces ---------------------------------------------------------------------------
     def youngs_modulus(self, theta_K: float) -> float:
@@ -254,16 +254,14 @@ class CoverMap:
 
     def x_c(self, table, x_kiss_ref: float) -> float:
         """The bearing-system constant X_c that puts the reference kiss point at ``x_kiss_ref``, m."""
-        key = (id(table), x_kiss_ref)
-        hit = self._xc.get(key)
-        if hit is not None and hit[0] is table:
-            return hit[1]
+        if self._xc[0] is table and self._xc[1] == x_kiss_ref:
+            return self._xc[2]
         c = self.c
         theta_ref_c = c.reference_temperature_K - 273.15
         s_k0 = c.installed_deflection_m + table.full_compression(theta_ref_c) / self.kp
         f_to = (self.moment(s_k0, c.diaphragm_youngs_modulus_Pa) - table.force(0.0, theta_ref_c) * self.L_pp) / self.L_b
         xc = x_kiss_ref + self.kb * s_k0 + self.comp * f_to
-        self._xc[key] = (table, xc)
+        self._xc = (table, x_kiss_ref, xc)
         return xc
 
     # ---- the map ----------------------------------------------------------------------------

@@ -25,6 +25,10 @@ static void set_starts(double *r) {
     for (k = 0; k < CC_NVARS; ++k) r[k] = CC_VARIABLES[k].start;
 }
 
+/* the cover's parameters are one block of variables in CV_* order (clutch_model.VARIABLES lists them so) */
+typedef char cover_block_is_contiguous[(VR_REFERENCE_TEMPERATURE_K - VR_DIAPHRAGM_OUTER_RADIUS_M == CV_NPAR - 1 &&
+                                        VR_FULCRUM_RADIUS_M - VR_DIAPHRAGM_OUTER_RADIUS_M == CV_RF) ? 1 : -1];
+
 static const char *phase_name(int phase) {
     switch (phase) {
     case PH_INSTANTIATED: return "Instantiated";
@@ -80,6 +84,7 @@ void cc_reset(CcModel *m) {
     m->terminated = 0;
     m->time = 0.0;
     m->dirty = 1;
+    m->cover_ok = 0;
     m->phase = PH_INSTANTIATED;
 }
 
@@ -87,6 +92,47 @@ void cc_reset(CcModel *m) {
 static int range_ok(int k, double v) {
     const double *g = CC_VARIABLES[k].range;
     return isfinite(v) && (g[2] ? v > g[0] : v >= g[0]) && (g[3] ? v < g[1] : v <= g[1]);
+}
+
+/* the cover parameters of a variable vector (CV_* order) */
+static const double *cover_params(const double *r) { return r + VR_DIAPHRAGM_OUTER_RADIUS_M; }
+
+/* the cover's consistency rules of cover.CoverParameters.problems (ranges are checked before);
+   logs each problem when m is not NULL; returns 1 if the cover is consistent */
+static int cover_consistent(CcModel *m, const double *r, const char *fn) {
+    const double *c = cover_params(r);
+    double lever = r[VR_LEVER_RATIO];
+    int ok = 1;
+    if (!(c[CV_B] < c[CV_RF] && c[CV_RF] < c[CV_RPP] && c[CV_RPP] <= c[CV_A])) {
+        if (m) cc_log(m, CC_ERROR, "%s: radii must satisfy diaphragm_inner_radius_m < fulcrum_radius_m < "
+                      "pressure_plate_radius_m <= diaphragm_outer_radius_m (got %g < %g < %g <= %g)", fn, c[CV_B],
+                      c[CV_RF], c[CV_RPP], c[CV_A]);
+        ok = 0;
+    }
+    if (!(c[CV_H] < 2.0 * sqrt(2.0) * c[CV_T])) {
+        if (m) cc_log(m, CC_ERROR, "%s: diaphragm_cone_height_m / diaphragm_thickness_m = %g must be < 2 sqrt(2) "
+                      "(above, the diaphragm's valley force is negative: it snaps through)", fn, c[CV_H] / c[CV_T]);
+        ok = 0;
+    }
+    if (!(c[CV_KE] * (2000.0 - c[CV_TREF]) < 1.0)) {
+        if (m) cc_log(m, CC_ERROR, "%s: diaphragm_modulus_drop_per_K: E(theta) must stay > 0 up to 2000 K", fn);
+        ok = 0;
+    }
+    if (ok && !(lever * (c[CV_RPP] - c[CV_RF]) < c[CV_RF])) {
+        if (m) cc_log(m, CC_ERROR, "%s: lever_ratio = %g puts the bearing at r_b = r_f - i (r_pp - r_f) = %g m; "
+                      "must be > 0", fn, lever, c[CV_RF] - lever * (c[CV_RPP] - c[CV_RF]));
+        ok = 0;
+    }
+    if (ok && m) {
+        CcCover cv;
+        cc_cover_prepare(&cv, c, lever, r[VR_X_KISS_REF], &m->table);
+        if (!(cc_cover_slope_bound(&cv) > 0.0)) {
+            cc_log(m, CC_ERROR, "%s: release_compliance_m_per_N = %g: the release snaps through (x_to(s) not "
+                   "monotone on the diaphragm's falling branch); reduce it", fn, c[CV_C]);
+            ok = 0;
+        }
+    }
+    return ok;
 }
 
 /* every parameter problem is logged (prefix names the call); returns 1 if all are valid */
@@ -104,6 +150,7 @@ static int check_parameters(CcModel *m, const double *r, const char *fn) {
         cc_log(m, CC_ERROR, "%s: parameter n_surfaces = %g must be a whole number in [1, 16]", fn, r[VR_N_SURFACES]);
         ok = 0;
     }
+    if (ok && !cover_consistent(m, r, fn)) ok = 0;
     if (ok && !(r[VR_U] + r[VR_H] > 0.0)) {
         cc_log(m, CC_ERROR, "%s: U + H must be > 0 (the cushion spring needs a heat path)", fn);
         ok = 0;
@@ -131,20 +178,32 @@ static void log_inputs(CcModel *m, int status, double t, const char *what) {
 }
 
 /* -------------------------------------------------------------------- model */
-static void update_outputs(CcModel *m) {
+static double facing_wear(const CcModel *m) { return m->r[VR_FACING_WEAR]; }
+
+/* outputs of the current inputs and state; CC_DISCARD (logged) if the diaphragm cannot hold the cushion */
+static int update_outputs(CcModel *m) {
     double *r = m->r;
     const Table *tb = &m->table;
-    double theta_c = r[VR_THETA_CS] - KELVIN;
-    double x_kiss = r[VR_X_KISS_REF] - r[VR_LEVER_RATIO] * cc_table_delta(tb, theta_c);
-    double u = (r[VR_X_TO] - x_kiss) / r[VR_LEVER_RATIO];
-    double force = cc_table_force(tb, u, theta_c);
+    CcCoverState st;
     double mu = tb->f_mu ? cc_table_mu(tb, r[VR_THETA_CM] - KELVIN, r[VR_OMEGA_SLIP]) : r[VR_MU];
     double g = r[VR_U] + r[VR_H];
-    r[VR_TORQUE] = r[VR_N_SURFACES] * mu * r[VR_R_EQ] * force;
-    r[VR_FORCE] = force;
-    r[VR_U_F] = u > 0.0 ? u : 0.0;
-    r[VR_X_KISS] = x_kiss;
+    if (!m->cover_ok) {
+        cc_cover_prepare(&m->cover, cover_params(r), r[VR_LEVER_RATIO], r[VR_X_KISS_REF], tb);
+        m->cover_ok = 1;
+    }
     r[CC_VR_DER_THETA_CS] = (r[VR_U] * r[VR_THETA_CM] + r[VR_H] * r[VR_THETA_A] - g * r[VR_THETA_CS]) / r[VR_C];
+    if (cc_cover_state(&m->cover, tb, r[VR_X_TO], r[VR_THETA_CS], r[VR_THETA_CM], facing_wear(m), &st) != 0) {
+        cc_log(m, CC_DISCARD, "t = %g s: the diaphragm cannot hold the cushion at theta_cs = %g K, theta_cm = %g K, "
+               "facing_wear = %g m (bearing force %g N < 0); outputs not updated", m->time, r[VR_THETA_CS],
+               r[VR_THETA_CM], facing_wear(m), st.bearing);
+        return CC_DISCARD;
+    }
+    r[VR_TORQUE] = r[VR_N_SURFACES] * mu * r[VR_R_EQ] * st.clamp;
+    r[VR_FORCE] = st.cushion;
+    r[VR_U_F] = st.u > 0.0 ? st.u : 0.0;
+    r[VR_X_KISS] = st.x_kiss;
+    r[VR_CLAMP_FORCE] = st.clamp;
+    r[VR_BEARING_FORCE] = st.bearing;
     m->dirty = 0;
     if (!(tb->theta[0] + KELVIN <= r[VR_THETA_CS] && r[VR_THETA_CS] <= tb->theta[tb->nt - 1] + KELVIN) &&
         !m->range_warned) {
@@ -153,19 +212,29 @@ static void update_outputs(CcModel *m) {
                "are clamped to the nearest table temperature (warned once)", r[VR_THETA_CS],
                tb->theta[0] + KELVIN, tb->theta[tb->nt - 1] + KELVIN);
     }
+    return CC_OK;
 }
 
-/* outputs of the current inputs and state (in Initialization Mode: theta_cs = theta_cs_start);
-   with invalid inputs they keep their last values */
-static void refresh(CcModel *m) {
-    if (!m->dirty || !inputs_ok(m->r)) return;
+/* outputs of the current inputs and state (in Initialization Mode: theta_cs = theta_cs_start).
+   Invalid inputs: the outputs keep their last values and CC_DISCARD is returned (logged) */
+static int refresh(CcModel *m, const char *fn) {
+    if (!m->dirty) return CC_OK;
+    if (!inputs_ok(m->r)) {
+        char what[200];
+        snprintf(what, sizeof what, "%s: outputs not updated", fn);
+        log_inputs(m, CC_DISCARD, m->time, what);
+        return CC_DISCARD;
+    }
     if (m->phase == PH_INIT) {
-        if (!(m->r[VR_LEVER_RATIO] > 0.0 && m->r[VR_C] > 0.0)) return;
+        int k;
+        for (k = 0; k < CC_NVARS; ++k)
+            if (is_parameter((unsigned int)k) && !range_ok(k, m->r[k])) return CC_OK; /* reported at ExitInit */
+        if (!cover_consistent(NULL, m->r, fn)) return CC_OK;
         m->r[VR_THETA_CS] = m->r[VR_THETA_CS_START];
     } else if (!(m->phase & (PH_STEP | PH_EVENT | PH_CONT | PH_TERMINATED))) {
-        return;
+        return CC_OK;
     }
-    update_outputs(m);
+    return update_outputs(m);
 }
 
 int cc_set_real(CcModel *m, const unsigned int vr[], size_t n, const double v[], const char *fn) {
@@ -188,7 +257,10 @@ int cc_set_real(CcModel *m, const unsigned int vr[], size_t n, const double v[],
             return CC_ERROR;
         }
     }
-    for (k = 0; k < n; ++k) m->r[vr[k]] = v[k];
+    for (k = 0; k < n; ++k) {
+        m->r[vr[k]] = v[k];
+        if (is_parameter(vr[k])) m->cover_ok = 0;
+    }
     if (n) m->dirty = 1;
     return CC_OK;
 }
@@ -202,7 +274,12 @@ int cc_get_real(CcModel *m, const unsigned int vr[], size_t n, double v[], const
             cc_log(m, CC_ERROR, "%s: unknown value reference %u", fn, vr[k]);
             return CC_ERROR;
         }
-    if (m->dirty) refresh(m);
+    if (m->dirty && refresh(m, fn) != CC_OK && m->me) {
+        /* Model Exchange: outputs of invalid inputs are refused, as the derivative is */
+        for (k = 0; k < n; ++k)
+            if ((CC_VARIABLES[vr[k]].causality == CC_OUTPUT && vr[k] != VR_THETA_CS) || vr[k] == CC_VR_DER_THETA_CS)
+                return CC_DISCARD;
+    }
     for (k = 0; k < n; ++k) v[k] = m->r[vr[k]];
     return CC_OK;
 }
@@ -221,14 +298,15 @@ int cc_enter_init(CcModel *m, double start_time, const char *fn) {
 int cc_exit_init(CcModel *m, const char *fn) {
     if (!cc_allowed(m, PH_INIT, fn)) return CC_ERROR;
     if (!check_parameters(m, m->r, fn)) {
-        m->r[VR_TORQUE] = m->r[VR_FORCE] = m->r[VR_U_F] = 0.0;
+        m->r[VR_TORQUE] = m->r[VR_FORCE] = m->r[VR_U_F] = m->r[VR_CLAMP_FORCE] = m->r[VR_BEARING_FORCE] = 0.0;
         m->phase = PH_ERROR;
         return CC_ERROR;
     }
     m->r[VR_THETA_CS] = m->r[VR_THETA_CS_START];
     m->phase = m->me ? PH_EVENT : PH_STEP;
     m->dirty = 1;
-    refresh(m);
+    m->cover_ok = 0;
+    if (inputs_ok(m->r)) update_outputs(m);
     return CC_OK;
 }
 
@@ -254,8 +332,11 @@ int cc_do_step(CcModel *m, double t, double h, const char *fn) {
     g = r[VR_U] + r[VR_H];
     theta_inf = (r[VR_U] * r[VR_THETA_CM] + r[VR_H] * r[VR_THETA_A]) / g;
     r[VR_THETA_CS] = theta_inf + (r[VR_THETA_CS] - theta_inf) * exp(-h * g / r[VR_C]);
-    update_outputs(m);
     m->time = t + h;
+    if (update_outputs(m) != CC_OK) {
+        m->terminated = 1;
+        return CC_DISCARD;
+    }
     m->terminated = 0;
     return status;
 }
@@ -265,11 +346,23 @@ int cc_derivative(CcModel *m, double *der, const char *fn) {
     double theta;
     if (!cc_allowed(m, PH_INIT | PH_EVENT | PH_CONT | PH_TERMINATED | PH_ERROR, fn)) return CC_ERROR;
     if (!inputs_ok(r)) {
-        log_inputs(m, CC_ERROR, m->time, "no derivative");
-        return CC_ERROR;
+        char what[200];
+        snprintf(what, sizeof what, "%s: no derivative", fn);
+        log_inputs(m, CC_DISCARD, m->time, what);
+        return CC_DISCARD;
     }
     theta = m->phase == PH_INIT ? r[VR_THETA_CS_START] : r[VR_THETA_CS];
     *der = (r[VR_U] * r[VR_THETA_CM] + r[VR_H] * r[VR_THETA_A] - (r[VR_U] + r[VR_H]) * theta) / r[VR_C];
+    return CC_OK;
+}
+
+int cc_set_time(CcModel *m, double t, const char *fn) {
+    if (!cc_allowed(m, PH_EVENT | PH_CONT, fn)) return CC_ERROR;
+    if (!isfinite(t)) {
+        cc_log(m, CC_ERROR, "%s: time = %g s is not finite; refused", fn, t);
+        return CC_ERROR;
+    }
+    m->time = t;
     return CC_OK;
 }
 
@@ -358,4 +451,5 @@ void cc_state_load(CcModel *m, const CcState *s) {
     m->terminated = s->terminated;
     m->time = s->time;
     m->dirty = 1;
+    m->cover_ok = 0;
 }

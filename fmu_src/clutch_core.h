@@ -53,6 +53,31 @@ typedef struct {
     double *f_theta, *f_omega, *f_mu;
 } Table;
 
+/* cover parameters, in the order of cover.CoverParameters' fields (cushion_clutch/model/cover.py) */
+enum {
+    CV_A, CV_B, CV_T, CV_H, CV_E, CV_KE, CV_NU, CV_RPP, CV_RF, CV_SINST, CV_C, CV_TF, CV_AF, CV_TPP, CV_APP,
+    CV_LFW, CV_AFW, CV_TREF, CV_NPAR
+};
+
+/* the cover's force balance, prepared once per parameter set (clutch_cover.c) */
+typedef struct {
+    double p[CV_NPAR];
+    double e, L_pp, L_b, kb, kp, fal; /* arms (m), bearing/pp travel per unit s, F_AL factor without E */
+    double u_full_ref;                /* cushion full compression at the reference temperature, m */
+    double xc;                        /* bearing-system constant X_c, m */
+    int hint[2], hint_k[2];           /* last table intervals (Newton; kiss and solid points) */
+    /* the frame of the last (theta_cs K, theta_cm K, wear m): bracket, E, positions and forces */
+    double f_theta_cs, f_theta_cm, f_wear, f_e, f_w;
+    const Curve *f_c0, *f_c1;
+    double s_kiss, s_solid, fc_solid, m_solid, fto_solid, fto_kiss, x_solid, x_kiss;
+} CcCover;
+
+typedef struct {
+    double clamp, bearing, cushion; /* F_pp, F_to, F_c, N */
+    double u, s;                    /* cushion compression from its kiss point, diaphragm deflection, m */
+    double x_kiss, x_solid, x_lift; /* bearing positions, m */
+} CcCoverState;
+
 /* message sink of a front end: status, category, the finished message (never a format) */
 typedef void (*CcLogger)(void *ctx, int status, const char *category, const char *message);
 
@@ -66,6 +91,8 @@ typedef struct {
     int terminated;   /* CS: the last step was refused (fmi2Terminated / terminateSimulation) */
     int logging_on;
     Table table;
+    CcCover cover;
+    int cover_ok;     /* cover prepared from the current parameters */
     int table_ok;
     char table_error[600];
     CcLogger logger;
@@ -74,7 +101,7 @@ typedef struct {
 
 /* the serialized (and saved) FMU state: versioned, checksummed, validated before use */
 #define CC_STATE_MAGIC 0x43434653u /* "CCFS" */
-#define CC_STATE_VERSION 2u
+#define CC_STATE_VERSION 3u /* 3: the cover variables */
 typedef struct {
     uint32_t magic, version, size;
     int32_t phase, me, range_warned, terminated, reserved;
@@ -89,6 +116,16 @@ void cc_table_free(Table *tb);
 double cc_table_force(const Table *tb, double u, double theta_degC);
 double cc_table_delta(const Table *tb, double theta_degC);
 double cc_table_mu(const Table *tb, double theta_degC, double omega);
+double cc_table_full(const Table *tb, double theta_degC);
+/* table temperatures i and i+1 around theta with weight w of i+1 (clamped: w = 0 or 1) */
+void cc_table_bracket(const Table *tb, double theta_degC, int *i, double *w);
+
+/* ---- cover (clutch_cover.c) */
+void cc_cover_prepare(CcCover *cv, const double *par, double lever_ratio, double x_kiss_ref, const Table *tb);
+double cc_cover_slope_bound(const CcCover *cv);
+/* 0, or -1 if the diaphragm cannot hold the cushion (bearing force < 0); out is filled either way */
+int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, double theta_cm, double wear,
+                   CcCoverState *out);
 
 /* ---- model (clutch_core.c) */
 int cc_instantiate(CcModel *m, const char *resource_dir, int me, CcLogger logger, void *ctx, int logging_on);
@@ -106,6 +143,8 @@ int cc_enter_init(CcModel *m, double start_time, const char *fn);
 int cc_exit_init(CcModel *m, const char *fn);
 int cc_do_step(CcModel *m, double t, double h, const char *fn);
 int cc_derivative(CcModel *m, double *der, const char *fn);
+/* ME SetTime: refuses a non-finite time */
+int cc_set_time(CcModel *m, double t, const char *fn);
 int cc_set_state_value(CcModel *m, double theta_cs, const char *fn);
 /* the continuous state theta_cs, K (its start value during initialisation) */
 int cc_get_state_value(CcModel *m, double *theta_cs, const char *fn);

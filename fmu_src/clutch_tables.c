@@ -71,6 +71,19 @@ static void grid_bracket(const double *g, int n, double v, int *i, double *w) {
     *w = (v - g[lo]) / (g[lo + 1] - g[lo]);
 }
 
+void cc_table_bracket(const Table *tb, double theta, int *i, double *w) { grid_bracket(tb->theta, tb->nt, theta, i, w); }
+
+/* compression from which F no longer grows at theta (the longest active curve) */
+double cc_table_full(const Table *tb, double theta) {
+    int i; double w, a, b;
+    grid_bracket(tb->theta, tb->nt, theta, &i, &w);
+    a = tb->curves[i].x[tb->curves[i].n - 1];
+    if (w == 0.0) return a;
+    b = tb->curves[i + 1].x[tb->curves[i + 1].n - 1];
+    return w == 1.0 ? b : (a > b ? a : b);
+}
+
+
 double cc_table_force(const Table *tb, double u, double theta) {
     int i; double w, f0;
     grid_bracket(tb->theta, tb->nt, theta, &i, &w);
@@ -228,6 +241,12 @@ int cc_table_load(Table *tb, const char *dir, char *err, size_t errlen) {
         if (!(fabs(fd[3 * k + 2]) <= FORCE_LIMIT)) {
             snprintf(err, errlen, "%s line %d: force_N = %g is outside [-%g, %g] N (the torque would overflow)",
                      path, fdl[k], fd[3 * k + 2], FORCE_LIMIT, FORCE_LIMIT);
+            goto fail;
+        }
+    for (k = 0; k < nfd; ++k)
+        if (fd[3 * k + 2] < 0.0) {
+            snprintf(err, errlen, "%s line %d: force_N = %g < 0 (a clamp force cannot be negative)", path, fdl[k],
+                     fd[3 * k + 2]);
             goto fail;
         }
     uniq = (double *)malloc(sizeof(double) * (nfd + nkp + 1));

@@ -28,7 +28,6 @@ import json
 import math
 import sys
 import zlib
-from dataclasses import fields
 from pathlib import Path
 
 from pythonfmu import Fmi2Causality, Fmi2Slave, Fmi2Variability, Real
@@ -44,7 +43,7 @@ PARAMETERS = [name for name, causality, _, _ in VARIABLES if causality == "param
 #: the outputs that clutch_model.outputs() returns (fields of Outputs): every output but the state theta_cs
 OUTPUTS = [name for name, causality, _, _ in VARIABLES if causality == "output" and name != "theta_cs"]
 #: tag of a serialized state; bump when the state's content changes
-STATE_FORMAT = "cushion_clutch.pythonfmu.state/1"
+STATE_FORMAT = "cushion_clutch.pythonfmu.state/2"
 PHASES = ("instantiated", "initialization", "stepping", "terminated")
 
 
@@ -147,14 +146,14 @@ class CushionClutch(Fmi2Slave):
         problems = []
         if self._table is None:
             problems.append(self._table_error or "tables missing")
-        params = ClutchParameters(**{f.name: getattr(self, f.name) for f in fields(ClutchParameters)})
+        params = ClutchParameters.from_flat({name: getattr(self, name) for name in PARAMETERS})
         problems += [f"parameter {p}" for p in params.problems()]
         self._problems = problems
         for p in problems:
             self.log(p, Fmi2Status.error)
         self.theta_cs = params.theta_cs_start
         if problems:
-            self.torque = self.force = self.u_f = 0.0
+            self.torque = self.force = self.u_f = self.clamp_force = self.bearing_force = 0.0
             return
         self._params = params
         if not self._input_problems():
@@ -309,7 +308,7 @@ class CushionClutch(Fmi2Slave):
         if t is not None and not (isinstance(t, (int, float)) and math.isfinite(t)):
             out.append(f"time {t!r} is not finite")
         if not out and state["_phase"] in ("stepping", "terminated"):
-            params = ClutchParameters(**{p: float(state[p]) for p in PARAMETERS})
+            params = ClutchParameters.from_flat({p: float(state[p]) for p in PARAMETERS})
             out += [f"parameter {p}" for p in params.problems()]
             if not 0.0 < state["theta_cs"] < THETA_CM_LIMIT:
                 out.append(f"theta_cs = {state['theta_cs']!r} K is outside (0, {THETA_CM_LIMIT:g}) K")
@@ -328,7 +327,7 @@ class CushionClutch(Fmi2Slave):
         self._range_warned = bool(state.get("_range_warned"))
         self._problems, self._faults = list(state["_problems"]), list(state["_faults"])
         if self._phase in ("stepping", "terminated"):
-            self._params = ClutchParameters(**{p: float(state[p]) for p in PARAMETERS})
+            self._params = ClutchParameters.from_flat({p: float(state[p]) for p in PARAMETERS})
 
     @staticmethod
     def _fmu_state_to_bytes(state) -> bytes:

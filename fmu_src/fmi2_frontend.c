@@ -222,8 +222,7 @@ fmi2Status fmi2CompletedIntegratorStep(fmi2Component comp, fmi2Boolean noSetPrio
 fmi2Status fmi2SetTime(fmi2Component comp, fmi2Real time) {
     COMP(fmi2Error)
     ME_ONLY("fmi2SetTime")
-    if (!cc_allowed(m, PH_EVENT | PH_CONT, "fmi2SetTime")) return fmi2Error;
-    m->time = time;
+    if (cc_set_time(m, time, "fmi2SetTime") != CC_OK) return fmi2Error;
     return fmi2OK;
 }
 

@@ -338,8 +338,7 @@ fmi3Status fmi3CompletedIntegratorStep(fmi3Instance instance, fmi3Boolean noSetP
 fmi3Status fmi3SetTime(fmi3Instance instance, fmi3Float64 time) {
     INST(fmi3Error)
     ME_ONLY("fmi3SetTime")
-    if (!cc_allowed(m, PH_EVENT | PH_CONT, "fmi3SetTime")) return fmi3Error;
-    m->time = time;
+    if (cc_set_time(m, time, "fmi3SetTime") != CC_OK) return fmi3Error;
     return fmi3OK;
 }
 

@@ -15,6 +15,8 @@ from scipy.io import loadmat
 from cushion_clutch.fe.exports import export_mat, export_modelica, read_modelica
 from cushion_clutch.fmu.build import build_fmu
 from cushion_clutch.data import DEFAULT_TABLES
+from cushion_clutch.model import load_table
+from cushion_clutch.model.cover import CoverMap, CoverParameters
 from cushion_clutch.fe.tables import read_tables
 
 pytestmark = pytest.mark.fmu
@@ -109,33 +111,39 @@ def test_torque_equals_n_mu_r_f_from_the_table(fmu, tables):
     n, mu, r = 2.0, 0.28, 0.089
     for theta, u, f, d in zip(tables.theta_degC, tables.u_m, tables.force_N, tables.delta_kiss_m):
         inst = Instance(fmu, theta_cs_start=theta + 273.15)
-        x_kiss = 0.004 - 3.0 * d
+        # bearing position of cushion compression u through the cover's balance (the Python reference)
+        frame = CoverMap(CoverParameters(), 3.0).prepare(theta + 273.15, theta + 273.15, 0.0, load_table(), 0.004)
+        x_of_u = lambda v: frame.x_of(frame.s_kiss - v / frame.g.kp)  # noqa: E731
         for i in np.linspace(0, len(u) - 1, 9).astype(int):
-            inst.set(x_to=x_kiss + 3.0 * u[i], theta_cm=theta + 273.15)
+            inst.set(x_to=x_of_u(u[i]) if i < len(u) - 1 else frame.x_solid, theta_cm=theta + 273.15)
             inst.step(0.0)
             got = inst.get(*OUT)
             assert got["force"] == pytest.approx(f[i], rel=1e-9, abs=1e-9)
             assert got["torque"] == pytest.approx(n * mu * r * f[i], rel=1e-9, abs=1e-9)
-            assert got["u_f"] == pytest.approx(max(u[i], 0.0), abs=1e-15)
+            assert got["u_f"] == pytest.approx(max(u[i], 0.0), abs=1e-14)
         # between table points: SciPy's PCHIP of the same rows
         um = 0.5 * (u[len(u) // 2] + u[len(u) // 2 + 1])
-        inst.set(x_to=x_kiss + 3.0 * um)
+        inst.set(x_to=x_of_u(um))
         inst.step(0.0)
         assert inst.get("force") == pytest.approx(float(PchipInterpolator(u, f)(um)), rel=1e-9)
-        # past full compression the force stays at its full-compression value
-        inst.set(x_to=x_kiss + 3.0 * (u[-1] + 1e-3))
+        # past full compression the cushion force stays at its full-compression value (the clamp rises on)
+        inst.set(x_to=frame.x_solid + 1e-3)
         inst.step(0.0)
         assert inst.get("force") == pytest.approx(f[-1], rel=1e-12)
+        assert inst.get("torque") == pytest.approx(n * mu * r * frame.clamp_installed(), rel=1e-12)
         inst.close()
 
 
 def test_kiss_point_moves_by_lever_ratio_times_delta(fmu, tables):
+    """The cushion's part of the shift is lever_ratio * delta_kiss (paper); stack growth and compliance add to it."""
     d195 = dict(zip(tables.theta_degC, tables.delta_kiss_m))[195.0]
     cold = Instance(fmu, theta_cs_start=293.15)
     hot = Instance(fmu, "hot", theta_cs_start=195.0 + 273.15, theta_cm=195.0 + 273.15)
     shift = cold.get("x_kiss") - hot.get("x_kiss")
-    assert shift == pytest.approx(3.0 * d195, rel=1e-12)
-    assert 0.2e-3 < shift < 0.42e-3               # paper: about 0.3 mm at the bearing
+    budget = CoverMap(CoverParameters(), 3.0).kiss_budget(468.15, 468.15, 0.0, load_table(), 0.004)
+    assert budget["cushion"] == pytest.approx(-3.0 * d195, rel=1e-12)
+    assert shift == pytest.approx(-budget["total"], rel=1e-9)
+    assert 0.2e-3 < 3.0 * d195 < 0.42e-3          # paper: about 0.3 mm at the bearing from the cushion spring
     cold.close(), hot.close()
 
 
@@ -263,3 +271,22 @@ def test_exports_read_back_equal_to_tables(tables, tmp_path):
     assert mat["delta_kiss_m"].ravel() == pytest.approx(tables.delta_kiss_m)
     assert mo["delta_kiss_m"][:, 1] == pytest.approx(tables.delta_kiss_m, rel=1e-11)
     assert "force_N [N]" in str(mat["units"])
+
+
+def test_exports_carry_the_cover_map_at_full_precision(tmp_path):
+    """clamp/bearing force tables equal the model at every node; x_to values are distinct after reading back."""
+    from cushion_clutch.model import ClutchParameters, outputs
+    mat = loadmat(export_mat(DEFAULT_TABLES, tmp_path / "t.mat"))
+    mo = read_modelica(export_modelica(DEFAULT_TABLES, tmp_path / "t.txt"))
+    table, p = load_table(), ClutchParameters()
+    x_mo, th = mo["clamp_force_N"][1:, 0], mo["clamp_force_N"][0, 1:]
+    assert np.all(np.diff(x_mo) > 0)                               # CombiTable2Ds needs strictly increasing u
+    assert np.array_equal(x_mo, mat["x_to_m"].ravel())             # %.17g round-trips exactly
+    assert np.array_equal(mo["force_N"][1:, 0], mat["u_m"].ravel())
+    for k in range(0, len(x_mo), 37):
+        for j, t in enumerate(th):
+            o = outputs(float(x_mo[k]), t + 273.15, table, p, t + 273.15)
+            assert mo["clamp_force_N"][1 + k, 1 + j] == o.clamp_force
+            assert mo["bearing_force_N"][1 + k, 1 + j] == o.bearing_force
+    assert np.all(np.diff(mat["clamp_force_N"], axis=0) >= 0)      # monotone in x_to at every temperature
+    assert "HoldLastPoint" in (tmp_path / "t.txt").read_text()

@@ -7,7 +7,7 @@ import pytest
 from scipy.interpolate import PchipInterpolator
 
 from cushion_clutch.data import DEFAULT_TABLES
-from cushion_clutch.model import (KELVIN, ClutchParameters, load_table, outputs, thermal_step, thermal_system,
+from cushion_clutch.model import (KELVIN, ClutchParameters, CoverParameters, load_table, outputs, thermal_step, thermal_system,
                                   x_to_for_torque)
 from cushion_clutch.fe.tables import read_tables
 
@@ -48,10 +48,15 @@ def test_linear_in_theta_between_tables(table, raw):
 
 
 def test_clamped_outside_table_temperatures(table):
-    hot = outputs(0.006, 400.0 + KELVIN, table, P)
-    edge = outputs(0.006, table.theta_degC[-1] + KELVIN, table, P)
+    # only the tables clamp: the cover's E(theta) and the stack's growth go on beyond them
+    table_only = ClutchParameters(cover=CoverParameters(diaphragm_modulus_drop_per_K=0.0, facing_expansion_per_K=0.0,
+                                                        pressure_plate_expansion_per_K=0.0,
+                                                        flywheel_expansion_per_K=0.0))
+    hot = outputs(0.006, 400.0 + KELVIN, table, table_only)
+    edge = outputs(0.006, table.theta_degC[-1] + KELVIN, table, table_only)
     assert hot.clamped and not edge.clamped
     assert hot.torque == edge.torque
+    assert outputs(0.006, 400.0 + KELVIN, table, P).torque != edge.torque
 
 
 def test_thermal_step_is_the_exponential_solution():
@@ -97,7 +102,8 @@ def test_inverse_saturates(table):
     theta = 195.0 + KELVIN
     x_full = x_to_for_torque(1e9, theta, table, P)
     assert outputs(x_full, theta, table, P).torque == pytest.approx(outputs(1.0, theta, table, P).torque)
-    assert outputs(x_to_for_torque(0.0, theta, table, P), theta, table, P).torque == 0.0
+    # first contact, back through the cover's Newton solve: zero to rounding (1e-15 N.m)
+    assert outputs(x_to_for_torque(0.0, theta, table, P), theta, table, P).torque == pytest.approx(0.0, abs=1e-12)
 
 
 def test_parameter_problems_name_the_parameter():
@@ -113,3 +119,15 @@ def test_malformed_table_is_a_clear_error(tmp_path):
     (tmp_path / "kiss_point.csv").write_text("theta_degC,delta_kiss_m\n20,0\n")
     with pytest.raises(ValueError, match="force_deflection.csv"):
         load_table(tmp_path)
+
+
+def test_negative_table_force_is_refused_with_its_row(tmp_path):
+    (tmp_path / "force_deflection.csv").write_text("theta_degC,u_m,force_N\n20,0,-5\n20,1e-4,-1\n20,2e-4,3\n")
+    (tmp_path / "kiss_point.csv").write_text("theta_degC,delta_kiss_m\n20,0\n")
+    with pytest.raises(ValueError, match=r"force_deflection.csv: row 1 \(line 2\): force_N = -5.0 < 0"):
+        load_table(tmp_path)
+
+
+def test_thermal_system_names_a_zero_heat_capacity():
+    with pytest.raises(ValueError, match="^C = 0"):
+        thermal_system(ClutchParameters(C=0))

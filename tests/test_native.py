@@ -21,7 +21,7 @@ from native_builds import model_final
 pytestmark = pytest.mark.fmu
 
 HOST_SRC = fmu_sources() / "hosts" / "fmi2_host.c"
-OUT = ["torque", "force", "theta_cs", "u_f", "x_kiss"]
+OUT = ["torque", "force", "theta_cs", "u_f", "x_kiss", "clamp_force", "bearing_force"]
 
 
 @pytest.fixture(scope="module")
@@ -84,7 +84,7 @@ def test_sources_build_with_fmpy_compile(fmus, tmp_path):
 def test_native_pythonfmu_and_model_agree_over_a_long_random_sequence(fmus):
     rng = np.random.default_rng(7)
     n = 20_000
-    x_to = rng.uniform(-0.001, 0.010, n)
+    x_to = rng.uniform(-0.001, 0.014, n)            # open, cushion, solid, bearing lifted
     theta_cm = rng.uniform(250.0, 750.0, n)           # beyond the table range too
     h = rng.choice([1e-4, 1e-3, 0.01, 0.1, 1.0, 5.0], n)
     nat, vr = open_slave(fmus["native"], name="native")
@@ -97,13 +97,55 @@ def test_native_pythonfmu_and_model_agree_over_a_long_random_sequence(fmus):
             s.setReal(vin, [x_to[k], theta_cm[k]])
             s.doStep(t, h[k])
         theta = thermal_step(theta, theta_cm[k], h[k], p)
-        o = outputs(x_to[k], theta, table, p)
-        ref = np.array([o.torque, o.force, theta, o.u_f, o.x_kiss])
+        o = outputs(x_to[k], theta, table, p, theta_cm[k])
+        ref = np.array([o.torque, o.force, theta, o.u_f, o.x_kiss, o.clamp_force, o.bearing_force])
         a, b = np.array(nat.getReal(vout)), np.array(pyf.getReal(vout))
-        scale = np.maximum(np.abs(ref), 1e-12)
+        scale = np.maximum(np.abs(ref), [1.0, 1.0, 1.0, 1e-3, 1e-3, 1.0, 1.0])     # N.m, N, K, m, m, N, N
         worst = max(worst, float(np.max(np.abs(a - ref) / scale)), float(np.max(np.abs(b - ref) / scale)))
         t += h[k]
     assert worst < 1e-9, worst
+
+
+COVER = {"facing_wear": 0.0005, "installed_deflection_m": 0.0033, "release_compliance_m_per_N": 1.5e-6,
+         "diaphragm_thickness_m": 0.0027, "lever_ratio": 2.8, "facing_expansion_per_K": 4e-5}
+
+
+def test_native_follows_the_cover_parameters_and_the_issue_bar(fmus):
+    """Non-default cover and wear through the FMU's parameters: native = Python model; issue 19's bar."""
+    from cushion_clutch.model import CoverParameters
+    table = load_table()
+    p = ClutchParameters.from_flat({**ClutchParameters().flat(), **COVER})
+    assert p.cover != CoverParameters() and p.problems() == []
+    for theta in (293.15, 468.15, 573.15):
+        nat, vr = open_slave(fmus["native"], name="cover", theta_cs_start=theta, **COVER)
+        pyf, _ = open_slave(fmus["python"], name="cover_py", theta_cs_start=theta, **COVER)
+        for x in np.linspace(0.0, 0.02, 161):
+            o = outputs(float(x), theta, table, p, theta)
+            for s in (nat, pyf):
+                s.setReal([vr["x_to"], vr["theta_cm"]], [float(x), theta])
+                s.doStep(0.0, 0.0)
+                got = dict(zip(OUT, s.getReal([vr[k] for k in OUT])))
+                assert got["clamp_force"] == pytest.approx(o.clamp_force, rel=1e-9, abs=1e-9)
+                assert got["bearing_force"] == pytest.approx(o.bearing_force, rel=1e-9, abs=1e-9)
+                assert got["torque"] == pytest.approx(o.torque, rel=1e-9, abs=1e-9)
+                assert got["x_kiss"] == pytest.approx(o.x_kiss, rel=1e-12)
+        nat.terminate(), pyf.terminate()
+    # issue 19's bar, default parameters, native FMU
+    for theta in (293.15, 468.15, 573.15):
+        s, vr = open_slave(fmus["native"], name=f"bar{theta}", theta_cs_start=theta)
+        torque = []
+        for x in np.linspace(0.0, 0.02, 2001):                  # direct feedthrough: no step needed
+            s.setReal([vr["x_to"], vr["theta_cm"]], [float(x), theta])
+            torque.append(s.getReal([vr["torque"]])[0])
+        assert np.all(np.diff(torque) >= 0.0), theta
+    s, vr = open_slave(fmus["native"], name="bar")
+    worn, _ = open_slave(fmus["native"], name="worn", facing_wear=0.0005)
+    s.setReal([vr["x_to"], vr["theta_cm"]], [0.020, 293.15])
+    assert 300.0 <= s.getReal([vr["torque"]])[0] <= 360.0 and s.getReal([vr["bearing_force"]])[0] == 0.0
+    mid = 0.007
+    s.setReal([vr["x_to"]], [mid])
+    worn.setReal([vr["x_to"]], [mid])
+    assert s.getReal([vr["torque"]])[0] - worn.getReal([vr["torque"]])[0] > 5.0
 
 
 def test_shared_object_does_not_need_python(fmus, tmp_path):

@@ -19,11 +19,11 @@ MODEL_SRC = Path(clutch_model.__file__).parent
 #: the modules the pythonfmu slave imports (siblings inside the FMU): the slave class (from ``FMU_SRC``)
 #: and the numpy-only model (from ``MODEL_SRC``)
 SLAVE_MODULES = {"cushion_slave.py": FMU_SRC, "clutch_model.py": MODEL_SRC, "spring_table.py": MODEL_SRC,
-                 "friction.py": MODEL_SRC, "table_format.py": MODEL_SRC}
+                 "friction.py": MODEL_SRC, "table_format.py": MODEL_SRC, "cover.py": MODEL_SRC}
 
 #: the native model core (shared) and the front end of each FMI version, as shipped in sources/
 CORE_HEADERS = ("clutch_core.h", "resource_uri.h")
-CORE_SOURCES = ("clutch_core.c", "clutch_tables.c", "resource_uri.c")
+CORE_SOURCES = ("clutch_core.c", "clutch_tables.c", "clutch_cover.c", "resource_uri.c")
 FRONT_ENDS = {2: "fmi2_frontend.c", 3: "fmi3_frontend.c"}
 #: the pythonfmu FMU's guard library
 GUARD_SOURCES = ("pythonfmu_guard.c", "resource_uri.c")
@@ -37,6 +37,7 @@ BASE_UNITS = {
     "m": {"m": "1"}, "K": {"K": "1"}, "N": {"kg": "1", "m": "1", "s": "-2"},
     "N.m": {"kg": "1", "m": "2", "s": "-2"}, "W/K": {"kg": "1", "m": "2", "s": "-3", "K": "-1"},
     "J/K": {"kg": "1", "m": "2", "s": "-2", "K": "-1"}, "1": {}, "rad/s": {"s": "-1", "rad": "1"},
+    "Pa": {"kg": "1", "m": "-1", "s": "-2"}, "1/K": {"K": "-1"}, "m/N": {"kg": "-1", "s": "2"},
 }
 
 

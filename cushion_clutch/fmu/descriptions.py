@@ -39,9 +39,12 @@ def _vr(name: str) -> int:
 def dependencies(has_friction: bool) -> dict[int, list[int]]:
     """Value references of the inputs and states each output and the derivative depend on."""
     x_to, theta_cm, theta_cs, omega = _vr("x_to"), _vr("theta_cm"), _vr("theta_cs"), _vr("omega_slip")
-    torque = [x_to, theta_cs] + ([theta_cm, omega] if has_friction else [])
-    return {_vr("torque"): sorted(torque), _vr("force"): [x_to, theta_cs], theta_cs: [theta_cs],
-            _vr("u_f"): [x_to, theta_cs], _vr("x_kiss"): [theta_cs], vr_der(): [theta_cm, theta_cs]}
+    # the cover's stack grows with theta_cm: every force and the kiss point depend on it
+    cover = [x_to, theta_cm, theta_cs]
+    torque = cover + ([omega] if has_friction else [])
+    return {_vr("torque"): sorted(torque), _vr("force"): cover, theta_cs: [theta_cs], _vr("u_f"): cover,
+            _vr("x_kiss"): [theta_cm, theta_cs], _vr("clamp_force"): cover, _vr("bearing_force"): cover,
+            vr_der(): [theta_cm, theta_cs]}
 
 
 def _variables():

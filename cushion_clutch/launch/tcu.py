@@ -108,6 +108,7 @@ class TcuController:
         self.period = sc.tcu.period_s
         self.theta_ref = table.theta_degC[0] + KELVIN
         self.theta_ideal = theta0
+        self.theta_cm_ideal = theta0      # the ideal TCU's facing temperature (it is told the true one), K
         self.observer = (FacingObserver(sc.observer, p.theta_a, theta0, self.period)
                          if variant.temperature == "estimated" else None)
         self.learner = (KissLearner(sc.adaptation, self.period, j_d_kg_m2, t_load_Nm)
@@ -144,9 +145,15 @@ class TcuController:
         """The observer's facing temperature, K (NaN without an observer)."""
         return self.observer.theta_cm if self.observer is not None else float("nan")
 
+    def theta_cm_used(self) -> float | None:
+        """The facing temperature the TCU's clutch model assumes (the stack's growth), K; None: theta_cs."""
+        if self.v.temperature == "ideal":
+            return self.theta_cm_ideal
+        return self.observer.theta_cm if self.observer is not None else None
+
     def model_kiss(self, theta: float) -> float:
-        """The model's kiss point at ``theta`` (K), m."""
-        return self.p.x_kiss_ref - self.p.lever_ratio * self.table.delta_kiss(theta - KELVIN)
+        """The model's kiss point at ``theta`` (K), m (the cover's balance: cushion, growth, wear)."""
+        return outputs(0.0, theta, self.table, self.p, self.theta_cm_used()).x_kiss
 
     def kiss(self) -> float:
         """The kiss point the TCU believes, m."""
@@ -154,15 +161,17 @@ class TcuController:
 
     def command(self, torque_Nm: float) -> float:
         """Bearing position for ``torque_Nm``, m."""
-        return x_to_for_torque(torque_Nm, self.theta_used(), self.table, self.p) + self.offset
+        return x_to_for_torque(torque_Nm, self.theta_used(), self.table, self.p,
+                               theta_cm=self.theta_cm_used()) + self.offset
 
     def model_torque(self, x_m: float) -> float:
         """Torque the TCU's model expects at bearing position ``x_m``, N.m."""
-        return outputs(x_m - self.offset, self.theta_used(), self.table, self.p).torque
+        return outputs(x_m - self.offset, self.theta_used(), self.table, self.p, self.theta_cm_used()).torque
 
     def _learn(self, torque_Nm: float, x_mean: float) -> None:
         theta = self.theta_used()
-        distance = x_to_for_torque(torque_Nm, theta, self.table, self.p) - self.model_kiss(theta)
+        distance = (x_to_for_torque(torque_Nm, theta, self.table, self.p, theta_cm=self.theta_cm_used())
+                    - self.model_kiss(theta))
         estimate = x_mean - distance
         self.learner.estimates.append((self.launch, estimate))
         self.offset += self.learner.gain * (estimate - self.kiss())
@@ -222,6 +231,7 @@ class TcuController:
         tc = self.sc.tcu
         if self.v.temperature == "ideal":
             self.theta_ideal = thermal_step(self.theta_ideal, theta_cm_true, self.period, self.p)
+            self.theta_cm_ideal = theta_cm_true
         elif self.observer is not None:
             slip = abs(w_e - w_d)
             self.observer.update(self.model_torque(x_meas) * slip if self.phase == LAUNCH else 0.0)

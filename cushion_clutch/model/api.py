@@ -9,6 +9,7 @@ Examples
 """
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 from .clutch_model import ClutchParameters, SpringTable, outputs
@@ -39,6 +40,8 @@ def thermal_system(p: ClutchParameters | None = None):
     import control
 
     p = p or ClutchParameters()
+    if not (isinstance(p.C, (int, float)) and math.isfinite(p.C) and p.C > 0.0):
+        raise ValueError(f"C = {p.C!r}: the cushion-spring heat capacity (J/K) must be a finite number > 0")
     g = p.U + p.H
     return control.ss([[-g / p.C]], [[p.U / p.C, p.H / p.C]], [[1.0]], [[0.0, 0.0]],
                       inputs=["theta_cm", "theta_a"], outputs=["theta_cs"], states=["theta_cs"],

@@ -7,30 +7,37 @@ temperatures in K except where a name says ``_degC`` (the tables).
 - Cushion-spring temperature: ``C dtheta_cs/dt = U (theta_cm - theta_cs) +
   H (theta_a - theta_cs)``, advanced with its exact solution for an input
   held over the step, so any step size is stable and exact.
-- Kiss point at the bearing: ``x_kiss = x_kiss_ref - lever_ratio delta_kiss(theta_cs)``.
-- Cushion compression: ``u = (x_to - x_kiss) / lever_ratio``; ``u_f = max(u, 0)``.
-- Force ``F(u, theta_cs)``: shape-preserving (PCHIP, Fritsch-Carlson) cubic in u
+- Cover (:mod:`cover`, equations there): Almen-Laszlo diaphragm spring, finger lever
+  (``lever_ratio``), release compliance and the moment balance
+  ``M(s) = F_pp L_pp + F_to L_b`` give the clamp force ``F_pp``, the bearing force ``F_to``
+  and the cushion compression ``u`` at bearing position ``x_to``; the kiss point moves with
+  the cushion's ``delta_kiss(theta_cs)`` (times the lever, as in the paper), the stack's
+  thermal growth at ``theta_cm`` and ``facing_wear``. Once the cushion is solid the clamp
+  force rises to the diaphragm's installed load.
+- Cushion force ``F(u, theta_cs)``: shape-preserving (PCHIP, Fritsch-Carlson) cubic in u
   per table temperature, linear between temperatures; u below the table's
-  first contact gives its first force (zero), beyond full compression the
-  full-compression force; temperatures outside the table are clamped.
-- Torque ``T = n_surfaces mu R_eq F``; ``mu`` is the parameter, or
+  first contact gives its first force (zero); temperatures outside the table are clamped.
+- Torque ``T = n_surfaces mu R_eq F_pp``; ``mu`` is the parameter, or
   ``mu(theta_cm, omega_slip)`` from the table set's optional ``friction.csv``.
 """
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, field, fields
+from functools import lru_cache
 
 try:                                    # inside the pythonfmu FMU the modules are siblings
+    from .cover import CoverMap, CoverParameters, range_problems
     from .friction import FrictionTable
     from .spring_table import KELVIN, Curve, SpringTable, pchip_slopes
     from .table_format import load_csv
 except ImportError:
+    from cover import CoverMap, CoverParameters, range_problems
     from friction import FrictionTable
     from spring_table import KELVIN, Curve, SpringTable, pchip_slopes
     from table_format import load_csv
 
-__all__ = ["KELVIN", "VARIABLES", "ClutchParameters", "Outputs", "SpringTable", "FrictionTable", "Curve",
+__all__ = ["KELVIN", "VARIABLES", "ClutchParameters", "CoverParameters", "CoverMap", "cover_frame", "Outputs", "SpringTable", "FrictionTable", "Curve",
            "load_csv", "pchip_slopes", "thermal_step", "friction_coefficient", "outputs", "x_to_for_torque",
            "OMEGA_SLIP_START", "OMEGA_SLIP_LIMIT", "start_values"]
 
@@ -56,6 +63,30 @@ VARIABLES = (
     ("x_kiss_ref", "parameter", "m", "kiss point at the bearing at the table reference temperature"),
     ("lever_ratio", "parameter", "1", "diaphragm-spring lever ratio, bearing / pressure-plate travel"),
     ("omega_slip", "input", "rad/s", "clutch slip speed; selects mu from the friction table, if any"),
+    ("clamp_force", "output", "N", "pressure-plate (clamp) force F_pp from the cover's force balance"),
+    ("bearing_force", "output", "N", "release-bearing force F_to on the diaphragm fingers (0: lifted off)"),
+    ("facing_wear", "parameter", "m", "axial wear of both facings since new (moves the kiss point and the "
+                                      "diaphragm's installed deflection)"),
+    # the cover (cover.CoverParameters, in its field order: the native core reads them as one block)
+    ("diaphragm_outer_radius_m", "parameter", "m", "diaphragm spring outer radius a"),
+    ("diaphragm_inner_radius_m", "parameter", "m", "diaphragm spring inner radius b (finger roots)"),
+    ("diaphragm_thickness_m", "parameter", "m", "diaphragm spring sheet thickness t"),
+    ("diaphragm_cone_height_m", "parameter", "m", "diaphragm spring free cone height h between the edges"),
+    ("diaphragm_youngs_modulus_Pa", "parameter", "Pa", "diaphragm Young's modulus at reference_temperature_K"),
+    ("diaphragm_modulus_drop_per_K", "parameter", "1/K", "E(theta_cs) = E_ref (1 - k (theta_cs - theta_ref))"),
+    ("diaphragm_poisson_ratio", "parameter", "1", "diaphragm Poisson ratio"),
+    ("pressure_plate_radius_m", "parameter", "m", "diaphragm load circle on the pressure plate r_pp"),
+    ("fulcrum_radius_m", "parameter", "m", "cover fulcrum (pivot ring) radius r_f"),
+    ("installed_deflection_m", "parameter", "m", "diaphragm edge deflection of the closed clutch, new facings, "
+                                                 "reference temperature"),
+    ("release_compliance_m_per_N", "parameter", "m/N", "finger + bearing + release-system compliance"),
+    ("facing_thickness_m", "parameter", "m", "both facings together (thermal growth)"),
+    ("facing_expansion_per_K", "parameter", "1/K", "facings' through-thickness expansion coefficient"),
+    ("pressure_plate_thickness_m", "parameter", "m", "pressure plate, friction face to diaphragm contact"),
+    ("pressure_plate_expansion_per_K", "parameter", "1/K", "pressure plate expansion coefficient"),
+    ("flywheel_length_m", "parameter", "m", "flywheel, cover mounting face to friction face"),
+    ("flywheel_expansion_per_K", "parameter", "1/K", "flywheel expansion coefficient"),
+    ("reference_temperature_K", "parameter", "K", "temperature of E_ref and of zero thermal growth"),
 )
 #: start value of the optional slip-speed input, rad/s (mu does not depend on it without a friction table)
 OMEGA_SLIP_START = 0.0
@@ -81,6 +112,8 @@ class ClutchParameters:
     theta_cs_start: float = 293.15  #: initial cushion-spring temperature, K
     x_kiss_ref: float = 0.004     #: kiss point at the bearing at the table's reference temperature, m
     lever_ratio: float = 3.0      #: diaphragm-spring lever ratio, bearing travel / pressure-plate travel, 1
+    facing_wear: float = 0.0      #: axial wear of the facings (both together) since new, m
+    cover: CoverParameters = field(default_factory=CoverParameters)  #: diaphragm-spring cover and axial stack
 
     #: allowed ranges: (low, high, low_open, high_open)
     RANGES = {
@@ -94,24 +127,31 @@ class ClutchParameters:
         "theta_cs_start": (0.0, 2000.0, True, False),
         "x_kiss_ref": (-1.0, 1.0, False, False),
         "lever_ratio": (0.0, 100.0, True, False),
+        "facing_wear": (0.0, 0.004, False, False),
+        **CoverParameters.RANGES,
     }
+
+    def flat(self) -> dict[str, float]:
+        """Every parameter by its FMU name (the cover's fields are FMU parameters too)."""
+        out = {f.name: getattr(self, f.name) for f in fields(self) if f.name != "cover"}
+        out.update({f.name: getattr(self.cover, f.name) for f in fields(CoverParameters)})
+        return out
+
+    @classmethod
+    def from_flat(cls, values: dict[str, float]) -> "ClutchParameters":
+        """The parameters from FMU names (as :meth:`flat` gives them); missing names keep their default."""
+        cover_names = {f.name for f in fields(CoverParameters)}
+        return cls(cover=CoverParameters(**{k: v for k, v in values.items() if k in cover_names}),
+                   **{k: v for k, v in values.items() if k not in cover_names})
 
     def problems(self) -> list[str]:
         """Every parameter outside its allowed range, with the range."""
-        out = []
-        for f in fields(self):
-            v = getattr(self, f.name)
-            lo, hi, lo_open, hi_open = self.RANGES[f.name]
-            ok = isinstance(v, (int, float)) and math.isfinite(v) and (
-                v > lo if lo_open else v >= lo) and (v < hi if hi_open else v <= hi)
-            if not ok:
-                out.append(f"{f.name} = {v!r} is out of range {'(' if lo_open else '['}{lo:g}, "
-                           f"{hi:g}{')' if hi_open else ']'}")
+        out = range_problems(self, self.RANGES)
         if not out and self.n_surfaces != int(self.n_surfaces):
             out.append(f"n_surfaces = {self.n_surfaces!r} must be a positive integer in [1, 16]")
         if not out and self.U + self.H <= 0.0:
             out.append("U + H must be > 0 (the cushion spring needs a heat path)")
-        return out
+        return out + self.cover.problems(self.lever_ratio if "lever_ratio" not in " ".join(out) else None)
 
 
 def start_values(p: ClutchParameters | None = None) -> dict[str, float]:
@@ -133,7 +173,7 @@ def start_values(p: ClutchParameters | None = None) -> dict[str, float]:
     out = {}
     for name, causality, _, _ in VARIABLES:
         if causality == "parameter":
-            out[name] = float(getattr(p, name))
+            out[name] = float(p.flat()[name])
         elif causality == "input":
             if name not in inputs:
                 raise KeyError(f"input {name!r} has no start value in clutch_model.start_values")
@@ -196,21 +236,53 @@ def thermal_step(theta_cs: float, theta_cm: float, dt: float, p: ClutchParameter
 class Outputs:
     """Model outputs at one instant (SI)."""
 
-    torque: float     #: transmissible clutch torque, N.m
-    force: float      #: cushion-spring (clamp) force, N
+    torque: float     #: transmissible clutch torque n mu R_eq F_pp, N.m
+    force: float      #: cushion-spring force F(u, theta_cs), N
     u_f: float        #: cushion compression from the kiss point, clipped at 0, m
     x_kiss: float     #: kiss point at the bearing, m
     clamped: bool     #: theta_cs was outside the table and was clamped
+    clamp_force: float = 0.0    #: pressure-plate (clamp) force F_pp from the cover's force balance, N
+    bearing_force: float = 0.0  #: release-bearing force F_to, N
+
+
+@lru_cache(maxsize=32)
+def _cover_map(cover: CoverParameters, lever_ratio: float) -> CoverMap:
+    return CoverMap(cover, lever_ratio)
+
+
+_LAST_FRAME: list = [None, None, None]   # table, key, frame: the last temperature/wear frame
+
+
+def cover_frame(table: SpringTable, p: ClutchParameters, theta_cs: float, theta_cm: float):
+    """The cover's force balance at ``theta_cs``, ``theta_cm`` (K) and ``p.facing_wear`` (cached: last one).
+
+    Raises
+    ------
+    ValueError
+        If the diaphragm cannot hold the cushion at this temperature and wear.
+    """
+    key = (p.cover, p.lever_ratio, p.x_kiss_ref, p.facing_wear, theta_cs, theta_cm)
+    if _LAST_FRAME[0] is table and _LAST_FRAME[1] == key:
+        return _LAST_FRAME[2]
+    frame = _cover_map(p.cover, p.lever_ratio).prepare(theta_cs, theta_cm, p.facing_wear, table, p.x_kiss_ref)
+    _LAST_FRAME[:] = [table, key, frame]
+    return frame
 
 
 #: the parameters that outputs() and x_to_for_torque() use
-CLUTCH_PARAMETERS = ("n_surfaces", "mu", "R_eq", "x_kiss_ref", "lever_ratio")
+CLUTCH_PARAMETERS = ("n_surfaces", "mu", "R_eq", "x_kiss_ref", "lever_ratio", "facing_wear")
 
 
 def _clutch_ok(p: ClutchParameters) -> bool:
     """Cheap range check of the parameters in CLUTCH_PARAMETERS (False for NaN)."""
     return (1.0 <= p.n_surfaces <= 16.0 and p.n_surfaces == int(p.n_surfaces) and 0.0 <= p.mu <= 2.0
-            and 0.0 < p.R_eq <= 1.0 and -1.0 <= p.x_kiss_ref <= 1.0 and 0.0 < p.lever_ratio <= 100.0)
+            and 0.0 < p.R_eq <= 1.0 and -1.0 <= p.x_kiss_ref <= 1.0 and 0.0 < p.lever_ratio <= 100.0
+            and 0.0 <= p.facing_wear <= 0.004 and not _cover_problems(p.cover, p.lever_ratio))
+
+
+@lru_cache(maxsize=32)
+def _cover_problems(cover: CoverParameters, lever_ratio: float) -> tuple[str, ...]:
+    return tuple(cover.problems(lever_ratio))
 
 
 def friction_coefficient(table: SpringTable, p: ClutchParameters, theta_cm: float | None,
@@ -229,10 +301,13 @@ def friction_coefficient(table: SpringTable, p: ClutchParameters, theta_cm: floa
 
 def outputs(x_to: float, theta_cs: float, table: SpringTable, p: ClutchParameters,
             theta_cm: float | None = None, omega_slip: float = OMEGA_SLIP_START) -> Outputs:
-    """Torque and force from bearing position ``x_to`` (m) and ``theta_cs`` (K).
+    """Torque and forces from bearing position ``x_to`` (m) and ``theta_cs`` (K).
 
-    ``theta_cm`` (K) and ``omega_slip`` (rad/s) select mu when the table set
-    has a friction table; otherwise mu is ``p.mu``.
+    The clamp force comes from the cover's force balance (:mod:`cover`): the cushion
+    force while the cushion compresses, then up to the diaphragm's installed load.
+    ``theta_cm`` (K, the facing temperature; None: ``theta_cs``) sets the stack's thermal
+    growth and, with ``omega_slip`` (rad/s), mu when the table set has a friction table;
+    otherwise mu is ``p.mu``.
 
     Raises
     ------
@@ -244,13 +319,11 @@ def outputs(x_to: float, theta_cs: float, table: SpringTable, p: ClutchParameter
             and (theta_cm is None or 0.0 < theta_cm < THETA_CM_LIMIT) and _clutch_ok(p)):
         raise _argument_error({"x_to": x_to, "theta_cs": theta_cs, "omega_slip": omega_slip,
                                **({} if theta_cm is None else {"theta_cm": theta_cm})}, p, CLUTCH_PARAMETERS)
-    theta_c = theta_cs - KELVIN
-    x_kiss = p.x_kiss_ref - p.lever_ratio * table.delta_kiss(theta_c)
-    u = (x_to - x_kiss) / p.lever_ratio
-    force = table.force(u, theta_c)
+    st = cover_frame(table, p, theta_cs, theta_cs if theta_cm is None else theta_cm).state(x_to)
     clamped = not (table.theta_min_K <= theta_cs <= table.theta_max_K)
     mu = friction_coefficient(table, p, theta_cm, omega_slip)
-    return Outputs(p.n_surfaces * mu * p.R_eq * force, force, max(u, 0.0), x_kiss, clamped)
+    return Outputs(p.n_surfaces * mu * p.R_eq * st.clamp_force, st.cushion_force, max(st.u, 0.0), st.x_kiss, clamped,
+                   st.clamp_force, st.bearing_force)
 
 
 def x_to_for_torque(torque: float, theta_cs: float, table: SpringTable, p: ClutchParameters,
@@ -258,10 +331,11 @@ def x_to_for_torque(torque: float, theta_cs: float, table: SpringTable, p: Clutc
                     omega_slip: float = OMEGA_SLIP_START) -> float:
     """Bearing position (m) giving ``torque`` (N.m) at ``theta_cs`` (K): the TCU's inverse.
 
-    F is non-decreasing in u, so the smallest position reaching the torque is
-    found by bisection. A torque at or below zero returns the first-contact
-    position; above the full-compression torque, the full-compression position.
-    ``theta_cm`` (K) and ``omega_slip`` (rad/s) select mu as in :func:`outputs`.
+    The clamp force is non-decreasing in x_to, so the smallest position reaching the torque
+    is found explicitly from the cover's balance (the cushion table inverted by bisection).
+    A torque at or below zero returns the first-contact position; above the closed capacity,
+    the position where the bearing lifts off. ``theta_cm`` (K) and ``omega_slip`` (rad/s) as in
+    :func:`outputs`.
 
     Raises
     ------
@@ -274,19 +348,6 @@ def x_to_for_torque(torque: float, theta_cs: float, table: SpringTable, p: Clutc
             and (theta_cm is None or 0.0 < theta_cm < THETA_CM_LIMIT) and _clutch_ok(p)):
         raise _argument_error({"torque": torque, "theta_cs": theta_cs, "tol_m": tol_m, "omega_slip": omega_slip,
                                **({} if theta_cm is None else {"theta_cm": theta_cm})}, p, CLUTCH_PARAMETERS)
-    theta_c = theta_cs - KELVIN
     gain = p.n_surfaces * friction_coefficient(table, p, theta_cm, omega_slip) * p.R_eq
-    x_kiss = p.x_kiss_ref - p.lever_ratio * table.delta_kiss(theta_c)
-    lo, hi = table.first_contact(theta_c), table.full_compression(theta_c)
-    if gain <= 0.0 or torque <= gain * table.force(lo, theta_c):
-        return x_kiss + p.lever_ratio * lo
-    if torque >= gain * table.force(hi, theta_c):
-        return x_kiss + p.lever_ratio * hi
-    target = torque / gain
-    while hi - lo > tol_m:
-        mid = 0.5 * (lo + hi)
-        if table.force(mid, theta_c) < target:
-            lo = mid
-        else:
-            hi = mid
-    return x_kiss + p.lever_ratio * hi
+    frame = cover_frame(table, p, theta_cs, theta_cs if theta_cm is None else theta_cm)
+    return frame.x_for_clamp(torque / gain if gain > 0.0 else 0.0, tol_m)

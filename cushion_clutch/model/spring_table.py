@@ -86,6 +86,18 @@ class Curve:
         return ((2 * t3 - 3 * t2 + 1) * y[i] + (t3 - 2 * t2 + t) * h * d[i]
                 + (-2 * t3 + 3 * t2) * y[i + 1] + (t3 - t2) * h * d[i + 1])
 
+    def slope(self, u: float) -> float:
+        """dF/du of the interpolant (0 outside the table), N/m."""
+        x, y, d = self.x, self.y, self.d
+        if u <= self.x_min or u >= self.x_max:
+            return 0.0
+        i = bisect_right(x, u) - 1
+        h = x[i + 1] - x[i]
+        t = (u - x[i]) / h
+        t2 = t * t
+        return ((6 * t2 - 6 * t) * (y[i] - y[i + 1]) / h + (3 * t2 - 4 * t + 1) * d[i]
+                + (3 * t2 - 2 * t) * d[i + 1])
+
 
 class SpringTable:
     """F(u, theta) and delta_kiss(theta) from a table set.
@@ -136,6 +148,11 @@ class SpringTable:
         folder = Path(folder)
         fd = load_csv(folder / FORCE_DEFLECTION, COLUMNS[FORCE_DEFLECTION])
         kp = load_csv(folder / KISS_POINT, COLUMNS[KISS_POINT])
+        negative = np.flatnonzero(fd[:, 2] < 0.0)
+        if negative.size:
+            k = int(negative[0])
+            raise ValueError(f"{folder / FORCE_DEFLECTION}: row {k + 1} (line {k + 2}): force_N = {float(fd[k, 2])!r} "
+                             f"< 0 (a clamp force cannot be negative; {negative.size} such row(s))")
         thetas = np.unique(fd[:, 0])
         if not np.array_equal(np.sort(kp[:, 0]), thetas):
             raise ValueError(f"{folder}: {KISS_POINT} and {FORCE_DEFLECTION} temperatures differ")
@@ -164,6 +181,12 @@ class SpringTable:
         i, w = self._bracket(theta_degC)
         f0 = self.curves[i](u_m)
         return f0 if w == 0.0 else (1.0 - w) * f0 + w * self.curves[i + 1](u_m)
+
+    def force_slope(self, u_m: float, theta_degC: float) -> float:
+        """dF/du at compression ``u_m`` and ``theta_degC``, N/m."""
+        i, w = self._bracket(theta_degC)
+        d0 = self.curves[i].slope(u_m)
+        return d0 if w == 0.0 else (1.0 - w) * d0 + w * self.curves[i + 1].slope(u_m)
 
     def delta_kiss(self, theta_degC: float) -> float:
         """Kiss-point shift of the spring, m (linear in theta, clamped)."""

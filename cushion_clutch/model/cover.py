@@ -1,0 +1,405 @@
+"""Cover assembly of a push-type diaphragm clutch: Almen-Laszlo diaphragm, finger lever, clamp load.
+
+Pure Python (math only): the pythonfmu slave, the Python API and the native C core
+(``clutch_core.c``, ``cc_cover_*``) implement exactly these equations; the native FMU is
+tested against this module.
+
+Geometry and symbols (SI)
+-------------------------
+Diaphragm (Belleville) section: outer radius ``a``, inner radius ``b`` (finger roots),
+thickness ``t``, free cone height ``h`` (between the edges), Young's modulus ``E(theta)``,
+Poisson ratio ``nu``. Load circles: pressure-plate contact ``r_pp`` and cover fulcrum ``r_f``
+with ``b <= r_f < r_pp <= a``; the fingers carry the release bearing at
+``r_b = r_f - i (r_pp - r_f)`` (``i`` = ``lever_ratio``, rigid-finger bearing travel per
+pressure-plate travel, paper: 3). Arms ``L_pp = r_pp - r_f``, ``L_b = r_f - r_b = i L_pp``,
+``e = a - b``.
+
+1. Almen-Laszlo (the section turns rigidly about its neutral circle by ``psi``; the edge
+   deflection from the free cone is ``s = e psi``)::
+
+       F_AL(s) = 4 E / (1 - nu^2) * t^4 / (K1 D_e^2) * (s/t) * [(h/t - s/t)(h/t - s/(2t)) + 1]
+       K1 = (1/pi) ((delta - 1)/delta)^2 / ((delta + 1)/(delta - 1) - 2/ln(delta)),
+       delta = a/b,  D_e = 2a.
+
+   ``F_AL`` is the force of a pair of edge loads; the elastic moment of the section is
+   ``M(s) = F_AL(s) e`` (virtual work: ``F_AL ds = M dpsi``). With ``h/t < 2 sqrt(2)`` the
+   valley force stays positive (``min (h-s)(h-s/2) = -h^2/8``).
+2. Moment balance of the diaphragm about the fulcrum circle (pressure-plate reaction ``F_pp``
+   at ``r_pp``, bearing force ``F_to`` at ``r_b``, both turning it the same way)::
+
+       M(s) = F_pp L_pp + F_to L_b.
+
+   The fulcrum carries ``F_pp - F_to``. Open clutch: ``F_pp = 0``, ``F_to = M/L_b`` (the release
+   force, with the diaphragm's rise-peak-fall shape). Closed, bearing lifted: ``F_pp = M/L_pp``.
+3. Pressure-plate kinematics. The plate moves ``L_pp/e`` per unit of ``s``. Its kiss point and
+   its solid (cushion fully compressed) position, in ``s``::
+
+       s_kiss(theta, w)  = s_inst + (u_full(theta_ref) + Delta_stack(theta) - w) e / L_pp
+       s_solid(theta, w) = s_kiss - u_full(theta) e / L_pp
+       Delta_stack = delta_kiss(theta_cs) + growth_facing + growth_pp + growth_flywheel
+       u(s) = (s_kiss - s) L_pp / e   (cushion compression from its kiss point, s >= s_solid)
+
+   ``s_inst`` (``installed_deflection_m``) is the diaphragm deflection of the closed clutch
+   with new facings at the reference temperature; ``w`` is the facing wear (total axial loss
+   of the facings). Growth, wear and the cushion's free-height growth ``delta_kiss`` all move
+   the pressure plate's kiss and solid positions, hence both the kiss point at the bearing and
+   the diaphragm's installed deflection (so the closed clamp load). Thermal growth is
+   ``alpha_k L_k (theta_cm - theta_ref)`` for the facings, the pressure plate and the
+   flywheel, all taken at the facing temperature ``theta_cm`` (an upper bound: the bulk of the
+   plates lags the friction interface); ``delta_kiss`` and ``E`` use ``theta_cs``, the model's
+   slow thermal node (the diaphragm sits in the cover, away from the interface).
+4. Cushion phase (``s_solid <= s``): ``F_pp = F_c(u(s), theta_cs)`` (the FE table; paper
+   Fig. 2: ``F_pp(x_to) = F_fc(u_f)``) and ``F_to = (M(s) - F_pp L_pp) / L_b``.
+5. Bearing kinematics with release-system compliance ``c`` (fingers + bearing + hydraulics,
+   m/N, in series)::
+
+       x_to = X_c - (L_b/e) s - c F_to(s)
+
+   ``x_to`` = bearing travel from the open position towards engagement; ``X_c`` is fixed by
+   ``x_kiss_ref``: the kiss point (``u = 0``) lies at ``x_to = x_kiss_ref`` at the reference
+   state (``delta_kiss = 0``, no growth, no wear, ``E = E_ref``). With ``c = 0`` this is the
+   paper's constant lever, ``x_pp = x_to / i``. ``x_to(s)`` decreases strictly if
+   ``L_b/e + c e min F_AL'/L_b > 0`` (``min F_AL'`` at ``s = h``); otherwise the release snaps
+   through and the parameters are refused.
+6. Solid phase (``x_to >= x_solid = x_to(s_solid)``): the plate cannot move, ``s = s_solid``;
+   ``F_to = max(0, F_to(s_solid) - (x_to - x_solid)/c)`` falls to zero (the bearing lifts off)
+   and ``F_pp = (M(s_solid) - F_to L_b)/L_pp`` rises continuously from the cushion's
+   full-compression force to the diaphragm's installed load ``M(s_solid)/L_pp``. (``c = 0``:
+   the step is immediate.) The torque is then ``n mu R_eq F_pp``, non-decreasing in ``x_to``.
+
+The forward map (``x_to`` -> ``s``) is solved by a safeguarded Newton iteration on ``s``
+bracketed by ``[s_solid, s_rigid]`` (``s_rigid`` = the ``c = 0`` answer); the inverse
+(clamp force -> ``x_to``) is explicit: the cushion table is inverted for ``u``.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields
+
+__all__ = ["range_problems", "CoverParameters", "CoverState", "k1", "almen_laszlo_force", "almen_laszlo_slope", "CoverMap"]
+
+
+@dataclass(frozen=True)
+class CoverParameters:
+    """Diaphragm-spring cover, finger lever and axial stack (SI; temperatures in K).
+
+    The default is a 240 mm passenger-car cover sized (by its geometry) for about 6.3 kN of
+    clamp load with new facings at 20 degC.
+    """
+
+    diaphragm_outer_radius_m: float = 0.1125            #: diaphragm outer radius a, m
+    diaphragm_inner_radius_m: float = 0.085             #: diaphragm inner radius b (finger roots), m
+    diaphragm_thickness_m: float = 0.0026               #: diaphragm sheet thickness t, m
+    diaphragm_cone_height_m: float = 0.0052             #: free cone height h between the edges, m
+    diaphragm_youngs_modulus_Pa: float = 206e9          #: E at reference_temperature_K, Pa
+    diaphragm_modulus_drop_per_K: float = 2.7e-4  #: E(theta) = E_ref (1 - k (theta - theta_ref)), 1/K
+    diaphragm_poisson_ratio: float = 0.3                #: nu, 1
+    pressure_plate_radius_m: float = 0.111    #: load circle on the pressure plate r_pp, m
+    fulcrum_radius_m: float = 0.089           #: cover fulcrum (pivot ring) radius r_f, m
+    installed_deflection_m: float = 0.0036    #: edge deflection s of the closed clutch, new facings, at theta_ref, m
+    release_compliance_m_per_N: float = 1.0e-6  #: finger + bearing + release-system compliance c, m/N
+    facing_thickness_m: float = 0.007         #: both facings together, m
+    facing_expansion_per_K: float = 3.0e-5    #: facings' through-thickness expansion, 1/K
+    pressure_plate_thickness_m: float = 0.016  #: pressure plate, friction face to diaphragm contact, m
+    pressure_plate_expansion_per_K: float = 1.1e-5  #: grey cast iron, 1/K
+    flywheel_length_m: float = 0.010          #: flywheel, cover mounting face to friction face, m
+    flywheel_expansion_per_K: float = 1.1e-5  #: grey cast iron, 1/K
+    reference_temperature_K: float = 293.15   #: temperature of E_ref and of zero growth, K
+
+    #: allowed ranges: (low, high, low_open, high_open)
+    RANGES = {
+        "diaphragm_outer_radius_m": (0.0, 1.0, True, False),
+        "diaphragm_inner_radius_m": (0.0, 1.0, True, False),
+        "diaphragm_thickness_m": (0.0, 0.05, True, False),
+        "diaphragm_cone_height_m": (0.0, 0.1, True, False),
+        "diaphragm_youngs_modulus_Pa": (1e9, 1e12, False, False),
+        "diaphragm_modulus_drop_per_K": (0.0, 4e-4, False, False),
+        "diaphragm_poisson_ratio": (0.0, 0.5, False, True),
+        "pressure_plate_radius_m": (0.0, 1.0, True, False),
+        "fulcrum_radius_m": (0.0, 1.0, True, False),
+        "installed_deflection_m": (0.0, 0.1, False, False),
+        "release_compliance_m_per_N": (0.0, 1e-3, False, False),
+        "facing_thickness_m": (0.0, 0.05, False, False),
+        "facing_expansion_per_K": (0.0, 1e-3, False, False),
+        "pressure_plate_thickness_m": (0.0, 0.2, False, False),
+        "pressure_plate_expansion_per_K": (0.0, 1e-3, False, False),
+        "flywheel_length_m": (0.0, 0.2, False, False),
+        "flywheel_expansion_per_K": (0.0, 1e-3, False, False),
+        "reference_temperature_K": (0.0, 2000.0, True, True),
+    }
+
+    def problems(self, lever_ratio: float | None = None) -> list[str]:
+        """Every parameter outside its range and every inconsistent geometry, with the rule."""
+        out = range_problems(self, self.RANGES)
+        if out:
+            return out
+        a, b, r_pp, r_f = self.diaphragm_outer_radius_m, self.diaphragm_inner_radius_m, self.pressure_plate_radius_m, self.fulcrum_radius_m
+        if not b < r_f < r_pp <= a:
+            out.append(f"radii must satisfy diaphragm_inner_radius_m < fulcrum_radius_m < pressure_plate_radius_m <= "
+                       f"diaphragm_outer_radius_m (got {b:g} < {r_f:g} < {r_pp:g} <= {a:g})")
+        if not self.diaphragm_cone_height_m < 2.0 * math.sqrt(2.0) * self.diaphragm_thickness_m:
+            out.append(f"diaphragm_cone_height_m / diaphragm_thickness_m = {self.diaphragm_cone_height_m / self.diaphragm_thickness_m:g} must be < 2 sqrt(2) "
+                       "(above, the diaphragm's valley force is negative: it snaps through)")
+        if self.diaphragm_modulus_drop_per_K * (2000.0 - self.reference_temperature_K) >= 1.0:
+            out.append("diaphragm_modulus_drop_per_K: E(theta) must stay > 0 up to 2000 K")
+        if lever_ratio is not None and not out and not lever_ratio * (r_pp - r_f) < r_f:
+            out.append(f"lever_ratio = {lever_ratio:g} puts the bearing at r_b = r_f - i (r_pp - r_f) = "
+                       f"{r_f - lever_ratio * (r_pp - r_f):g} m; must be > 0")
+        if lever_ratio is not None and not out:
+            g = CoverMap(self, lever_ratio)
+            e_max = self.diaphragm_youngs_modulus_Pa * (1.0 + self.diaphragm_modulus_drop_per_K * self.reference_temperature_K)
+            if not g.x_slope_bound(e_max) > 0.0:
+                out.append(f"release_compliance_m_per_N = {self.release_compliance_m_per_N:g}: the release snaps "
+                           "through (x_to(s) not monotone on the diaphragm's falling branch); reduce it")
+        return out
+
+
+def range_problems(params, ranges: dict) -> list[str]:
+    """Every field of the dataclass ``params`` named in ``ranges`` that is not a finite number in its range.
+
+    ``ranges`` maps a field name to ``(low, high, low_open, high_open)``.
+    """
+    out = []
+    for f in fields(params):
+        if f.name not in ranges:
+            continue
+        v = getattr(params, f.name)
+        lo, hi, lo_open, hi_open = ranges[f.name]
+        ok = isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) and (
+            v > lo if lo_open else v >= lo) and (v < hi if hi_open else v <= hi)
+        if not ok:
+            out.append(f"{f.name} = {v!r} is out of range {'(' if lo_open else '['}{lo:g}, "
+                       f"{hi:g}{')' if hi_open else ']'}")
+    return out
+
+
+def k1(a: float, b: float) -> float:
+    """Almen-Laszlo shape factor K1 of an annulus with radii ``a > b`` (1)."""
+    d = a / b
+    return ((d - 1.0) / d) ** 2 / ((d + 1.0) / (d - 1.0) - 2.0 / math.log(d)) / math.pi
+
+
+def almen_laszlo_force(s: float, a: float, b: float, t: float, h: float, e_mod: float, nu: float) -> float:
+    """Almen-Laszlo edge load (N) of a disc spring deflected ``s`` (m) from its free cone."""
+    return (4.0 * e_mod / (1.0 - nu * nu) * t ** 4 / (k1(a, b) * 4.0 * a * a)
+            * (s / t) * ((h - s) * (h - 0.5 * s) / (t * t) + 1.0))
+
+
+def almen_laszlo_slope(s: float, a: float, b: float, t: float, h: float, e_mod: float, nu: float) -> float:
+    """dF_AL/ds (N/m) of :func:`almen_laszlo_force`."""
+    c = 4.0 * e_mod / (1.0 - nu * nu) * t ** 4 / (k1(a, b) * 4.0 * a * a) / t
+    # d/ds { s [(h-s)(h-s/2)/t^2 + 1] } = (h-s)(h-s/2)/t^2 + 1 + s (-(h-s/2) - (h-s)/2)/t^2
+    return c * ((h - s) * (h - 0.5 * s) / (t * t) + 1.0 - s * (1.5 * h - s) / (t * t))
+
+
+@dataclass
+class CoverState:
+    """The cover at one bearing position (SI)."""
+
+    clamp_force: float    #: pressure-plate (clamp) force F_pp, N
+    bearing_force: float  #: release-bearing force F_to, N
+    cushion_force: float  #: cushion-spring force F_c(u), N
+    u: float              #: cushion compression from its kiss point, m (<= u_full; < 0: gap)
+    s: float              #: diaphragm edge deflection from its free cone, m
+    x_kiss: float         #: bearing position of the kiss point (u = 0), m
+    x_solid: float        #: bearing position where the cushion is fully compressed, m
+    x_lift: float         #: bearing position where the bearing lifts off the fingers, m
+
+
+class CoverMap:
+    """The force balance of :mod:`cover` for one cover and lever ratio (geometry prepared once)."""
+
+    def __init__(self, cover: CoverParameters, lever_ratio: float):
+        self.c = cover
+        self.a, self.b = cover.diaphragm_outer_radius_m, cover.diaphragm_inner_radius_m
+        self.e = self.a - self.b
+        self.L_pp = cover.pressure_plate_radius_m - cover.fulcrum_radius_m
+        self.L_b = lever_ratio * self.L_pp
+        self.r_b = cover.fulcrum_radius_m - self.L_b
+        self.i = lever_ratio
+        self.kb = self.L_b / self.e              # bearing travel per unit of s (rigid fingers)
+        self.kp = self.L_pp / self.e             # pressure-plate travel per unit of s
+        self.comp = cover.release_compliance_m_per_N
+        t, nu = cover.diaphragm_thickness_m, cover.diaphragm_poisson_ratio
+        #: F_AL(s) / E / (s/t) / [...]: the Almen-Laszlo factor without E, 1/Pa * N
+        self._fal = 4.0 / (1.0 - nu * nu) * t ** 4 / (k1(self.a, self.b) * 4.0 * self.a * self.a)
+        self._xc: tuple = (None, None, None)     # (table, x_kiss_ref, X_c) of the last call: holds one table only
+
+    # ---- pieces ---------------------------------------------------------------------------
+    def youngs_modulus(self, theta_K: float) -> float:
+        """E(theta), Pa."""
+        c = self.c
+        return c.diaphragm_youngs_modulus_Pa * (1.0 - c.diaphragm_modulus_drop_per_K * (theta_K - c.reference_temperature_K))
+
+    def moment(self, s: float, e_mod: float) -> float:
+        """Elastic moment M(s) = F_AL(s) e of the diaphragm section, N.m (:func:`almen_laszlo_force` times e)."""
+        t, h = self.c.diaphragm_thickness_m, self.c.diaphragm_cone_height_m
+        return self._fal * e_mod * (s / t) * ((h - s) * (h - 0.5 * s) / (t * t) + 1.0) * self.e
+
+    def moment_slope(self, s: float, e_mod: float) -> float:
+        """dM/ds, N (:func:`almen_laszlo_slope` times e)."""
+        t, h = self.c.diaphragm_thickness_m, self.c.diaphragm_cone_height_m
+        return self._fal * e_mod / t * ((h - s) * (h - 0.5 * s) / (t * t) + 1.0 - s * (1.5 * h - s) / (t * t)) * self.e
+
+    def x_slope_bound(self, e_mod: float) -> float:
+        """-(dx_to/ds) at its largest, open phase, 1 (> 0: no snap-through)."""
+        return self.kb + self.comp * self.moment_slope(self.c.diaphragm_cone_height_m, e_mod) / self.L_b
+
+    def growth(self, theta_cm: float) -> dict:
+        """Axial thermal growth of the stack parts at facing temperature ``theta_cm`` (K), m each."""
+        c, dT = self.c, theta_cm - self.c.reference_temperature_K
+        return {"facing": c.facing_thickness_m * c.facing_expansion_per_K * dT,
+                "pressure_plate": c.pressure_plate_thickness_m * c.pressure_plate_expansion_per_K * dT,
+                "flywheel": c.flywheel_length_m * c.flywheel_expansion_per_K * dT}
+
+    def x_c(self, table, x_kiss_ref: float) -> float:
+        """The bearing-system constant X_c that puts the reference kiss point at ``x_kiss_ref``, m."""
+        if self._xc[0] is table and self._xc[1] == x_kiss_ref:
+            return self._xc[2]
+        c = self.c
+        theta_ref_c = c.reference_temperature_K - 273.15
+        s_k0 = c.installed_deflection_m + table.full_compression(theta_ref_c) / self.kp
+        f_to = (self.moment(s_k0, c.diaphragm_youngs_modulus_Pa) - table.force(0.0, theta_ref_c) * self.L_pp) / self.L_b
+        xc = x_kiss_ref + self.kb * s_k0 + self.comp * f_to
+        self._xc = (table, x_kiss_ref, xc)
+        return xc
+
+    # ---- the map ----------------------------------------------------------------------------
+    def prepare(self, theta_cs: float, theta_cm: float, wear: float, table, x_kiss_ref: float) -> "_Frame":
+        """Everything of the balance that depends on temperature and wear, not on ``x_to``."""
+        c, kp = self.c, self.kp
+        theta_c = theta_cs - 273.15
+        stack = table.delta_kiss(theta_c) + sum(self.growth(theta_cm).values())
+        s_kiss = c.installed_deflection_m + (table.full_compression(c.reference_temperature_K - 273.15)
+                                             + stack - wear) / kp
+        return _Frame(self, table, theta_c, self.youngs_modulus(theta_cs), self.x_c(table, x_kiss_ref), s_kiss,
+                      s_kiss - table.full_compression(theta_c) / kp, theta_cs, wear)
+
+    def state(self, x_to: float, theta_cs: float, theta_cm: float, wear: float, table, x_kiss_ref: float,
+              tol: float = 1e-15) -> CoverState:
+        """Solve the force balance at bearing position ``x_to`` (m), temperatures in K, wear in m.
+
+        Raises
+        ------
+        ValueError
+            If the diaphragm cannot hold the cushion (bearing force < 0 before the cushion is solid).
+        """
+        return self.prepare(theta_cs, theta_cm, wear, table, x_kiss_ref).state(x_to, tol)
+
+    def kiss_budget(self, theta_cs: float, theta_cm: float, wear: float, table, x_kiss_ref: float) -> dict:
+        """Kiss-point shift at the bearing (m, + = later engagement) split by cause, and the closed clamp load.
+
+        ``cushion``, ``facing``, ``pressure_plate``, ``flywheel``, ``wear``: lever ratio times each part's
+        move of the pressure plate's kiss position; ``compliance``: the release system's deflection change
+        (bearing force at the kiss point differs from the reference); ``total`` = their sum =
+        ``x_kiss - x_kiss_ref``; ``clamp_closed_N``: the diaphragm's installed load (bearing lifted).
+        """
+        fr = self.prepare(theta_cs, theta_cm, wear, table, x_kiss_ref)
+        grow = self.growth(theta_cm)
+        out = {"cushion": -self.i * table.delta_kiss(theta_cs - 273.15), "facing": -self.i * grow["facing"],
+               "pressure_plate": -self.i * grow["pressure_plate"], "flywheel": -self.i * grow["flywheel"],
+               "wear": self.i * wear}
+        out["compliance"] = fr.x_kiss - x_kiss_ref - sum(out.values())
+        out["total"] = fr.x_kiss - x_kiss_ref
+        out["clamp_closed_N"] = fr.clamp_installed()
+        return out
+
+    def x_for_clamp(self, clamp_force: float, theta_cs: float, theta_cm: float, wear: float, table,
+                    x_kiss_ref: float, tol_m: float = 1e-12) -> float:
+        """Smallest bearing position (m) whose clamp force reaches ``clamp_force`` (N); the inverse map.
+
+        At or below zero: the cushion's first contact; above the installed load: the lift-off position.
+        """
+        return self.prepare(theta_cs, theta_cm, wear, table, x_kiss_ref).x_for_clamp(clamp_force, tol_m)
+
+
+class _Frame:
+    """The cover balance at one temperature and wear (see the module docstring for the equations)."""
+
+    def __init__(self, g: CoverMap, table, theta_c: float, e_mod: float, xc: float, s_kiss: float, s_solid: float,
+                 theta_cs: float, wear: float):
+        self.g, self.table, self.theta_c, self.e_mod, self.xc = g, table, theta_c, e_mod, xc
+        i, self._w = table._bracket(theta_c)        # the curves of this temperature, as table.force uses them
+        self._c0 = table.curves[i]
+        self._c1 = table.curves[i + 1] if self._w != 0.0 else None
+        self.s_kiss, self.s_solid, self.theta_cs, self.wear = s_kiss, s_solid, theta_cs, wear
+        self.fto_solid, self.fc_solid = self.f_to(s_solid)
+        self.x_solid = xc - g.kb * s_solid - g.comp * self.fto_solid
+        self.x_lift = self.x_solid + g.comp * max(self.fto_solid, 0.0)
+        self.x_kiss = self.x_of(s_kiss)
+        if self.fto_solid < 0.0:
+            raise ValueError(self._weak(self.fto_solid, "the solid position"))
+
+    def _weak(self, fto: float, where: str) -> str:
+        return (f"the diaphragm cannot hold the cushion: bearing force {fto:.6g} N < 0 at {where} "
+                f"(theta_cs = {self.theta_cs:g} K, facing_wear = {self.wear:g} m)")
+
+    def cushion(self, u: float) -> float:
+        """F(u, theta_cs), N (= ``table.force``, with the temperature bracket found once)."""
+        f0 = self._c0(u)
+        return f0 if self._w == 0.0 else (1.0 - self._w) * f0 + self._w * self._c1(u)
+
+    def cushion_slope(self, u: float) -> float:
+        """dF/du at theta_cs, N/m (= ``table.force_slope``)."""
+        d0 = self._c0.slope(u)
+        return d0 if self._w == 0.0 else (1.0 - self._w) * d0 + self._w * self._c1.slope(u)
+
+    def f_to(self, s: float) -> tuple[float, float]:
+        """(bearing force, cushion force) at deflection ``s`` while the bearing is on the fingers, N."""
+        g = self.g
+        fc = self.cushion((self.s_kiss - s) * g.kp)
+        return (g.moment(s, self.e_mod) - fc * g.L_pp) / g.L_b, fc
+
+    def x_of(self, s: float) -> float:
+        """Bearing position at deflection ``s`` (s >= s_solid), m."""
+        return self.xc - self.g.kb * s - self.g.comp * self.f_to(s)[0]
+
+    def clamp_installed(self) -> float:
+        """The diaphragm's load at the solid position, bearing lifted: the closed clamp force, N."""
+        return self.g.moment(self.s_solid, self.e_mod) / self.g.L_pp
+
+    def state(self, x_to: float, tol: float = 1e-15) -> CoverState:
+        g, kb, kp, comp = self.g, self.g.kb, self.g.kp, self.g.comp
+        s_kiss, u_full = self.s_kiss, (self.s_kiss - self.s_solid) * kp
+        if x_to >= self.x_solid:
+            fto = max(0.0, self.fto_solid - (x_to - self.x_solid) / comp) if comp > 0.0 else 0.0
+            fpp = (g.moment(self.s_solid, self.e_mod) - fto * g.L_b) / g.L_pp
+            return CoverState(fpp, fto, self.fc_solid, u_full, self.s_solid, self.x_kiss, self.x_solid, self.x_lift)
+        lo, hi = self.s_solid, (self.xc - x_to) / kb       # x_of(lo) > x_to >= x_of(hi)
+        s = hi
+        r = self.x_of(s) - x_to
+        for _ in range(100):
+            if abs(r) <= tol * (1.0 + abs(x_to)) or hi - lo <= tol * (1.0 + hi):
+                break
+            if r > 0.0:
+                lo = s
+            else:
+                hi = s
+            u = (s_kiss - s) * kp
+            slope = -kb - comp * (g.moment_slope(s, self.e_mod)
+                                  + self.cushion_slope(u) * kp * g.L_pp) / g.L_b
+            s_new = s - r / slope if slope < 0.0 else 0.5 * (lo + hi)
+            s = s_new if lo < s_new < hi else 0.5 * (lo + hi)
+            r = self.x_of(s) - x_to
+        fto, fc = self.f_to(s)
+        if fto < 0.0:
+            raise ValueError(self._weak(fto, f"x_to = {x_to:g} m"))
+        return CoverState(fc, fto, fc, (s_kiss - s) * kp, s, self.x_kiss, self.x_solid, self.x_lift)
+
+    def x_for_clamp(self, force: float, tol_m: float = 1e-12) -> float:
+        g, table, th = self.g, self.table, self.theta_c
+        if force >= self.clamp_installed():
+            return self.x_lift
+        if force > self.fc_solid:       # solid phase: F_to = (M(s_solid) - F L_pp) / L_b
+            fto = (g.moment(self.s_solid, self.e_mod) - force * g.L_pp) / g.L_b
+            return self.x_solid + g.comp * (self.fto_solid - fto)
+        lo, hi = table.first_contact(th), table.full_compression(th)
+        if force <= table.force(lo, th):
+            return self.x_of(self.s_kiss - lo / g.kp)
+        while hi - lo > tol_m / g.i:
+            mid = 0.5 * (lo + hi)
+            if table.force(mid, th) < force:
+                lo = mid
+            else:
+                hi = mid
+        return self.x_of(self.s_kiss - hi / g.kp)

@@ -1,0 +1,190 @@
+/*
+ * CushionClutch model core, part 3: the cover assembly (diaphragm spring, finger lever, clamp load).
+ * The equations are those of cushion_clutch/model/cover.py (module docstring), the reference implementation:
+ *
+ *   F_AL(s) = 4 E/(1-nu^2) t^4/(K1 D_e^2) (s/t) [(h/t - s/t)(h/t - s/(2t)) + 1]   (Almen-Laszlo)
+ *   M(s) = F_AL(s) e = F_pp L_pp + F_to L_b                                       (moment balance)
+ *   u(s) = (s_kiss - s) L_pp/e,  F_pp = F_c(u, theta_cs) while s > s_solid         (cushion phase)
+ *   x_to = X_c - (L_b/e) s - c F_to(s)                                             (bearing kinematics)
+ *   x_to >= x_solid: s = s_solid, F_to = max(0, F_to(s_solid) - (x_to - x_solid)/c),
+ *                    F_pp = (M(s_solid) - F_to L_b)/L_pp                           (solid phase)
+ *
+ * The forward map is a safeguarded Newton iteration on s in [s_solid, s_rigid] from a chord start
+ * (3-4 iterations); the start depends on the inputs only, so results are reproducible bit for bit
+ * (saved and restored states, any call history).
+ */
+#include "clutch_core.h"
+
+#include <math.h>
+#include <string.h>
+
+#define KELVIN 273.15
+#define PI 3.14159265358979323846
+
+static double k1(double a, double b) {
+    double d = a / b;
+    return ((d - 1.0) / d) * ((d - 1.0) / d) / ((d + 1.0) / (d - 1.0) - 2.0 / log(d)) / PI;
+}
+
+/* M(s) = F_AL(s) e (E folded into fal) and dM/ds */
+static double moment(const CcCover *cv, double s, double e_mod) {
+    double t = cv->p[CV_T], h = cv->p[CV_H];
+    return cv->fal * e_mod * (s / t) * ((h - s) * (h - 0.5 * s) / (t * t) + 1.0) * cv->e;
+}
+
+static double moment_slope(const CcCover *cv, double s, double e_mod) {
+    double t = cv->p[CV_T], h = cv->p[CV_H];
+    return cv->fal * e_mod / t * ((h - s) * (h - 0.5 * s) / (t * t) + 1.0 - s * (1.5 * h - s) / (t * t)) * cv->e;
+}
+
+static double youngs(const CcCover *cv, double theta_K) {
+    return cv->p[CV_E] * (1.0 - cv->p[CV_KE] * (theta_K - cv->p[CV_TREF]));
+}
+
+void cc_cover_prepare(CcCover *cv, const double *par, double lever_ratio, double x_kiss_ref, const Table *tb) {
+    double s_k0, f_to, th_ref;
+    memcpy(cv->p, par, sizeof cv->p);
+    cv->e = par[CV_A] - par[CV_B];
+    cv->L_pp = par[CV_RPP] - par[CV_RF];
+    cv->L_b = lever_ratio * cv->L_pp;
+    cv->kb = cv->L_b / cv->e;
+    cv->kp = cv->L_pp / cv->e;
+    cv->fal = 4.0 / (1.0 - par[CV_NU] * par[CV_NU]) * pow(par[CV_T], 4) / (k1(par[CV_A], par[CV_B]) * 4.0 *
+                                                                             par[CV_A] * par[CV_A]);
+    th_ref = par[CV_TREF] - KELVIN;
+    cv->u_full_ref = cc_table_full(tb, th_ref);
+    s_k0 = par[CV_SINST] + cv->u_full_ref / cv->kp;
+    f_to = (moment(cv, s_k0, par[CV_E]) - cc_table_force(tb, 0.0, th_ref) * cv->L_pp) / cv->L_b;
+    cv->xc = x_kiss_ref + cv->kb * s_k0 + par[CV_C] * f_to;
+    cv->f_theta_cs = NAN; /* no frame yet */
+    cv->hint[0] = cv->hint[1] = cv->hint_k[0] = cv->hint_k[1] = 0;
+}
+
+/* -(dx_to/ds) at its smallest (open phase, s = h) at the largest E: > 0 means no snap-through */
+double cc_cover_slope_bound(const CcCover *cv) {
+    double e_max = cv->p[CV_E] * (1.0 + cv->p[CV_KE] * cv->p[CV_TREF]);
+    return cv->kb + cv->p[CV_C] * moment_slope(cv, cv->p[CV_H], e_max) / cv->L_b;
+}
+
+/* F(u) and dF/du of one curve (PCHIP, as clutch_tables.c); *hint: the last interval, checked before use */
+static double curve_vd(const Curve *c, double u, double *dfdu, int *hint) {
+    int n = c->n, i = *hint;
+    double h, t, t2;
+    if (u <= c->x[0]) { *dfdu = 0.0; return c->y[0]; }
+    if (u >= c->x[n - 1]) { *dfdu = 0.0; return c->y[n - 1]; }
+    if (!(i >= 0 && i < n - 1 && c->x[i] <= u && u < c->x[i + 1])) {
+        int lo = 0, hi = n - 1;
+        while (hi - lo > 1) { /* x[lo] <= u < x[hi] */
+            int mid = (lo + hi) / 2;
+            if (c->x[mid] <= u) lo = mid; else hi = mid;
+        }
+        i = *hint = lo;
+    }
+    h = c->x[i + 1] - c->x[i];
+    t = (u - c->x[i]) / h;
+    t2 = t * t;
+    *dfdu = (6 * t2 - 6 * t) * (c->y[i] - c->y[i + 1]) / h + (3 * t2 - 4 * t + 1) * c->d[i] +
+            (3 * t2 - 2 * t) * c->d[i + 1];
+    return (2 * t2 * t - 3 * t2 + 1) * c->y[i] + (t2 * t - 2 * t2 + t) * h * c->d[i] + (-2 * t2 * t + 3 * t2) *
+           c->y[i + 1] + (t2 * t - t2) * h * c->d[i + 1];
+}
+
+/* the cushion force at one temperature bracket: curves i and i+1 with weight w (as cc_table_force) */
+typedef struct { const Curve *c0, *c1; double w; } Bracket;
+
+static double cushion(const Bracket *b, double u, double *dfdu, int *hint) {
+    double d0, d1, f0 = curve_vd(b->c0, u, &d0, &hint[0]), f1;
+    if (b->w == 0.0) { *dfdu = d0; return f0; }
+    f1 = curve_vd(b->c1, u, &d1, &hint[1]);
+    *dfdu = (1.0 - b->w) * d0 + b->w * d1;
+    return (1.0 - b->w) * f0 + b->w * f1;
+}
+
+int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, double theta_cm, double wear,
+                   CcCoverState *out) {
+    const double *p = cv->p;
+    double th = theta_cs - KELVIN, kb = cv->kb, kp = cv->kp, comp = p[CV_C];
+    double lo, hi, s, r, fc, fto, dfc, e_mod;
+    int k;
+    if (!(theta_cs == cv->f_theta_cs && theta_cm == cv->f_theta_cm && wear == cv->f_wear)) {
+        /* the frame: everything that depends on temperature and wear, not on x_to */
+        int i;
+        double w, stack, m_solid, dummy;
+        Bracket b;
+        e_mod = youngs(cv, theta_cs);
+        cc_table_bracket(tb, th, &i, &w);
+        b.c0 = &tb->curves[i];
+        b.c1 = w == 0.0 ? b.c0 : &tb->curves[i + 1];
+        b.w = w;
+        stack = (w == 0.0 ? tb->delta[i] : (1.0 - w) * tb->delta[i] + w * tb->delta[i + 1]) +
+                (p[CV_TF] * p[CV_AF] + p[CV_TPP] * p[CV_APP] + p[CV_LFW] * p[CV_AFW]) * (theta_cm - p[CV_TREF]);
+        cv->f_e = e_mod;
+        cv->f_c0 = b.c0;
+        cv->f_c1 = b.c1;
+        cv->f_w = w;
+        cv->s_kiss = p[CV_SINST] + (cv->u_full_ref + stack - wear) / kp;
+        cv->s_solid = cv->s_kiss - cc_table_full(tb, th) / kp;
+        cv->fc_solid = cushion(&b, (cv->s_kiss - cv->s_solid) * kp, &dummy, cv->hint_k);
+        m_solid = moment(cv, cv->s_solid, e_mod);
+        cv->m_solid = m_solid;
+        cv->fto_solid = (m_solid - cv->fc_solid * cv->L_pp) / cv->L_b;
+        cv->x_solid = cv->xc - kb * cv->s_solid - comp * cv->fto_solid;
+        fc = cushion(&b, 0.0, &dummy, cv->hint_k);
+        cv->fto_kiss = (moment(cv, cv->s_kiss, e_mod) - fc * cv->L_pp) / cv->L_b;
+        cv->x_kiss = cv->xc - kb * cv->s_kiss - comp * cv->fto_kiss;
+        cv->f_theta_cs = theta_cs;
+        cv->f_theta_cm = theta_cm;
+        cv->f_wear = wear;
+    }
+    e_mod = cv->f_e;
+    out->x_solid = cv->x_solid;
+    out->x_lift = cv->x_solid + comp * (cv->fto_solid > 0.0 ? cv->fto_solid : 0.0);
+    out->x_kiss = cv->x_kiss;
+    if (cv->fto_solid < 0.0) { out->bearing = cv->fto_solid; return -1; }
+    if (x_to >= cv->x_solid) {
+        fto = comp > 0.0 ? cv->fto_solid - (x_to - cv->x_solid) / comp : 0.0;
+        if (fto < 0.0) fto = 0.0;
+        out->bearing = fto;
+        out->clamp = (cv->m_solid - fto * cv->L_b) / cv->L_pp;
+        out->cushion = cv->fc_solid;
+        out->u = (cv->s_kiss - cv->s_solid) * kp;
+        out->s = cv->s_solid;
+        return 0;
+    }
+    {
+        Bracket b;
+        double s_kiss = cv->s_kiss;
+        b.c0 = cv->f_c0;
+        b.c1 = cv->f_c1;
+        b.w = cv->f_w;
+        lo = cv->s_solid;
+        hi = (cv->xc - x_to) / kb;
+        /* start (from the inputs only, so the result never depends on the call history): the chord of
+           x(s) between the solid and kiss points (cushion phase) or the rigid lever shifted by the
+           kiss-point compliance (open) */
+        if (x_to >= cv->x_kiss)
+            s = cv->s_solid + (cv->s_kiss - cv->s_solid) * (cv->x_solid - x_to) / (cv->x_solid - cv->x_kiss);
+        else s = (cv->xc - x_to - comp * cv->fto_kiss) / kb;
+        if (!(s > lo && s < hi)) s = hi;
+        fc = cushion(&b, (s_kiss - s) * kp, &dfc, cv->hint);
+        fto = (moment(cv, s, e_mod) - fc * cv->L_pp) / cv->L_b;
+        r = cv->xc - kb * s - comp * fto - x_to;
+        for (k = 0; k < 100; ++k) {
+            double slope, s_new;
+            if (fabs(r) <= 1e-15 * (1.0 + fabs(x_to)) || hi - lo <= 1e-15 * (1.0 + hi)) break;
+            if (r > 0.0) lo = s; else hi = s;
+            slope = -kb - comp * (moment_slope(cv, s, e_mod) + dfc * kp * cv->L_pp) / cv->L_b;
+            s_new = slope < 0.0 ? s - r / slope : 0.5 * (lo + hi);
+            s = (s_new > lo && s_new < hi) ? s_new : 0.5 * (lo + hi);
+            fc = cushion(&b, (s_kiss - s) * kp, &dfc, cv->hint);
+            fto = (moment(cv, s, e_mod) - fc * cv->L_pp) / cv->L_b;
+            r = cv->xc - kb * s - comp * fto - x_to;
+        }
+        out->clamp = fc;
+        out->bearing = fto;
+        out->cushion = fc;
+        out->u = (s_kiss - s) * kp;
+        out->s = s;
+    }
+    return fto < 0.0 ? -1 : 0;
+}

@@ -42,7 +42,9 @@ def test_energy_balance(hot_runs):
     for res in hot_runs.values():
         e = res.energy
         assert e.engine_work > 1e5
-        assert abs(e.residual()) < 0.01 * e.engine_work
+        # midpoint-speed bookkeeping closes to round-off: 2e-10 of engine work measured (about 4e-5 J
+        # of 2e5 J); end-of-step speeds would leave about 24 J (1e-4)
+        assert abs(e.residual()) < 1e-8 * e.engine_work
         # and every term is there: the car climbed, slipped, rolled and braked
         assert e.potential > 0 and e.slip > 1e4 and e.resistance > 0 and e.brake > 0
         assert abs(e.kinetic) < 1.0                  # at rest again at the end

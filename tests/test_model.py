@@ -112,3 +112,38 @@ def test_malformed_table_is_a_clear_error(tmp_path):
     (tmp_path / "kiss_point.csv").write_text("theta_degC,delta_kiss_m\n20,0\n")
     with pytest.raises(ValueError, match="force_deflection.csv"):
         load_table(tmp_path)
+
+
+@pytest.mark.parametrize("bad, message", [
+    ({"mu": -0.1}, "p.mu = -0.1 is out of range [0, 2]"),
+    ({"mu": math.nan}, "p.mu = nan is out of range [0, 2]"),
+    ({"R_eq": 0.0}, "p.R_eq = 0.0 is out of range (0, 1]"),
+    ({"n_surfaces": 0.0}, "p.n_surfaces = 0.0 is out of range [1, 16]"),
+    ({"n_surfaces": 2.5}, "p.n_surfaces = 2.5 must be a positive integer in [1, 16]"),
+    ({"lever_ratio": 0.0}, "p.lever_ratio = 0.0 is out of range (0, 100]"),
+    ({"x_kiss_ref": 2.0}, "p.x_kiss_ref = 2.0 is out of range [-1, 1]"),
+])
+def test_api_refuses_bad_clutch_parameters(table, bad, message):
+    p = ClutchParameters(**bad)
+    for call in (lambda: outputs(0.006, 400.0, table, p), lambda: x_to_for_torque(100.0, 400.0, table, p)):
+        with pytest.raises(ValueError) as err:
+            call()
+        assert str(err.value) == message
+
+
+@pytest.mark.parametrize("args, message", [
+    ((math.inf, 400.0), "x_to = inf is outside [-1, 1]"),
+    ((0.006, 0.0), "theta_cs = 0.0 is outside (0, 2000)"),
+    ((0.006, 2000.0), "theta_cs = 2000.0 is outside (0, 2000)"),
+    ((2.0, -1.0), "x_to = 2.0 is outside [-1, 1]; theta_cs = -1.0 is outside (0, 2000)"),
+])
+def test_api_argument_errors_name_every_bad_argument(table, args, message):
+    with pytest.raises(ValueError) as err:
+        outputs(*args, table, P)
+    assert str(err.value) == message
+
+
+def test_thermal_step_refuses_bad_arguments_and_parameters():
+    with pytest.raises(ValueError) as err:
+        thermal_step(300.0, 400.0, -1.0, ClutchParameters(C=0.0))
+    assert str(err.value) == "dt = -1.0 is outside [0, 1e+09]; p.C = 0.0 is out of range (0, 1e+06]"

@@ -387,3 +387,66 @@ def test_fmi3_sources_build_with_fmpy_compile(tmp_path):
     a, b = (simulate_fmu(str(f), stop_time=2.0, start_values={"theta_cm": 500.0}, output=["theta_cs"])
             for f in (src_only, native_fmus()[3]))
     assert a["theta_cs"][-1] == pytest.approx(b["theta_cs"][-1], rel=1e-13) and a["theta_cs"][-1] > 320.0
+
+
+# ------------------------------------------------------- outputs against the closed form
+def test_der_theta_cs_output_is_the_heat_balance_in_both_versions():
+    """der(theta_cs) = (U theta_cm + H theta_a - (U + H) theta_cs) / C (eq. 3), and it is the slope of theta_cs."""
+    p = ClutchParameters()
+    for version, fmu in native_fmus().items():
+        md = read_model_description(str(fmu))
+        vr = {v.name: v.valueReference for v in md.modelVariables}
+        cls = FMU2Slave if version == 2 else FMU3Slave
+        s = cls(guid=md.guid, unzipDirectory=extract(str(fmu)), modelIdentifier="CushionClutch",
+                instanceName=f"der{version}")
+        s.instantiate()
+        if version == 2:
+            s.setupExperiment(startTime=0.0)
+            s.enterInitializationMode()
+        else:
+            s.enterInitializationMode(startTime=0.0)
+        s.exitInitializationMode()
+        get = s.getReal if version == 2 else s.getFloat64
+        put = s.setReal if version == 2 else s.setFloat64
+        t = 0.0
+        for theta_cm in (600.0, 600.0, 250.0):          # heating, then cooling below theta_cs
+            put([vr["x_to"], vr["theta_cm"]], [0.006, theta_cm])
+            theta, der = get([vr["theta_cs"], vr["der(theta_cs)"]])
+            assert der == pytest.approx((p.U * theta_cm + p.H * p.theta_a - G * theta) / p.C, rel=1e-12)
+            h = 1e-4
+            s.doStep(t, h)
+            t += h
+            slope = (get([vr["theta_cs"]])[0] - theta) / h
+            assert slope == pytest.approx(der, rel=1e-3)
+            s.doStep(t, 2.0)
+            t += 2.0
+        assert der < 0.0                                 # the last row cools
+        s.terminate()
+        s.freeInstance()
+
+
+def test_fmi3_refused_step_asks_to_terminate():
+    """fmi3DoStep's terminateSimulation: true after a discarded step, false after a good one."""
+    import ctypes
+    fmu = native_fmus()[3]
+    md = read_model_description(str(fmu))
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    s = FMU3Slave(guid=md.guid, unzipDirectory=extract(str(fmu)), modelIdentifier="CushionClutch", instanceName="t3")
+    s.instantiate(loggingOn=False)
+    s.enterInitializationMode(startTime=0.0)
+    s.exitInitializationMode()
+    do_step = s.dll.fmi3DoStep
+    do_step.restype = ctypes.c_int
+    do_step.argtypes = [ctypes.c_void_p, ctypes.c_double, ctypes.c_double, ctypes.c_bool] + [ctypes.c_void_p] * 4
+
+    def step(t):
+        flags = [ctypes.c_bool(True), ctypes.c_bool(True), ctypes.c_bool(True)]
+        last = ctypes.c_double(-1.0)
+        status = do_step(s.component, t, 1.0, True, *[ctypes.byref(f) for f in flags], ctypes.byref(last))
+        return status, [f.value for f in flags], last.value
+    s.setFloat64([vr["x_to"], vr["theta_cm"]], [0.006, 500.0])
+    assert step(0.0) == (0, [False, False, False], 1.0)          # OK, no event, go on, early return false
+    s.setFloat64([vr["theta_cm"]], [-1.0])
+    assert step(1.0) == (2, [False, True, False], 1.0)           # Discard: terminate, last good time 1 s
+    s.terminate()
+    s.freeInstance()

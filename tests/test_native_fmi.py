@@ -450,3 +450,23 @@ def test_fmi3_refused_step_asks_to_terminate():
     assert step(1.0) == (2, [False, True, False], 1.0)           # Discard: terminate, last good time 1 s
     s.terminate()
     s.freeInstance()
+
+
+def test_u_f_is_clipped_before_the_kiss_point_and_linear_after():
+    """u_f = max(0, (x_to - x_kiss) / lever_ratio), by hand, in the native FMU and the Python model."""
+    p, table = ClutchParameters(), load_table()
+    s, vr = _slave(name="uf")
+    s.instantiate()
+    s.setupExperiment(startTime=0.0)
+    s.enterInitializationMode()
+    s.exitInitializationMode()
+    for x in (0.0, 0.002, 0.0039, 0.0045, 0.006):
+        s.setReal([vr["x_to"]], [x])
+        u_f, x_kiss, force = s.getReal([vr["u_f"], vr["x_kiss"], vr["force"]])
+        assert x_kiss == pytest.approx(p.x_kiss_ref, abs=1e-15)        # 20 degC: the reference kiss point
+        assert u_f == max(0.0, (x - x_kiss) / p.lever_ratio)
+        assert u_f == outputs(x, p.theta_cs_start, table, p).u_f
+        if x < x_kiss - 0.3e-3 * p.lever_ratio:                         # before the toe: no contact
+            assert force == 0.0
+    s.terminate()
+    s.freeInstance()

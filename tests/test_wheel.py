@@ -1,8 +1,9 @@
 """Issue 8, item 1: the wheel works anywhere, from an empty folder, with no repository in sight.
 
-Builds the wheel, installs it (no editable install, no source tree on the path) into a fresh
-virtual environment that borrows only the third-party dependencies, and runs the user-facing
-commands from an empty folder.
+Builds the wheel, installs it with its dependencies from pip (PyPI; pip's cache keeps it fast) into
+a fresh, isolated virtual environment (no system site packages, so neither the editable install nor
+the source tree can fill in a module the wheel lacks), imports every module of the source tree from
+it, and runs the user-facing commands from an empty folder.
 """
 from __future__ import annotations
 
@@ -10,6 +11,7 @@ import os
 import re
 import subprocess
 import sys
+import tomllib
 import venv
 from pathlib import Path
 
@@ -31,10 +33,10 @@ def installed(tmp_path_factory):
                     "-w", str(dist), str(REPO)], check=True, capture_output=True)
     wheel = next(dist.glob("cushion_clutch-*.whl"))
     env_dir = root / "venv"
-    venv.EnvBuilder(system_site_packages=True, with_pip=False).create(env_dir)
+    venv.EnvBuilder(system_site_packages=False, with_pip=False).create(env_dir)
     py = env_dir / "bin" / "python"
-    subprocess.run([sys.executable, "-m", "pip", "--python", str(py), "install", "--no-deps", "-q",
-                    str(wheel)], check=True, capture_output=True)
+    subprocess.run([sys.executable, "-m", "pip", "--python", str(py), "install", "-q", str(wheel)],
+                   check=True, capture_output=True)
     env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONHOME")}
     return py, env_dir / "bin" / "cushion-clutch", env
 
@@ -52,6 +54,45 @@ def test_the_package_comes_from_the_wheel(installed, tmp_path):
                 "print(d.DEFAULT_TABLES); print(d.fmu_sources())"], tmp_path, env)
     for line in out.splitlines():
         assert "site-packages" in line and str(REPO) not in line, out
+
+
+def source_modules(repo: Path = REPO) -> list[str]:
+    """Every module and package of the source tree, by walking the folders (not pyproject's package list)."""
+    conf = tomllib.loads((repo / "pyproject.toml").read_text())
+    roots = {"cushion_clutch": repo / "cushion_clutch",
+             **{pkg: repo / folder for pkg, folder in conf["tool"]["setuptools"]["package-dir"].items() if pkg}}
+    names = set()
+    for pkg, folder in roots.items():
+        for path in folder.rglob("*.py"):
+            rel = path.relative_to(folder).with_suffix("").parts
+            if "__pycache__" in rel:
+                continue
+            names.add(".".join((pkg, *rel[:-1])) if rel[-1] == "__init__" else ".".join((pkg, *rel)))
+    return sorted(names)
+
+
+IMPORT_ALL = """
+import importlib, sys, sysconfig
+site = sysconfig.get_paths()["purelib"]
+bad = []
+for name in sys.argv[1:]:
+    try:
+        mod = importlib.import_module(name)
+    except Exception as exc:
+        bad.append(f"{name}: {type(exc).__name__}: {exc}")
+        continue
+    if not getattr(mod, "__file__", "").startswith(site):
+        bad.append(f"{name}: imported from {mod.__file__}, not from the wheel in {site}")
+print("\\n".join(bad) or "all imported")
+"""
+
+
+def test_every_module_of_the_source_tree_imports_from_the_wheel(installed, tmp_path):
+    py, _, env = installed
+    names = source_modules()
+    assert {"cushion_clutch.launch", "cushion_clutch.fe", "cushion_clutch.fmu_src.clutch_model"} <= set(names)
+    out = _run([py, "-c", IMPORT_ALL, *names], tmp_path, env)
+    assert out.strip() == "all imported", out
 
 
 def test_commands_work_from_an_empty_folder(installed, tmp_path):

@@ -111,6 +111,10 @@ MUTANTS = (
     Mutant("py-kiss-shift-sign", "cushion_clutch/fe/tables.py",
            "ref[0].kiss_travel_m - c.kiss_travel_m", "c.kiss_travel_m - ref[0].kiss_travel_m",
            ("tests/test_tables.py",), "kiss shift sign flipped (only a ccx test caught it)"),
+    # ---- packaging: a wheel without a subpackage (the wheel test installs it into an isolated venv)
+    Mutant("wheel-without-launch", "pyproject.toml", '"cushion_clutch.launch", ', "",
+           ("tests/test_wheel.py::test_every_module_of_the_source_tree_imports_from_the_wheel",),
+           "wheel built without cushion_clutch.launch (passed the wheel test on c5f3d16)"),
 )
 
 
@@ -148,9 +152,8 @@ def run_tests(copy: Path, tests: tuple[str, ...], timeout_s: float) -> tuple[str
     env = dict(os.environ, PYTHONPATH=str(copy), PYTHONDONTWRITEBYTECODE="1")
     t0 = time.perf_counter()
     try:
-        res = subprocess.run([sys.executable, "-m", "pytest", "-x", "-q", "-p", "no:cacheprovider",
-                              "-m", "not ccx", *tests], cwd=copy, env=env, capture_output=True,
-                             text=True, timeout=timeout_s)
+        res = subprocess.run([sys.executable, "-m", "pytest", "-x", "-q", "-p", "no:cacheprovider", *tests],
+                             cwd=copy, env=env, capture_output=True, text=True, timeout=timeout_s)
     except subprocess.TimeoutExpired:
         return "timeout", time.perf_counter() - t0
     verdict = {0: "passed", 1: "failed"}.get(res.returncode, "error")
@@ -185,13 +188,14 @@ def hand_mutants(mutants, timeout_s: float, progress=print) -> list[tuple[Mutant
                 verdict, secs = run_tests(copy, m.tests, timeout_s)
             finally:
                 (copy / m.path).write_text(original)
-            status = "SURVIVED" if verdict == "passed" else f"killed ({verdict})"
+            status = {"passed": "SURVIVED", "failed": "killed", "timeout": "killed (timeout)"}.get(
+                verdict, "ERROR (no verdict)")
             progress(f"{m.name:24s} {status:18s} {secs:6.0f} s  {m.why}")
             out.append((m, verdict, secs))
     return out
 
 
-def run_mutmut(timeout_s: float, progress=print) -> dict[str, int]:
+def run_mutmut(timeout_s: float, max_children: int = 1, progress=print) -> dict[str, int]:
     """mutmut over [tool.mutmut]'s paths in a copy of the checkout; counts by mutmut's status."""
     root = repo_root()
     counts: dict[str, int] = {}
@@ -200,7 +204,7 @@ def run_mutmut(timeout_s: float, progress=print) -> dict[str, int]:
         env = dict(os.environ, PYTHONPATH=str(copy))
         exe = [sys.executable, "-m", "mutmut"]
         progress("mutmut run (this takes a while) ...")
-        subprocess.run([*exe, "run"], cwd=copy, env=env, timeout=timeout_s, capture_output=True, text=True)
+        subprocess.run([*exe, "run", "--max-children", str(max_children)], cwd=copy, env=env, timeout=timeout_s, capture_output=True, text=True)
         res = subprocess.run([*exe, "results", "--all", "true"], cwd=copy, env=env, capture_output=True, text=True)
         for line in res.stdout.splitlines():
             name, _, status = line.strip().rpartition(": ")
@@ -232,11 +236,11 @@ def main(argv=None) -> int:
                 print(f"unknown mutant in {a.only}; --list shows them", file=sys.stderr)
                 return 2
             res = hand_mutants(chosen, a.timeout)
-            killed = sum(v != "passed" for _, v, _ in res)
+            killed = sum(v in ("failed", "timeout") for _, v, _ in res)
             print(f"hand mutants: {killed}/{len(res)} killed ({100.0 * killed / max(len(res), 1):.0f} %)")
             for m, v, _ in res:
-                if v == "passed":
-                    print(f"  survived: {m.name}: {m.why}")
+                if v not in ("failed", "timeout"):
+                    print(f"  {'survived' if v == 'passed' else 'no verdict (pytest error)'}: {m.name}: {m.why}")
         if a.part in ("mutmut", "all"):
             counts = run_mutmut(a.timeout)
             total = sum(counts.values())

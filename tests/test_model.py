@@ -147,3 +147,20 @@ def test_thermal_step_refuses_bad_arguments_and_parameters():
     with pytest.raises(ValueError) as err:
         thermal_step(300.0, 400.0, -1.0, ClutchParameters(C=0.0))
     assert str(err.value) == "dt = -1.0 is outside [0, 1e+09]; p.C = 0.0 is out of range (0, 1e+06]"
+
+
+def test_cold_characteristic_error_grows_with_temperature(table):
+    """README (launch results): "the naive error grows with theta_cs". On the model: a bearing position
+    chosen from the 20 degC characteristic over-delivers the slipping-launch torques (2-30 % of full) when
+    the spring is hot, more the hotter it is (the kiss point moves 0.39 mm towards the open side at 250 degC);
+    the temperature-aware inverse has no such error."""
+    full = outputs(1.0, 20.0 + KELVIN, table, P).torque
+    for frac in (0.02, 0.1, 0.3):
+        target = frac * full
+        x_cold = x_to_for_torque(target, 20.0 + KELVIN, table, P)
+        ratios = [outputs(x_cold, th + KELVIN, table, P).torque / target for th in (20.0, 80.0, 195.0, 250.0, 300.0)]
+        assert ratios[0] == pytest.approx(1.0, rel=1e-6)
+        assert all(b > a for a, b in zip(ratios, ratios[1:])), ratios
+        assert ratios[3] > 1.1
+        x_hot = x_to_for_torque(target, 250.0 + KELVIN, table, P)
+        assert outputs(x_hot, 250.0 + KELVIN, table, P).torque == pytest.approx(target, rel=1e-6)

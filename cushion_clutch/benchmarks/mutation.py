@@ -126,8 +126,13 @@ def repo_root() -> Path:
     return root
 
 
-def scratch_copy(root: Path, dest: Path) -> Path:
-    """Copy the checkout's tracked and untracked-not-ignored files into ``dest``; link mapped packages."""
+def scratch_copy(root: Path, dest: Path, link: bool = True) -> Path:
+    """Copy the checkout's tracked and untracked-not-ignored files into ``dest``.
+
+    Packages that pyproject maps to another folder (``cushion_clutch.fmu_src`` = ``fmu_src/``) are
+    linked there (``link``: a mutant of ``fmu_src/x`` is what the package imports) or copied (for
+    mutmut, which copies the package again and does not follow links).
+    """
     files = subprocess.run(["git", "-C", str(root), "ls-files", "-co", "--exclude-standard", "-z"],
                            check=True, capture_output=True, text=True).stdout.split("\0")
     for name in filter(None, files):
@@ -135,15 +140,15 @@ def scratch_copy(root: Path, dest: Path) -> Path:
         if src.is_file():
             (dest / name).parent.mkdir(parents=True, exist_ok=True)
             shutil.copy2(src, dest / name)
-    # setuptools' package-dir mapping (cushion_clutch.fmu_src = fmu_src/ ...) as links, so that the
-    # copy imports from itself and never from the editable install
+    # so that the copy imports from itself, never from an editable install
     conf = tomllib.loads((root / "pyproject.toml").read_text())
     for pkg, folder in conf.get("tool", {}).get("setuptools", {}).get("package-dir", {}).items():
-        if pkg:
-            link = dest.joinpath(*pkg.split("."))
-            if not link.exists():
-                link.parent.mkdir(parents=True, exist_ok=True)
-                link.symlink_to(dest / folder, target_is_directory=True)
+        target = dest.joinpath(*pkg.split("."))
+        if pkg and not target.exists() and (dest / folder).is_dir():
+            if link:
+                target.symlink_to(dest / folder, target_is_directory=True)
+            else:
+                shutil.copytree(dest / folder, target)
     return dest
 
 
@@ -200,7 +205,7 @@ def run_mutmut(timeout_s: float, max_children: int = 1, progress=print) -> dict[
     root = repo_root()
     counts: dict[str, int] = {}
     with tempfile.TemporaryDirectory(prefix="cushion_mutmut_") as tmp:
-        copy = scratch_copy(root, Path(tmp))
+        copy = scratch_copy(root, Path(tmp), link=False)
         env = dict(os.environ, PYTHONPATH=str(copy))
         exe = [sys.executable, "-m", "mutmut"]
         progress("mutmut run (this takes a while) ...")

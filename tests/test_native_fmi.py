@@ -242,14 +242,25 @@ def test_corrupted_states_are_refused_and_change_nothing(capfd):
     s.freeInstance()
 
 
-def test_fmi3_state_logging_and_statuses(capfd):
-    fmu = native_fmus()[3]
+def _stepping(version: int, name: str, logging: bool = True):
+    """(slave, value references) of the native FMI ``version`` CS FMU, initialised, in Step Mode at t = 0."""
+    fmu = native_fmus()[version]
     md = read_model_description(str(fmu))
     vr = {v.name: v.valueReference for v in md.modelVariables}
-    s = FMU3Slave(guid=md.guid, unzipDirectory=extract(str(fmu)), modelIdentifier="CushionClutch", instanceName="f3")
-    s.instantiate(loggingOn=False)
-    s.enterInitializationMode(startTime=0.0)
+    cls = FMU2Slave if version == 2 else FMU3Slave
+    s = cls(guid=md.guid, unzipDirectory=extract(str(fmu)), modelIdentifier="CushionClutch", instanceName=name)
+    s.instantiate(loggingOn=logging)
+    if version == 2:
+        s.setupExperiment(startTime=0.0)
+        s.enterInitializationMode()
+    else:
+        s.enterInitializationMode(startTime=0.0)
     s.exitInitializationMode()
+    return s, vr
+
+
+def test_fmi3_state_logging_and_statuses(capfd):
+    s, vr = _stepping(3, "f3", logging=False)
     s.setFloat64([vr["x_to"], vr["theta_cm"]], [0.006, 600.0])
     s.doStep(0.0, 1.0)
     state = s.getFMUState()
@@ -393,19 +404,8 @@ def test_fmi3_sources_build_with_fmpy_compile(tmp_path):
 def test_der_theta_cs_output_is_the_heat_balance_in_both_versions():
     """der(theta_cs) = (U theta_cm + H theta_a - (U + H) theta_cs) / C (eq. 3), and it is the slope of theta_cs."""
     p = ClutchParameters()
-    for version, fmu in native_fmus().items():
-        md = read_model_description(str(fmu))
-        vr = {v.name: v.valueReference for v in md.modelVariables}
-        cls = FMU2Slave if version == 2 else FMU3Slave
-        s = cls(guid=md.guid, unzipDirectory=extract(str(fmu)), modelIdentifier="CushionClutch",
-                instanceName=f"der{version}")
-        s.instantiate()
-        if version == 2:
-            s.setupExperiment(startTime=0.0)
-            s.enterInitializationMode()
-        else:
-            s.enterInitializationMode(startTime=0.0)
-        s.exitInitializationMode()
+    for version in (2, 3):
+        s, vr = _stepping(version, f"der{version}")
         get = s.getReal if version == 2 else s.getFloat64
         put = s.setReal if version == 2 else s.setFloat64
         t = 0.0
@@ -428,13 +428,7 @@ def test_der_theta_cs_output_is_the_heat_balance_in_both_versions():
 def test_fmi3_refused_step_asks_to_terminate():
     """fmi3DoStep's terminateSimulation: true after a discarded step, false after a good one."""
     import ctypes
-    fmu = native_fmus()[3]
-    md = read_model_description(str(fmu))
-    vr = {v.name: v.valueReference for v in md.modelVariables}
-    s = FMU3Slave(guid=md.guid, unzipDirectory=extract(str(fmu)), modelIdentifier="CushionClutch", instanceName="t3")
-    s.instantiate(loggingOn=False)
-    s.enterInitializationMode(startTime=0.0)
-    s.exitInitializationMode()
+    s, vr = _stepping(3, "t3", logging=False)
     do_step = s.dll.fmi3DoStep
     do_step.restype = ctypes.c_int
     do_step.argtypes = [ctypes.c_void_p, ctypes.c_double, ctypes.c_double, ctypes.c_bool] + [ctypes.c_void_p] * 4
@@ -455,11 +449,7 @@ def test_fmi3_refused_step_asks_to_terminate():
 def test_u_f_is_clipped_before_the_kiss_point_and_linear_after():
     """u_f = max(0, (x_to - x_kiss) / lever_ratio), by hand, in the native FMU and the Python model."""
     p, table = ClutchParameters(), load_table()
-    s, vr = _slave(name="uf")
-    s.instantiate()
-    s.setupExperiment(startTime=0.0)
-    s.enterInitializationMode()
-    s.exitInitializationMode()
+    s, vr = _stepping(2, "uf")
     for x in (0.0, 0.002, 0.0039, 0.0045, 0.006):
         s.setReal([vr["x_to"]], [x])
         u_f, x_kiss, force = s.getReal([vr["u_f"], vr["x_kiss"], vr["force"]])

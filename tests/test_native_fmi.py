@@ -460,3 +460,16 @@ def test_u_f_is_clipped_before_the_kiss_point_and_linear_after():
             assert force == 0.0
     s.terminate()
     s.freeInstance()
+
+
+def test_force_beyond_full_compression_is_the_table_s_last_row():
+    """Past full compression F stays at the table's last force (hand value: the CSV's last 20 degC row)."""
+    from cushion_clutch.data import DEFAULT_TABLES
+    from cushion_clutch.fe.tables import read_tables
+    full_20 = read_tables(DEFAULT_TABLES).force_N[0][-1]
+    s, vr = _stepping(2, "full")
+    for x in (0.0095, 0.02):                   # u = 1.83 and 5.3 mm; full compression at 20 degC: 1.74 mm
+        s.setReal([vr["x_to"]], [x])
+        assert s.getReal([vr["force"]])[0] == full_20
+    s.terminate()
+    s.freeInstance()

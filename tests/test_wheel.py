@@ -1,14 +1,17 @@
 """Issue 8, item 1: the wheel works anywhere, from an empty folder, with no repository in sight.
 
-Builds the wheel, installs it with its dependencies from pip (PyPI; pip's cache keeps it fast) into
-a fresh, isolated virtual environment (no system site packages, so neither the editable install nor
-the source tree can fill in a module the wheel lacks), imports every module of the source tree from
-it, and runs the user-facing commands from an empty folder.
+Builds the wheel and installs it into an isolated virtual environment (no system site packages, so
+neither the editable install nor the source tree can fill in a module the wheel lacks) whose
+dependencies come from pip (PyPI; cached between sessions; the project is re-installed from the
+wheel every time), imports every module of the source tree from it, and runs the user-facing
+commands from an empty folder.
 """
 from __future__ import annotations
 
+import hashlib
 import os
 import re
+import shutil
 import subprocess
 import sys
 import tomllib
@@ -24,19 +27,43 @@ REPO = Path(__file__).resolve().parents[1]          # the checkout under test (t
 pytestmark = [pytest.mark.fmu, pytest.mark.ccx]
 
 
+def _dependency_venv() -> Path:
+    """An isolated venv (no system site packages) holding the wheel's dependencies from pip.
+
+    Kept between sessions in ``~/.cache/cushion-clutch/`` under a hash of the Python version and the
+    dependency list, so that only the first run downloads and installs them; the project itself is
+    re-installed from the fresh wheel every time (the old one uninstalled first).
+    """
+    deps = tomllib.loads((REPO / "pyproject.toml").read_text())["project"]["dependencies"]
+    key = hashlib.sha256(repr((sys.version, sorted(deps))).encode()).hexdigest()[:16]
+    env_dir = Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache")) / "cushion-clutch" / f"wheel-venv-{key}"
+    py = env_dir / "bin" / "python"
+    if not (env_dir / "complete").exists():
+        shutil.rmtree(env_dir, ignore_errors=True)
+        venv.EnvBuilder(system_site_packages=False, with_pip=False).create(env_dir)
+        subprocess.run([sys.executable, "-m", "pip", "--python", str(py), "install", "-q", *deps],
+                       check=True, capture_output=True)
+        (env_dir / "complete").write_text("dependencies installed\n")
+    return env_dir
+
+
 @pytest.fixture(scope="module")
 def installed(tmp_path_factory):
-    """(python, cushion-clutch script, environment) of a venv holding only the built wheel."""
+    """(python, cushion-clutch script, environment) of an isolated venv: dependencies from pip, the project
+    only from the built wheel."""
     root = tmp_path_factory.mktemp("wheel")
     dist = root / "dist"
     subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps", "-q",
                     "-w", str(dist), str(REPO)], check=True, capture_output=True)
     wheel = next(dist.glob("cushion_clutch-*.whl"))
-    env_dir = root / "venv"
-    venv.EnvBuilder(system_site_packages=False, with_pip=False).create(env_dir)
+    env_dir = _dependency_venv()
     py = env_dir / "bin" / "python"
-    subprocess.run([sys.executable, "-m", "pip", "--python", str(py), "install", "-q", str(wheel)],
-                   check=True, capture_output=True)
+    pip = [sys.executable, "-m", "pip", "--python", str(py)]
+    subprocess.run([*pip, "uninstall", "-y", "-q", "cushion-clutch"], capture_output=True)
+    subprocess.run([*pip, "install", "--no-deps", "-q", str(wheel)], check=True, capture_output=True)
+    res = subprocess.run([*pip, "check"], capture_output=True, text=True)        # the wheel's requirements met
+    assert res.returncode == 0, res.stdout + res.stderr
+    assert "include-system-site-packages = false" in (env_dir / "pyvenv.cfg").read_text()
     env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONHOME")}
     return py, env_dir / "bin" / "cushion-clutch", env
 
@@ -78,6 +105,18 @@ bad = []
 for name in sys.argv[1:]:
     try:
         mod = importlib.import_module(name)
+    except ModuleNotFoundError as exc:
+        # the pythonfmu slave scripts import their siblings top-level, as pythonfmu loads them
+        # from the FMU's resources: import them so, from the wheel's fmu_src folder
+        pkg, _, base = name.rpartition(".")
+        sys.path.insert(0, importlib.import_module(pkg).__path__[0])
+        try:
+            mod = importlib.import_module(base)
+        except Exception as exc2:
+            bad.append(f"{name}: {type(exc).__name__}: {exc}; top-level: {type(exc2).__name__}: {exc2}")
+            continue
+        finally:
+            del sys.path[0]
     except Exception as exc:
         bad.append(f"{name}: {type(exc).__name__}: {exc}")
         continue

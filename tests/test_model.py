@@ -164,3 +164,49 @@ def test_cold_characteristic_error_grows_with_temperature(table):
         assert ratios[3] > 1.1
         x_hot = x_to_for_torque(target, 250.0 + KELVIN, table, P)
         assert outputs(x_hot, 250.0 + KELVIN, table, P).torque == pytest.approx(target, rel=1e-6)
+
+
+#: the parameter ranges, written out by hand from the docstring of ClutchParameters and the FMUs' checks
+#: (not read from the code): (low, high, low_open, high_open)
+DOCUMENTED_RANGES = {"n_surfaces": (1.0, 16.0, False, False), "mu": (0.0, 2.0, False, False),
+                     "R_eq": (0.0, 1.0, True, False), "U": (0.0, 1e4, False, False), "H": (0.0, 1e4, False, False),
+                     "C": (0.0, 1e6, True, False), "theta_a": (0.0, 2000.0, True, False),
+                     "theta_cs_start": (0.0, 2000.0, True, False), "x_kiss_ref": (-1.0, 1.0, False, False),
+                     "lever_ratio": (0.0, 100.0, True, False)}
+
+
+@pytest.mark.parametrize("name", sorted(DOCUMENTED_RANGES))
+def test_parameter_range_bounds_are_open_or_closed_as_documented(name):
+    lo, hi, lo_open, hi_open = DOCUMENTED_RANGES[name]
+    text = f"{'(' if lo_open else '['}{lo:g}, {hi:g}{')' if hi_open else ']'}"
+    for v, is_open in ((lo, lo_open), (hi, hi_open)):
+        got = ClutchParameters(**{name: v}).problems()
+        assert got == ([f"{name} = {v!r} is out of range {text}"] if is_open else []), (name, v, got)
+    for v in (lo - 1e-3 * (hi - lo), hi + 1e-3 * (hi - lo)):
+        assert ClutchParameters(**{name: v}).problems() == [f"{name} = {v!r} is out of range {text}"]
+
+
+def test_a_spring_without_a_heat_path_is_refused():
+    msg = "U + H must be > 0 (the cushion spring needs a heat path)"
+    assert ClutchParameters(U=0.0, H=0.0).problems() == [msg]
+    assert ClutchParameters(U=0.0, H=1e-9).problems() == []
+    with pytest.raises(ValueError) as err:
+        thermal_step(300.0, 400.0, 1.0, ClutchParameters(U=0.0, H=0.0))
+    assert str(err.value) == "p." + msg
+
+
+def test_argument_bounds(table):
+    """Closed bounds are accepted, open ones refused (x_to in [-1, 1] m, theta_cs in (0, 2000) K,
+    omega_slip in [-1e4, 1e4] rad/s, dt in [0, 1e9] s)."""
+    for x in (-1.0, 1.0):
+        outputs(x, 400.0, table, P)
+    for w in (-1e4, 1e4):
+        outputs(0.006, 400.0, table, P, omega_slip=w)
+    with pytest.raises(ValueError) as err:
+        outputs(0.006, 400.0, table, P, omega_slip=1e4 * (1 + 1e-12))
+    assert str(err.value).startswith("omega_slip = 10000.00000001 is outside [-10000, 10000]")
+    for bad in (0.0, 2000.0):
+        with pytest.raises(ValueError, match=r"^theta_cs = .* is outside \(0, 2000\)$"):
+            outputs(0.006, bad, table, P)
+    assert thermal_step(300.0, 400.0, 0.0, P) == 300.0
+    assert thermal_step(300.0, 400.0, 1e9, P) == pytest.approx((P.U * 400.0 + P.H * P.theta_a) / (P.U + P.H))

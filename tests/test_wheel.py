@@ -20,6 +20,7 @@ from pathlib import Path
 
 import pytest
 
+from cushion_clutch.benchmarks.mutation import scratch_copy
 from cushion_clutch.data import DEFAULT_SPRING
 
 REPO = Path(__file__).resolve().parents[1]          # the checkout under test (tests only)
@@ -53,8 +54,11 @@ def installed(tmp_path_factory):
     only from the built wheel."""
     root = tmp_path_factory.mktemp("wheel")
     dist = root / "dist"
+    # built from a clean copy of the sources: a stale build/ folder in the checkout would put modules
+    # into the wheel that the sources no longer package (setuptools reuses build/lib)
+    src = scratch_copy(REPO, root / "src")
     subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps", "-q",
-                    "-w", str(dist), str(REPO)], check=True, capture_output=True)
+                    "-w", str(dist), str(src)], check=True, capture_output=True)
     wheel = next(dist.glob("cushion_clutch-*.whl"))
     env_dir = _dependency_venv()
     py = env_dir / "bin" / "python"

@@ -133,13 +133,17 @@ def scratch_copy(root: Path, dest: Path, link: bool = True) -> Path:
     linked there (``link``: a mutant of ``fmu_src/x`` is what the package imports) or copied (for
     mutmut, which copies the package again and does not follow links).
     """
-    files = subprocess.run(["git", "-C", str(root), "ls-files", "-co", "--exclude-standard", "-z"],
-                           check=True, capture_output=True, text=True).stdout.split("\0")
-    for name in filter(None, files):
-        src = root / name
-        if src.is_file():
-            (dest / name).parent.mkdir(parents=True, exist_ok=True)
-            shutil.copy2(src, dest / name)
+    res = subprocess.run(["git", "-C", str(root), "ls-files", "-co", "--exclude-standard", "-z"],
+                         capture_output=True, text=True)
+    if res.returncode == 0:
+        for name in filter(None, res.stdout.split("\0")):
+            src = root / name
+            if src.is_file():
+                (dest / name).parent.mkdir(parents=True, exist_ok=True)
+                shutil.copy2(src, dest / name)
+    else:       # not a git checkout (a copy made by this function): everything but build products
+        shutil.copytree(root, dest, symlinks=True, dirs_exist_ok=True, ignore=shutil.ignore_patterns(
+            "build", "dist", "*.egg-info", "__pycache__", ".pytest_cache", ".hypothesis", "mutants"))
     # so that the copy imports from itself, never from an editable install
     conf = tomllib.loads((root / "pyproject.toml").read_text())
     for pkg, folder in conf.get("tool", {}).get("setuptools", {}).get("package-dir", {}).items():

@@ -3,7 +3,8 @@ import shutil
 
 import pytest
 
-from cushion_clutch.fmu.model import DEFAULT_TABLES, ClutchParameters, load_table, outputs
+from cushion_clutch.data import DEFAULT_TABLES
+from cushion_clutch.model import ClutchParameters, load_table, outputs
 
 KISS = {20.0: 0.0, 80.0: 2.736031536e-05, 195.0: 9.279361285e-05, 250.0: 1.311404764e-04, 300.0: 1.700326015e-04}
 

@@ -95,10 +95,10 @@ MUTANTS = (
            "        wm_e = 0.5 * (w_e + w_e_new)\n        v_m = 0.5 * (v + v_new)",
            "        wm_e = w_e_new\n        v_m = v_new",
            ("tests/test_launch.py",), "energy bookkeeping with end-of-step speeds"),
-    Mutant("py-kiss-row-order", "fmu_src/spring_table.py",
+    Mutant("py-kiss-row-order", "cushion_clutch/model/spring_table.py",
            "        kp = kp[np.argsort(kp[:, 0])]\n", "",
            ("tests/test_spring_table.py",), "pythonfmu loader ignores the row order of kiss_point.csv"),
-    Mutant("py-api-parameters", "fmu_src/clutch_model.py",
+    Mutant("py-api-parameters", "cushion_clutch/model/clutch_model.py",
            "            and (theta_cm is None or 0.0 < theta_cm < THETA_CM_LIMIT) and _clutch_ok(p)):\n"
            "        raise _argument_error({\"x_to\"",
            "            and (theta_cm is None or 0.0 < theta_cm < THETA_CM_LIMIT)):\n"

@@ -110,17 +110,20 @@ for name in sys.argv[1:]:
     try:
         mod = importlib.import_module(name)
     except ModuleNotFoundError as exc:
-        # the pythonfmu slave scripts import their siblings top-level, as pythonfmu loads them
-        # from the FMU's resources: import them so, from the wheel's fmu_src folder
+        # the pythonfmu slave scripts import their siblings and the model top-level, as pythonfmu
+        # loads them from the FMU's resources (the build copies cushion_clutch.model there): import
+        # them so, from the wheel's folders
         pkg, _, base = name.rpartition(".")
-        sys.path.insert(0, importlib.import_module(pkg).__path__[0])
+        folders = [importlib.import_module(pkg).__path__[0],
+                   importlib.import_module("cushion_clutch.model").__path__[0]]
+        sys.path[:0] = folders
         try:
             mod = importlib.import_module(base)
         except Exception as exc2:
             bad.append(f"{name}: {type(exc).__name__}: {exc}; top-level: {type(exc2).__name__}: {exc2}")
             continue
         finally:
-            del sys.path[0]
+            del sys.path[:len(folders)]
     except Exception as exc:
         bad.append(f"{name}: {type(exc).__name__}: {exc}")
         continue

@@ -98,3 +98,32 @@ def _write(tmp_path, text):
     path = tmp_path / "friction.csv"
     path.write_text(text)
     return path
+
+
+@pytest.mark.parametrize("args, message", [
+    (([20, 20], [0], [[0.3], [0.3]]), "theta_degC must be finite and strictly increasing"),
+    (([], [0], []), "theta_degC must be finite and strictly increasing; mu must have shape (0, 1)"),
+    (([20], [0, float("nan")], [[0.3, 0.3]]), "omega_slip_rad_s must be finite and strictly increasing"),
+    (([20], [-1, 5], [[0.3, 0.3]]), "omega_slip_rad_s must be >= 0"),
+    (([20, 30], [0], [[0.3], [2.5]]), "mu must be finite and in [0, 2]"),
+    (([20, 30], [0], [[-0.1], [0.3]]), "mu must be finite and in [0, 2]"),
+    (([20], [0], [[0.3], [0.3]]), "mu must have shape (1, 1)"),
+])
+def test_friction_grid_problems_are_named_exactly(args, message):
+    with pytest.raises(ValueError) as err:
+        FrictionTable(*args)
+    assert str(err.value) == "friction table: " + message
+
+
+def test_friction_is_bilinear_on_a_hand_grid():
+    """mu by hand: corners, edge midpoints, the centre, clamping and |omega| (a non-uniform 2 x 3 grid)."""
+    f = FrictionTable([0.0, 100.0], [0.0, 10.0, 30.0], [[0.4, 0.3, 0.1], [0.2, 0.1, 0.0]])
+    assert f(0.0, 0.0) == 0.4 and f(100.0, 30.0) == 0.0
+    assert f(50.0, 0.0) == pytest.approx(0.3, abs=1e-15)
+    assert f(0.0, 20.0) == pytest.approx(0.2, abs=1e-15)
+    assert f(25.0, 5.0) == pytest.approx(0.75 * 0.35 + 0.25 * 0.15, abs=1e-15)
+    assert f(75.0, -20.0) == pytest.approx(0.25 * 0.2 + 0.75 * 0.05, abs=1e-15)
+    assert f(-10.0, 99.0) == 0.1 and f(200.0, 0.0) == 0.2
+    one = FrictionTable([20.0], [0.0], [[0.33]])
+    assert one(-100.0, 0.0) == one(500.0, 1e3) == 0.33
+    assert isinstance(one(20.0, 0.0), float)

@@ -44,7 +44,9 @@ def test_energy_balance(hot_runs):
     for res in hot_runs.values():
         e = res.energy
         assert e.engine_work > 1e5
-        assert abs(e.residual()) < 1e-9 * e.engine_work          # exact discrete balance: round-off only
+        # exact discrete balance (midpoint speeds): round-off only, about 1e-14 of engine work measured;
+        # end-of-step speeds would leave about 1e-4
+        assert abs(e.residual()) < 1e-9 * e.engine_work
         # and every term is there: the car climbed, slipped, rolled and braked
         assert e.potential > 0 and e.slip > 1e4 and e.resistance > 0 and e.brake > 0 and e.damping > 0
         assert abs(e.kinetic) < 1.0 and e.elastic < 1.0     # at rest again at the end, shafts relaxed

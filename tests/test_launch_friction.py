@@ -30,8 +30,14 @@ def test_constant_mu_table_gives_todays_results(tmp_path):
     # equal to round-off: the bilinear weights make mu = 0.28 within one ulp, not bit for bit
     for f in a.series.dtype.names:
         np.testing.assert_allclose(b.series[f], a.series[f], rtol=1e-12, atol=1e-12, equal_nan=True)
+    assert len(a.metrics) == len(b.metrics) > 0
     for ma, mb in zip(a.metrics, b.metrics):
-        assert mb == pytest.approx(ma, rel=1e-9, abs=1e-9, nan_ok=True)
+        assert mb.keys() == ma.keys()
+        for key, va in ma.items():          # numbers to round-off; strings and flags exactly
+            if isinstance(va, float):
+                assert mb[key] == pytest.approx(va, rel=1e-9, abs=1e-9, nan_ok=True), key
+            else:
+                assert mb[key] == va, key
 
 
 def test_fade_table_lowers_the_torque_by_its_ratio(tmp_path):

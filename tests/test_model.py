@@ -131,3 +131,101 @@ def test_negative_table_force_is_refused_with_its_row(tmp_path):
 def test_thermal_system_names_a_zero_heat_capacity():
     with pytest.raises(ValueError, match="^C = 0"):
         thermal_system(ClutchParameters(C=0))
+
+
+@pytest.mark.parametrize("bad, message", [
+    ({"mu": -0.1}, "p.mu = -0.1 is out of range [0, 2]"),
+    ({"mu": math.nan}, "p.mu = nan is out of range [0, 2]"),
+    ({"R_eq": 0.0}, "p.R_eq = 0.0 is out of range (0, 1]"),
+    ({"n_surfaces": 0.0}, "p.n_surfaces = 0.0 is out of range [1, 16]"),
+    ({"n_surfaces": 2.5}, "p.n_surfaces = 2.5 must be a positive integer in [1, 16]"),
+    ({"lever_ratio": 0.0}, "p.lever_ratio = 0.0 is out of range (0, 100]"),
+    ({"x_kiss_ref": 2.0}, "p.x_kiss_ref = 2.0 is out of range [-1, 1]"),
+])
+def test_api_refuses_bad_clutch_parameters(table, bad, message):
+    p = ClutchParameters(**bad)
+    for call in (lambda: outputs(0.006, 400.0, table, p), lambda: x_to_for_torque(100.0, 400.0, table, p)):
+        with pytest.raises(ValueError) as err:
+            call()
+        assert str(err.value) == message
+
+
+@pytest.mark.parametrize("args, message", [
+    ((math.inf, 400.0), "x_to = inf is outside [-1, 1]"),
+    ((0.006, 0.0), "theta_cs = 0.0 is outside (0, 2000)"),
+    ((0.006, 2000.0), "theta_cs = 2000.0 is outside (0, 2000)"),
+    ((2.0, -1.0), "x_to = 2.0 is outside [-1, 1]; theta_cs = -1.0 is outside (0, 2000)"),
+])
+def test_api_argument_errors_name_every_bad_argument(table, args, message):
+    with pytest.raises(ValueError) as err:
+        outputs(*args, table, P)
+    assert str(err.value) == message
+
+
+def test_thermal_step_refuses_bad_arguments_and_parameters():
+    with pytest.raises(ValueError) as err:
+        thermal_step(300.0, 400.0, -1.0, ClutchParameters(C=0.0))
+    assert str(err.value) == "dt = -1.0 is outside [0, 1e+09]; p.C = 0.0 is out of range (0, 1e+06]"
+
+
+def test_cold_characteristic_error_grows_with_temperature(table):
+    """README (launch results): "the naive error grows with theta_cs". On the model: a bearing position
+    chosen from the 20 degC characteristic over-delivers the slipping-launch torques (2-30 % of full) when
+    the spring is hot, more the hotter it is (the kiss point moves 0.39 mm towards the open side at 250 degC);
+    the temperature-aware inverse has no such error."""
+    full = outputs(1.0, 20.0 + KELVIN, table, P).torque
+    for frac in (0.02, 0.1, 0.3):
+        target = frac * full
+        x_cold = x_to_for_torque(target, 20.0 + KELVIN, table, P)
+        ratios = [outputs(x_cold, th + KELVIN, table, P).torque / target for th in (20.0, 80.0, 195.0, 250.0, 300.0)]
+        assert ratios[0] == pytest.approx(1.0, rel=1e-6)
+        assert all(b > a for a, b in zip(ratios, ratios[1:])), ratios
+        assert ratios[3] > 1.1
+        x_hot = x_to_for_torque(target, 250.0 + KELVIN, table, P)
+        assert outputs(x_hot, 250.0 + KELVIN, table, P).torque == pytest.approx(target, rel=1e-6)
+
+
+#: the parameter ranges, written out by hand from the docstring of ClutchParameters and the FMUs' checks
+#: (not read from the code): (low, high, low_open, high_open)
+DOCUMENTED_RANGES = {"n_surfaces": (1.0, 16.0, False, False), "mu": (0.0, 2.0, False, False),
+                     "R_eq": (0.0, 1.0, True, False), "U": (0.0, 1e4, False, False), "H": (0.0, 1e4, False, False),
+                     "C": (0.0, 1e6, True, False), "theta_a": (0.0, 2000.0, True, False),
+                     "theta_cs_start": (0.0, 2000.0, True, False), "x_kiss_ref": (-1.0, 1.0, False, False),
+                     "lever_ratio": (0.0, 100.0, True, False)}
+
+
+@pytest.mark.parametrize("name", sorted(DOCUMENTED_RANGES))
+def test_parameter_range_bounds_are_open_or_closed_as_documented(name):
+    lo, hi, lo_open, hi_open = DOCUMENTED_RANGES[name]
+    text = f"{'(' if lo_open else '['}{lo:g}, {hi:g}{')' if hi_open else ']'}"
+    for v, is_open in ((lo, lo_open), (hi, hi_open)):
+        got = ClutchParameters(**{name: v}).problems()
+        assert got == ([f"{name} = {v!r} is out of range {text}"] if is_open else []), (name, v, got)
+    for v in (lo - 1e-3 * (hi - lo), hi + 1e-3 * (hi - lo)):
+        assert ClutchParameters(**{name: v}).problems() == [f"{name} = {v!r} is out of range {text}"]
+
+
+def test_a_spring_without_a_heat_path_is_refused():
+    msg = "U + H must be > 0 (the cushion spring needs a heat path)"
+    assert ClutchParameters(U=0.0, H=0.0).problems() == [msg]
+    assert ClutchParameters(U=0.0, H=1e-9).problems() == []
+    with pytest.raises(ValueError) as err:
+        thermal_step(300.0, 400.0, 1.0, ClutchParameters(U=0.0, H=0.0))
+    assert str(err.value) == "p." + msg
+
+
+def test_argument_bounds(table):
+    """Closed bounds are accepted, open ones refused (x_to in [-1, 1] m, theta_cs in (0, 2000) K,
+    omega_slip in [-1e4, 1e4] rad/s, dt in [0, 1e9] s)."""
+    for x in (-1.0, 1.0):
+        outputs(x, 400.0, table, P)
+    for w in (-1e4, 1e4):
+        outputs(0.006, 400.0, table, P, omega_slip=w)
+    with pytest.raises(ValueError) as err:
+        outputs(0.006, 400.0, table, P, omega_slip=1e4 * (1 + 1e-12))
+    assert str(err.value).startswith("omega_slip = 10000.00000001 is outside [-10000, 10000]")
+    for bad in (0.0, 2000.0):
+        with pytest.raises(ValueError, match=r"^theta_cs = .* is outside \(0, 2000\)$"):
+            outputs(0.006, bad, table, P)
+    assert thermal_step(300.0, 400.0, 0.0, P) == 300.0
+    assert thermal_step(300.0, 400.0, 1e9, P) == pytest.approx((P.U * 400.0 + P.H * P.theta_a) / (P.U + P.H))

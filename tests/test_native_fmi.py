@@ -247,14 +247,25 @@ def test_corrupted_states_are_refused_and_change_nothing(capfd):
     s.freeInstance()
 
 
-def test_fmi3_state_logging_and_statuses(capfd):
-    fmu = native_fmus()[3]
+def _stepping(version: int, name: str, logging: bool = True):
+    """(slave, value references) of the native FMI ``version`` CS FMU, initialised, in Step Mode at t = 0."""
+    fmu = native_fmus()[version]
     md = read_model_description(str(fmu))
     vr = {v.name: v.valueReference for v in md.modelVariables}
-    s = FMU3Slave(guid=md.guid, unzipDirectory=extract(str(fmu)), modelIdentifier="CushionClutch", instanceName="f3")
-    s.instantiate(loggingOn=False)
-    s.enterInitializationMode(startTime=0.0)
+    cls = FMU2Slave if version == 2 else FMU3Slave
+    s = cls(guid=md.guid, unzipDirectory=extract(str(fmu)), modelIdentifier="CushionClutch", instanceName=name)
+    s.instantiate(loggingOn=logging)
+    if version == 2:
+        s.setupExperiment(startTime=0.0)
+        s.enterInitializationMode()
+    else:
+        s.enterInitializationMode(startTime=0.0)
     s.exitInitializationMode()
+    return s, vr
+
+
+def test_fmi3_state_logging_and_statuses(capfd):
+    s, vr = _stepping(3, "f3", logging=False)
     s.setFloat64([vr["x_to"], vr["theta_cm"]], [0.006, 600.0])
     s.doStep(0.0, 1.0)
     state = s.getFMUState()
@@ -455,3 +466,78 @@ def test_negative_table_forces_are_refused_with_the_line(tmp_path, capfd):
     with pytest.raises(Exception, match="instantiate"):
         _outputs_with_tables(tmp_path, "negative", lambda folder: _set_force(folder, 1, "-498"))
     assert "force_deflection.csv line 2: force_N = -498 < 0" in capfd.readouterr().out
+
+
+# ------------------------------------------------------- outputs against the closed form
+def test_der_theta_cs_output_is_the_heat_balance_in_both_versions():
+    """der(theta_cs) = (U theta_cm + H theta_a - (U + H) theta_cs) / C (eq. 3), and it is the slope of theta_cs."""
+    p = ClutchParameters()
+    for version in (2, 3):
+        s, vr = _stepping(version, f"der{version}")
+        get = s.getReal if version == 2 else s.getFloat64
+        put = s.setReal if version == 2 else s.setFloat64
+        t = 0.0
+        for theta_cm in (600.0, 600.0, 250.0):          # heating, then cooling below theta_cs
+            put([vr["x_to"], vr["theta_cm"]], [0.006, theta_cm])
+            theta, der = get([vr["theta_cs"], vr["der(theta_cs)"]])
+            assert der == pytest.approx((p.U * theta_cm + p.H * p.theta_a - G * theta) / p.C, rel=1e-12)
+            h = 1e-4
+            s.doStep(t, h)
+            t += h
+            slope = (get([vr["theta_cs"]])[0] - theta) / h
+            assert slope == pytest.approx(der, rel=1e-3)
+            s.doStep(t, 2.0)
+            t += 2.0
+        assert der < 0.0                                 # the last row cools
+        s.terminate()
+        s.freeInstance()
+
+
+def test_fmi3_refused_step_asks_to_terminate():
+    """fmi3DoStep's terminateSimulation: true after a discarded step, false after a good one."""
+    import ctypes
+    s, vr = _stepping(3, "t3", logging=False)
+    do_step = s.dll.fmi3DoStep
+    do_step.restype = ctypes.c_int
+    do_step.argtypes = [ctypes.c_void_p, ctypes.c_double, ctypes.c_double, ctypes.c_bool] + [ctypes.c_void_p] * 4
+
+    def step(t):
+        flags = [ctypes.c_bool(True), ctypes.c_bool(True), ctypes.c_bool(True)]
+        last = ctypes.c_double(-1.0)
+        status = do_step(s.component, t, 1.0, True, *[ctypes.byref(f) for f in flags], ctypes.byref(last))
+        return status, [f.value for f in flags], last.value
+    s.setFloat64([vr["x_to"], vr["theta_cm"]], [0.006, 500.0])
+    assert step(0.0) == (0, [False, False, False], 1.0)          # OK, no event, go on, early return false
+    s.setFloat64([vr["theta_cm"]], [-1.0])
+    assert step(1.0) == (2, [False, True, False], 1.0)           # Discard: terminate, last good time 1 s
+    s.terminate()
+    s.freeInstance()
+
+
+def test_u_f_is_clipped_before_the_kiss_point_and_linear_after():
+    """u_f = max(0, (x_to - x_kiss) / lever_ratio), by hand, in the native FMU and the Python model."""
+    p, table = ClutchParameters(), load_table()
+    s, vr = _stepping(2, "uf")
+    for x in (0.0, 0.002, 0.0039, 0.0045, 0.006):
+        s.setReal([vr["x_to"]], [x])
+        u_f, x_kiss, force = s.getReal([vr["u_f"], vr["x_kiss"], vr["force"]])
+        assert x_kiss == pytest.approx(p.x_kiss_ref, abs=1e-15)        # 20 degC: the reference kiss point
+        assert u_f == max(0.0, (x - x_kiss) / p.lever_ratio)
+        assert u_f == outputs(x, p.theta_cs_start, table, p).u_f
+        if x < x_kiss - 0.3e-3 * p.lever_ratio:                         # before the toe: no contact
+            assert force == 0.0
+    s.terminate()
+    s.freeInstance()
+
+
+def test_force_beyond_full_compression_is_the_table_s_last_row():
+    """Past full compression F stays at the table's last force (hand value: the CSV's last 20 degC row)."""
+    from cushion_clutch.data import DEFAULT_TABLES
+    from cushion_clutch.fe.tables import read_tables
+    full_20 = read_tables(DEFAULT_TABLES).force_N[0][-1]
+    s, vr = _stepping(2, "full")
+    for x in (0.0095, 0.02):                   # u = 1.83 and 5.3 mm; full compression at 20 degC: 1.74 mm
+        s.setReal([vr["x_to"]], [x])
+        assert s.getReal([vr["force"]])[0] == full_20
+    s.terminate()
+    s.freeInstance()

@@ -36,10 +36,18 @@ def _curves():
 
 
 def test_written_tables_read_back(tmp_path):
-    out = write_tables(tmp_path / "set", _curves(), 20.0, {"solver": "test"})
+    curves = _curves()
+    out = write_tables(tmp_path / "set", curves, 20.0, {"solver": "test"})
     t = read_tables(out)
     assert list(t.theta_degC) == [20.0, 195.0]
     assert t.delta_kiss_m[0] == 0.0
+    assert t.metadata == {"solver": "test"}
+    # every value, against the curves written (u to 10 significant digits, force to 1 uN)
+    for c, u, f in zip(curves, t.u_m, t.force_N):
+        np.testing.assert_allclose(u, c.u_m, rtol=1e-9, atol=0.0)
+        np.testing.assert_allclose(f, c.force_N, rtol=0.0, atol=1e-6)
+    np.testing.assert_allclose(t.delta_kiss_m, [0.0, curves[0].kiss_travel_m - curves[1].kiss_travel_m],
+                               rtol=1e-9, atol=0.0)
     assert (out / "force_deflection.csv").read_text().startswith("theta_degC,u_m,force_N\n")
     assert (out / "kiss_point.csv").read_text().startswith("theta_degC,delta_kiss_m\n")
 
@@ -58,3 +66,20 @@ def test_malformed_table_is_named(tmp_path):
     (out / "kiss_point.csv").write_text("theta,delta\n20,0\n")
     with pytest.raises(TableError, match="kiss_point.csv: header"):
         read_tables(out)
+
+
+def test_tables_hold_hand_computed_values(tmp_path):
+    """Hand values: force in N (whole spring, 8 pairs), u in m, the kiss shift positive when the hot
+    spring touches earlier (it grew in free height), independent of the writer's own code."""
+    # paddle travel; the pair travel is twice that. Kiss at 10 N per pair.
+    cold = case(20.0, [0, 1e-4, 2e-4, 3e-4], [0, 0, 10, 30])      # kiss at pair travel 4e-4 m
+    hot = case(195.0, [0, 1e-4, 2e-4, 3e-4], [0, 10, 30, 50])      # kiss at pair travel 2e-4 m: earlier
+    curves = [curve_from_case(c, 8, 10.0) for c in (cold, hot)]
+    out = write_tables(tmp_path / "hand", curves, 20.0, {})
+    rows = [line.split(",") for line in (out / "force_deflection.csv").read_text().splitlines()[1:]]
+    got = np.array(rows, dtype=float)
+    np.testing.assert_allclose(got, [(20.0, -2e-4, 0.0), (20.0, 0.0, 80.0), (20.0, 2e-4, 240.0),
+                                 (195.0, -2e-4, 0.0), (195.0, 0.0, 80.0), (195.0, 2e-4, 240.0),
+                                 (195.0, 4e-4, 400.0)], rtol=0.0, atol=1e-12)
+    kiss = [line.split(",") for line in (out / "kiss_point.csv").read_text().splitlines()[1:]]
+    np.testing.assert_allclose(np.array(kiss, dtype=float), [(20.0, 0.0), (195.0, 2e-4)], rtol=0.0, atol=1e-15)

@@ -84,8 +84,9 @@ def curve_from_case(case: CaseResult, n_pairs: int, kiss_force_N: float) -> Curv
             f"{u[i] * 1e3:.4f} mm (snap-through); this curve cannot be tabulated")
     force = np.maximum.accumulate(force)
     # the kiss point itself as a row: u = 0, F = kiss force
+    # (an increment exactly at the kiss force is that row: u == 0 is dropped from both columns)
+    force = np.concatenate([force[u < 0], [kiss_force_N], force[u > 0]])
     u = np.concatenate([u[u < 0], [0.0], u[u > 0]])
-    force = np.concatenate([force[:k - start], [kiss_force_N], force[k - start:]])
     keep = np.concatenate([[True], np.diff(u) > 1e-12])
     return Curve(case.theta_degC, u[keep], n_pairs * force[keep], s_kiss,
                  n_pairs * float(drops.max()))

@@ -1,0 +1,33 @@
+"""The FMUs' table reader (fmu_src/spring_table.py): rows in any order, against hand-written tables."""
+import shutil
+
+import pytest
+
+from cushion_clutch.data import DEFAULT_TABLES
+from cushion_clutch.model import ClutchParameters, load_table, outputs
+
+KISS = {20.0: 0.0, 80.0: 2.736031536e-05, 195.0: 9.279361285e-05, 250.0: 1.311404764e-04, 300.0: 1.700326015e-04}
+
+
+def test_delta_kiss_is_the_committed_table_at_every_temperature():
+    table = load_table()
+    for theta, d in KISS.items():
+        assert table.delta_kiss(theta) == d
+    # linear in between, by hand: halfway from 195 to 250 degC
+    assert table.delta_kiss(222.5) == pytest.approx(0.5 * (KISS[195.0] + KISS[250.0]), rel=1e-12)
+
+
+def test_kiss_rows_in_any_order_give_the_same_kiss_point(tmp_path):
+    shutil.copytree(DEFAULT_TABLES, tmp_path / "t")
+    kp = tmp_path / "t" / "kiss_point.csv"
+    head, *rows = kp.read_text().splitlines()
+    kp.write_text("\n".join([head, *reversed(rows)]) + "\n")
+    shuffled, table = load_table(tmp_path / "t"), load_table()
+    for theta, d in KISS.items():
+        assert shuffled.delta_kiss(theta) == d
+    p = ClutchParameters()
+    # a bearing position that matters: 5.5 mm at 250 degC (the kiss point has moved 0.39 mm)
+    x_kiss = p.x_kiss_ref - p.lever_ratio * KISS[250.0]
+    got = outputs(0.0055, 250.0 + 273.15, shuffled, p)
+    assert got.x_kiss == pytest.approx(x_kiss, rel=1e-12)
+    assert got.torque == outputs(0.0055, 250.0 + 273.15, table, p).torque > 0.0

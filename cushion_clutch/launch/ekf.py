@@ -188,7 +188,9 @@ class ClutchEkf:
         """
         s = self.s if s is None else s
         th = min(max(float(s[IX_CS]), self.table.theta_min_K), self.table.theta_max_K)
-        return (float(s[IX_MU]) if mu is None else mu) * outputs(x_m - float(s[IX_DX]), th, self.table, self.p).torque
+        theta_cm = float(0.5 * (s[1] + s[2]))          # the stack's growth at the estimated facing temperature
+        return (float(s[IX_MU]) if mu is None else mu) * outputs(x_m - float(s[IX_DX]), th, self.table, self.p,
+                                                                 theta_cm).torque
 
     # --- prediction ----------------------------------------------------------------------------
     def _jacobian_f(self, w_engine: float, w_disc: float, clamped: bool) -> tuple[np.ndarray, np.ndarray]:

@@ -84,6 +84,10 @@ class ProductionTcu(TcuController):
     def theta_cm_estimate(self) -> float:
         return self.ekf.theta_cm
 
+    def theta_cm_used(self) -> float:
+        """The facing temperature the TCU's clutch model assumes (the EKF's estimate), K."""
+        return self.ekf.theta_cm
+
     def kiss(self) -> float:
         """The kiss point the TCU believes, in the true bearing frame, m."""
         return self.model_kiss(self.ekf.theta_cs) + self.ekf.dx_kiss - self.x_offset
@@ -91,7 +95,8 @@ class ProductionTcu(TcuController):
     def command(self, torque_Nm: float) -> float:
         """Bearing position for ``torque_Nm`` (N.m) as the position sensor reads it, m."""
         th = min(max(self.ekf.theta_cs, self.table.theta_min_K), self.table.theta_max_K)
-        return x_to_for_torque(torque_Nm / max(self.ekf.mu_used, 1e-3), th, self.table, self.p) + self.ekf.dx_kiss
+        return (x_to_for_torque(torque_Nm / max(self.ekf.mu_used, 1e-3), th, self.table, self.p,
+                                theta_cm=self.theta_cm_used()) + self.ekf.dx_kiss)
 
     def model_torque(self, x_m: float) -> float:
         """Torque the TCU believes at the true bearing position ``x_m`` (it sees it through its sensor), N.m."""

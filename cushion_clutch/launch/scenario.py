@@ -154,7 +154,7 @@ class Tcu(Checked):
     speed_ki_Nm_per_rad: float = 5.0
     sync_slip_rad_s: float = 30.0
     lockup_slip_rate_rad_s2: float = 10.0
-    x_to_closed_m: float = 0.009
+    x_to_closed_m: float = 0.015
     close_rate_m_per_s: float = 0.01
     actuator_time_constant_s: float = 0.02
     drive_time_s: float = 8.0

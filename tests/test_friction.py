@@ -1,4 +1,5 @@
 """mu(theta_cm, omega_slip) from friction.csv: the Python model, the native and the pythonfmu FMU."""
+import dataclasses
 import shutil
 
 import numpy as np
@@ -55,6 +56,14 @@ def test_model_uses_the_table_and_needs_theta_cm(fade_tables):
     table, p = load_table(fade_tables), ClutchParameters()
     hot = outputs(0.006, 450.0, table, p, theta_cm=573.15, omega_slip=0.0)
     cold = outputs(0.006, 450.0, table, p, theta_cm=293.15, omega_slip=0.0)
+    # theta_cm also grows the stack (facings, plates): the torque ratio is mu's ratio times the clamp ratio
+    assert hot.torque / cold.torque == pytest.approx(0.20 / 0.30 * hot.clamp_force / cold.clamp_force, rel=1e-12)
+    # with a stack that does not grow, theta_cm changes mu alone
+    still = ClutchParameters(cover=dataclasses.replace(p.cover, facing_expansion_per_K=0.0,
+                                                       pressure_plate_expansion_per_K=0.0,
+                                                       flywheel_expansion_per_K=0.0))
+    hot = outputs(0.006, 450.0, table, still, theta_cm=573.15, omega_slip=0.0)
+    cold = outputs(0.006, 450.0, table, still, theta_cm=293.15, omega_slip=0.0)
     assert hot.force == cold.force
     assert hot.torque / cold.torque == pytest.approx(0.20 / 0.30, rel=1e-12)
     with pytest.raises(ValueError, match="theta_cm"):
@@ -62,7 +71,7 @@ def test_model_uses_the_table_and_needs_theta_cm(fade_tables):
     plain = load_table()
     assert plain.friction is None
     assert outputs(0.006, 450.0, plain, p, theta_cm=573.15, omega_slip=50.0).torque == \
-        outputs(0.006, 450.0, plain, p).torque
+        outputs(0.006, 450.0, plain, p, theta_cm=573.15).torque
 
 
 @pytest.mark.fmu

@@ -170,9 +170,10 @@ def test_thermal_step_refuses_bad_arguments_and_parameters():
 
 def test_cold_characteristic_error_grows_with_temperature(table):
     """README (launch results): "the naive error grows with theta_cs". On the model: a bearing position
-    chosen from the 20 degC characteristic over-delivers the slipping-launch torques (2-30 % of full) when
-    the spring is hot, more the hotter it is (the kiss point moves 0.39 mm towards the open side at 250 degC);
-    the temperature-aware inverse has no such error."""
+    chosen from the 20 degC characteristic over-delivers the slipping-launch torques (2-30 % of the closed
+    torque, 312 N.m) when the spring is hot, more the hotter it is (the kiss point moves 0.56 mm towards the
+    open side at 250 degC, cushion and stack growth less the release compliance; the over-delivery at 250 degC
+    is 110 %, 45 % and 9.9 % at the three levels); the temperature-aware inverse has no such error."""
     full = outputs(1.0, 20.0 + KELVIN, table, P).torque
     for frac in (0.02, 0.1, 0.3):
         target = frac * full
@@ -180,7 +181,7 @@ def test_cold_characteristic_error_grows_with_temperature(table):
         ratios = [outputs(x_cold, th + KELVIN, table, P).torque / target for th in (20.0, 80.0, 195.0, 250.0, 300.0)]
         assert ratios[0] == pytest.approx(1.0, rel=1e-6)
         assert all(b > a for a, b in zip(ratios, ratios[1:])), ratios
-        assert ratios[3] > 1.1
+        assert ratios[3] > 1.05
         x_hot = x_to_for_torque(target, 250.0 + KELVIN, table, P)
         assert outputs(x_hot, 250.0 + KELVIN, table, P).torque == pytest.approx(target, rel=1e-6)
 
@@ -200,6 +201,12 @@ def test_parameter_range_bounds_are_open_or_closed_as_documented(name):
     text = f"{'(' if lo_open else '['}{lo:g}, {hi:g}{')' if hi_open else ']'}"
     for v, is_open in ((lo, lo_open), (hi, hi_open)):
         got = ClutchParameters(**{name: v}).problems()
+        if name == "lever_ratio" and v == hi:
+            # inside its range, but the default cover cannot take it: the bearing radius r_f - i (r_pp - r_f)
+            # would be negative (89 mm - 100 x 22 mm), which the cover's consistency check names
+            assert got == ["lever_ratio = 100 puts the bearing at r_b = r_f - i (r_pp - r_f) = -2.111 m; "
+                           "must be > 0"], got
+            continue
         assert got == ([f"{name} = {v!r} is out of range {text}"] if is_open else []), (name, v, got)
     for v in (lo - 1e-3 * (hi - lo), hi + 1e-3 * (hi - lo)):
         assert ClutchParameters(**{name: v}).problems() == [f"{name} = {v!r} is out of range {text}"]

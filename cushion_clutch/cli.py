@@ -279,8 +279,12 @@ def _tolerance(args: argparse.Namespace) -> int:
         print(f"{label}: P5 {p5:.4g}, P50 {p50:.4g}, P95 {p95:.4g} {unit}; band width P95-P5 "
               f"{p95 - p5:.4g} {unit}")
     for q, (index, value, target) in res.picks.items():
+        x_ref = next(s.x_kiss_ref_m for s in res.summaries if s.sample.index == index)
         print(f"P{q:02.0f} table set {res.sets[q]}: sample {index} (value {value:.4g}, P{q:02.0f} {target:.4g}; "
-              f"ranked by {RANK_BY[args.rank_by]})")
+              f"ranked by {RANK_BY[args.rank_by]}); its own x_kiss_ref = {x_ref * 1e3:.4f} mm "
+              f"(build-fmu takes it from metadata.json)")
+    for w in res.warnings:
+        print(f"warning: {w}", file=sys.stderr)
     print("wrote " + ", ".join(str(f) for f in res.files))
     return 0
 

@@ -4,6 +4,7 @@
  * FMI versions, and the saved state (versioned, checksummed, validated).
  */
 #include "clutch_core.h"
+#include "cushion_guid.h" /* CC_GUID and CC_X_KISS_REF_START, generated when the FMU is built */
 
 #include <math.h>
 #include <stdarg.h>
@@ -68,13 +69,22 @@ int cc_allowed(CcModel *m, int mask, const char *fn) {
 }
 
 /* ------------------------------------------------------------ instantiation */
+/* the defaults, with the table set's own kiss point at the bearing (a tolerance P5/P95 set's metadata) */
+static void set_defaults(CcModel *m) {
+    memcpy(m->r, DEFAULTS, sizeof m->r);
+#ifdef CC_X_KISS_REF_START
+    m->r[VR_X_KISS_REF] = CC_X_KISS_REF_START;
+    m->r[VR_X_KISS] = CC_X_KISS_REF_START;
+#endif
+}
+
 int cc_instantiate(CcModel *m, const char *dir, int me, CcLogger logger, void *ctx, int logging_on) {
     memset(m, 0, sizeof *m);
     m->logger = logger;
     m->log_ctx = ctx;
     m->logging_on = logging_on;
     m->me = me;
-    memcpy(m->r, DEFAULTS, sizeof m->r);
+    set_defaults(m);
     m->phase = PH_INSTANTIATED;
     m->dirty = 1;
     m->table_ok = cc_table_load(&m->table, dir, m->table_error, sizeof m->table_error) == 0;
@@ -85,7 +95,7 @@ int cc_instantiate(CcModel *m, const char *dir, int me, CcLogger logger, void *c
 void cc_free(CcModel *m) { cc_table_free(&m->table); }
 
 void cc_reset(CcModel *m) {
-    memcpy(m->r, DEFAULTS, sizeof m->r);
+    set_defaults(m);
     m->range_warned = 0;
     m->terminated = 0;
     m->time = 0.0;

@@ -196,3 +196,23 @@ def load_csv(path: Path, columns: tuple[str, ...]) -> np.ndarray:
     if not np.all(np.isfinite(data)):
         raise ValueError(f"{path}: non-finite value")
     return data
+
+
+def table_set_x_kiss_ref(folder: str | Path) -> float | None:
+    """The FMU parameter ``x_kiss_ref`` (m) a table set asks for, or None for the model default.
+
+    A tolerance study's P5/P95 set measures u from its own spring's kiss point;
+    ``metadata.json`` then holds ``tolerance_study.x_kiss_ref_m``, the bearing
+    position of that kiss point against the nominal spring's.
+    """
+    import json
+    path = Path(folder) / "metadata.json"
+    if not path.exists():
+        return None
+    value = json.loads(path.read_text()).get("tolerance_study", {}).get("x_kiss_ref_m")
+    if value is None:
+        return None
+    value = float(value)
+    if not (math.isfinite(value) and -1.0 <= value <= 1.0):
+        raise ValueError(f"{path}: tolerance_study.x_kiss_ref_m = {value!r}: allowed -1..1 m")
+    return value

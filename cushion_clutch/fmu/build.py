@@ -17,7 +17,7 @@ from xml.etree import ElementTree as ET
 
 from ..data import fmu_sources
 from ..errors import ParameterError, TableError
-from ..fmu_src.clutch_model import VARIABLES
+from ..fmu_src.clutch_model import VARIABLES, ClutchParameters
 from ..fe.tables import read_tables
 
 log = logging.getLogger(__name__)
@@ -147,6 +147,10 @@ def add_build_arguments(parser) -> None:
 
 def build_from_args(args) -> str:
     """Build the FMU that parsed ``build-fmu`` options describe; return a one-line report."""
+    from ..fmu_src.spring_table import table_set_x_kiss_ref
     version = getattr(args, "fmi_version", 2)
     out = build_fmu(args.tables, args.output, backend=args.backend, fmi_version=version)
-    return f"built {out} ({args.backend}, FMI {version}.0) from {args.tables}"
+    own = table_set_x_kiss_ref(args.tables)
+    kiss = (f"x_kiss_ref = {own * 1e3:.4f} mm (the table set's own kiss point, metadata.json tolerance_study)"
+            if own is not None else f"x_kiss_ref = {ClutchParameters().x_kiss_ref * 1e3:.4f} mm (default)")
+    return f"built {out} ({args.backend}, FMI {version}.0) from {args.tables}; {kiss}"

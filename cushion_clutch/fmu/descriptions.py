@@ -44,9 +44,12 @@ def dependencies(has_friction: bool) -> dict[int, list[int]]:
             _vr("u_f"): [x_to, theta_cs], _vr("x_kiss"): [theta_cs], VR_DER: [theta_cm, theta_cs]}
 
 
-def _variables():
-    """(vr, name, causality, unit, description, start) of every variable but time."""
-    defaults = ClutchParameters()
+def _variables(x_kiss_ref_m: float | None = None):
+    """(vr, name, causality, unit, description, start) of every variable but time.
+
+    ``x_kiss_ref_m``: the table set's own start value of ``x_kiss_ref`` (m), None for the default.
+    """
+    defaults = ClutchParameters() if x_kiss_ref_m is None else ClutchParameters(x_kiss_ref=x_kiss_ref_m)
     starts = {"x_to": 0.0, "theta_cm": defaults.theta_a, "omega_slip": OMEGA_SLIP_START}
     for vr, (name, causality, unit, desc) in enumerate(VARIABLES):
         start = starts.get(name) if causality == "input" else (
@@ -75,7 +78,7 @@ def _finish(root: ET.Element) -> str:
     return '<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
 
 
-def fmi2_description(guid: str, has_friction: bool) -> str:
+def fmi2_description(guid: str, has_friction: bool, x_kiss_ref_m: float | None = None) -> str:
     """FMI 2.0 modelDescription.xml: ME and CS, SourceFiles, ModelStructure with dependencies."""
     root = ET.Element("fmiModelDescription", fmiVersion="2.0", modelName=SLAVE, guid=guid, description=DESCRIPTION,
                       generationTool="cushion_clutch (native C)", variableNamingConvention="flat",
@@ -93,7 +96,7 @@ def fmi2_description(guid: str, has_friction: bool) -> str:
     _units(root)
     _log_categories(root)
     variables = ET.SubElement(root, "ModelVariables")
-    for vr, name, causality, unit, desc, start in _variables():
+    for vr, name, causality, unit, desc, start in _variables(x_kiss_ref_m):
         attrs = dict(name=name, valueReference=str(vr), description=f"{desc} [{unit}]", causality=causality)
         attrs.update(variability="fixed", initial="exact") if causality == "parameter" else attrs.update(
             variability="continuous")
@@ -119,7 +122,7 @@ def fmi2_description(guid: str, has_friction: bool) -> str:
     return _finish(root)
 
 
-def fmi3_description(token: str, has_friction: bool) -> str:
+def fmi3_description(token: str, has_friction: bool, x_kiss_ref_m: float | None = None) -> str:
     """FMI 3.0 modelDescription.xml: ME and CS, independent variable time, ModelStructure."""
     root = ET.Element("fmiModelDescription", fmiVersion="3.0", modelName=SLAVE, instantiationToken=token,
                       description=DESCRIPTION, generationTool="cushion_clutch (native C)",
@@ -133,7 +136,7 @@ def fmi3_description(token: str, has_friction: bool) -> str:
     variables = ET.SubElement(root, "ModelVariables")
     ET.SubElement(variables, "Float64", name="time", valueReference=str(VR_TIME), causality="independent",
                   variability="continuous", unit="s", description="simulation time [s]")
-    for vr, name, causality, unit, desc, start in _variables():
+    for vr, name, causality, unit, desc, start in _variables(x_kiss_ref_m):
         attrs = dict(name=name, valueReference=str(vr), description=f"{desc} [{unit}]", causality=causality)
         attrs.update(variability="fixed", initial="exact") if causality == "parameter" else attrs.update(
             variability="continuous")

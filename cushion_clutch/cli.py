@@ -86,26 +86,31 @@ def _sweep(args: argparse.Namespace) -> int:
 
 
 def _calibrate(args: argparse.Namespace) -> int:
-    from .fe.calibrate import calibrate, parse_bounds, read_measured
-    from .fe.calibration_report import params_toml, plot_calibration, report_text
+    from .fe.calibrate import calibrate, parse_bounds, parse_measured
+    from .fe.calibration_report import calibrated_params, params_toml, plot_calibration, report_text
     from .fe.params import load_params
 
     params = load_params(args.spring)
     if args.mesh_size is not None:
         params = params.replace(mesh={"element_size_m": args.mesh_size})
-    measured = read_measured(args.measured, args.basis)
+    measured = parse_measured(args.measured, args.basis, params.material.reference_temperature_degC)
     out = Path(args.out)
     cal = calibrate(params, measured, [n.strip() for n in args.fit.split(",") if n.strip()],
                     parse_bounds(args.bounds), cache_dir=Path(args.cache), jobs=args.jobs,
                     scheduler=args.scheduler,
                     on_case=lambda n: print(f"FE case {n} done", file=sys.stderr, flush=True))
     report = report_text(cal)
+    result = calibrated_params(cal, args.name or f"{params.name}_calibrated")
     out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(params_toml(cal.params, f"calibrated by cushion-clutch calibrate to {args.measured}\n"
-                               + report), encoding="utf-8")
+    out.write_text(params_toml(result, f"calibrated by cushion-clutch calibrate to "
+                                       f"{', '.join(m.source for m in measured)}\n" + report), encoding="utf-8")
     out.with_suffix(".txt").write_text(report, encoding="utf-8")
-    png = plot_calibration(cal, out.with_suffix(".png"), f"Spring '{params.name}': FE against {Path(args.measured).name}")
-    print(report + f"wrote {out}, {out.with_suffix('.txt')} and {png}")
+    png = plot_calibration(cal, out.with_suffix(".png"),
+                           f"Spring '{params.name}': FE against {', '.join(Path(m.source).name for m in measured)}")
+    print(report + f"wrote {out} (spring '{result.name}'), {out.with_suffix('.txt')} and {png}")
+    warnings = cal.warnings()
+    if warnings:
+        print("warning: calibration not to be trusted as is: " + "; ".join(warnings), file=sys.stderr)
     return 0
 
 
@@ -232,7 +237,10 @@ def _import_scan(args: argparse.Namespace) -> int:
           f"({fr.rivet_points} points, flatness RMS {fr.rivet_rms_m * 1e6:.2f} um)")
     print(f"mid-surface fit residual: RMS {f.rms_m * 1e6:.2f} um, max {f.max_m * 1e6:.2f} um; "
           f"peak height {f.peak_m * 1e3:.4f} mm")
-    print(f"wrote {res.toml}, {res.surface} and {res.plot}")
+    c = res.coverage
+    print(f"coverage: {len(c.gaps)} gap(s) (nodes > {c.distance_limit_m * 1e3:.2f} mm from every point), "
+          + (f"largest {c.gaps[0].describe()}" if c.gaps else "none") + "; none on the wave beyond the limits")
+    print(f"wrote {res.toml}, {res.surface}, {res.plot} and {res.coverage_plot}")
     return 0
 
 
@@ -311,13 +319,17 @@ def build_parser() -> argparse.ArgumentParser:
     sw.set_defaults(func=_sweep)
 
     ca = sub.add_parser("calibrate", help="fit spring parameters to a measured load-deflection curve")
-    ca.add_argument("--measured", required=True, help="CSV u_m,force_N from the kiss point (room temperature)")
+    ca.add_argument("--measured", required=True, action="append",
+                    help="CSV u_m,force_N, u from the reference temperature's kiss point, as measured (noise "
+                         "kept): FILE (reference temperature) or THETA_DEGC=FILE; repeat for hot curves, "
+                         "e.g. --measured 20=bench20.csv --measured 195=bench195.csv")
     ca.add_argument("--basis", choices=("pair", "spring"), default="pair",
                     help="the measured force is of one paddle pair (default) or the whole spring")
     ca.add_argument("--spring", default=DEFAULT_SPRING, help="start parameter TOML")
     ca.add_argument("--fit", required=True, help="comma-separated keys, e.g. wave_height_m,thickness_m")
     ca.add_argument("--bounds", help="NAME=LOWER:UPPER,... (default: start value +-30 %%)")
     ca.add_argument("--out", required=True, help="calibrated TOML (report .txt and .png beside it)")
+    ca.add_argument("--name", help="name of the calibrated spring (default: <spring name>_calibrated)")
     ca.add_argument("--mesh-size", type=float, help="override mesh.element_size_m [m]")
     ca.add_argument("--jobs", type=int, default=2, help="parallel ccx jobs")
     ca.add_argument("--scheduler", help="Dask scheduler address, e.g. tcp://host:8786")
@@ -358,7 +370,8 @@ def build_parser() -> argparse.ArgumentParser:
     im.add_argument("scan", help="point cloud CSV (x,y,z header) or STL/PLY/OBJ surface")
     im.add_argument("--spring", default=DEFAULT_SPRING, help="base spring TOML (plan shape, rivet zone, material)")
     im.add_argument("--out", required=True, help="spring TOML to write (the surface .npz and PNG go next to it)")
-    im.add_argument("--unit", choices=("mm", "m"), default="mm", help="length unit of the scan (default mm)")
+    im.add_argument("--unit", choices=("um", "mm", "cm", "in", "m"), default="mm",
+                    help="length unit of the scan (default mm)")
     im.add_argument("--face", choices=("top", "bottom", "mid"), default="top",
                     help="scanned face: top (away from the carrier, default), bottom, or mid-surface")
     im.add_argument("--datum", choices=("rigid", "offset"), default="rigid",

@@ -130,8 +130,10 @@ class ScanError(ParameterError):
     Like :class:`ParameterError`, it lists every problem found.
     """
 
-    def __init__(self, problems: Sequence[str], source: str | None = None):
+    def __init__(self, problems: Sequence[str], source: str | None = None, coverage=None):
         super().__init__(problems, source)
+        #: the scan's point coverage (:class:`cushion_clutch.fe.scan.Coverage`) when gaps refused it
+        self.coverage = coverage
         where = f" {source}" if source else ""
         lines = "\n  - ".join(self.problems)
         self.args = (f"cannot import the scan{where}:\n  - {lines}",)

@@ -8,7 +8,7 @@ import time
 from pathlib import Path
 
 from .data import DEFAULT_TABLES, tables_root
-from .errors import (CalculixNotFoundError, FmuError, ParameterError, RunInterrupted, SweepError,
+from .errors import (CalculixNotFoundError, ClusterError, FmuError, ParameterError, RunInterrupted, SweepError,
                      TableError)
 
 
@@ -424,7 +424,7 @@ def main(argv: list[str] | None = None) -> int:
             raise
         print(f"error: {_one_message(exc)}", file=sys.stderr)
         return 2
-    except SweepError as exc:
+    except (SweepError, ClusterError) as exc:
         if args.debug:
             raise
         print(f"error: {exc}", file=sys.stderr)

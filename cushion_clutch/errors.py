@@ -159,6 +159,12 @@ class StudyError(SweepError):
                   f"(a rerun resumes) and no band was written:\n{lines}")
 
 
+class ClusterError(RuntimeError):
+    """A Dask cluster cannot run the FE cases: no worker, a worker that lacks the
+    package or ccx, workers with different ccx versions, or workers lost mid-study.
+    The message names every worker concerned; finished cases stay cached."""
+
+
 class FmuCallError(RuntimeError):
     """An FMI function returned a status other than fmi2OK (or fmi2Warning).
 

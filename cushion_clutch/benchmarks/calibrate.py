@@ -23,7 +23,7 @@ import numpy as np
 
 #: perturbation factors of the "true" spring
 TRUTH = {"wave_height_m": 1.08, "thickness_m": 0.95, "far_end_stiffness_N_per_m": 1.3,
-         "temperature_ratio": 0.7, "wave_tilt_m": 1.2}
+         "temperature_ratio": 0.8, "wave_tilt_m": 1.2}
 
 
 def synthetic_curves(truth, temperatures, cache: Path, noise: float = 0.01, points: int = 30, seed: int = 1):

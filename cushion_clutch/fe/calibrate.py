@@ -393,6 +393,11 @@ def calibrate(base: SpringParams, measured: Measured | Sequence[Measured], names
     """
     from scipy.optimize import least_squares
 
+    if isinstance(scheduler, str):                  # one checked client for every FE evaluation
+        from .cluster import open_cluster
+        with open_cluster(scheduler) as (client, _):
+            return calibrate(base, measured, names, bounds, cache_dir=cache_dir, jobs=jobs, scheduler=client,
+                             on_case=on_case, max_iterations=max_iterations)
     measured = [measured] if isinstance(measured, Measured) else list(measured)
     keys = fit_keys(base, names)
     bnds = check_bounds(base, keys, bounds)

@@ -15,7 +15,6 @@ import json
 import logging
 import os
 import platform
-import tempfile
 import threading
 from concurrent.futures import ThreadPoolExecutor, as_completed
 from dataclasses import dataclass
@@ -50,19 +49,23 @@ class CaseOutcome:
     n_nodes: int
     n_elements: int
     from_cache: bool = False
+    ccx_version: str = "unknown"
+    """the CalculiX version that solved it (on whichever machine ran it)"""
 
     def to_json(self) -> dict:
         r = self.result
         return {"theta_degC": r.theta_degC, "paddles": r.paddles, "crest_rise_m": r.crest_rise_m,
                 "travel_m": r.travel_m.tolist(), "force_N": r.force_N.tolist(),
-                "thermal_force_N": r.thermal_force_N, "stats": vars(self.stats),
-                "n_nodes": self.n_nodes, "n_elements": self.n_elements}
+                "thermal_force_N": r.thermal_force_N, "thermal_force_lower_N": r.thermal_force_lower_N,
+                "stats": vars(self.stats),
+                "n_nodes": self.n_nodes, "n_elements": self.n_elements, "ccx_version": self.ccx_version}
 
     @classmethod
     def from_json(cls, d: dict) -> "CaseOutcome":
         r = CaseResult(d["theta_degC"], d["paddles"], d["crest_rise_m"], np.array(d["travel_m"]),
-                       np.array(d["force_N"]), d["thermal_force_N"])
-        return cls(r, RunStats(**d["stats"]), d["n_nodes"], d["n_elements"], from_cache=True)
+                       np.array(d["force_N"]), d["thermal_force_N"], d.get("thermal_force_lower_N", 0.0))
+        return cls(r, RunStats(**d["stats"]), d["n_nodes"], d["n_elements"], from_cache=True,
+                   ccx_version=d.get("ccx_version", "unknown"))
 
 
 def solve_case(params: SpringParams, theta_degC: float, workdir: Path, *, paddles: int = 1,
@@ -96,8 +99,40 @@ def solve_case(params: SpringParams, theta_degC: float, workdir: Path, *, paddle
     stats = run_ccx(deck, Path(workdir), threads=params.solver.threads,
                     theta_degC=theta_degC, on_line=on_line)
     result = parse_case(Path(workdir) / "case.dat", theta_degC, assembly.paddles)
+    check_heating(result, params)
     n_nodes = assembly.mesh.n_nodes
-    return CaseOutcome(result, stats, n_nodes, assembly.mesh.n_elements)
+    return CaseOutcome(result, stats, n_nodes, assembly.mesh.n_elements, ccx_version=ccx_version())
+
+
+#: heating alone may load a plate by at most this fraction of the kiss force (contact noise)
+HEATING_FORCE_FRACTION = 0.1
+
+
+def check_heating(result: CaseResult, params: SpringParams) -> None:
+    """Refuse a case in which heating alone pressed the paddle on a plate (a spurious force).
+
+    The plates are held during heating, so any force on them then is an
+    artefact: the carrier clearance is below the paddle's growth towards the
+    carrier (or within the contact law's reach of it).
+
+    Raises
+    ------
+    ResultError
+        Naming the force, the clearance and the least clearance to try.
+    """
+    from ..errors import ResultError
+    limit = HEATING_FORCE_FRACTION * params.sweep.kiss_force_N
+    worst = max(abs(result.thermal_force_N), abs(result.thermal_force_lower_N))
+    if worst > limit:
+        g = params.geometry
+        raise ResultError(
+            f"theta = {result.theta_degC:g} degC: heating alone pressed the paddle on "
+            f"{'the carrier' if abs(result.thermal_force_lower_N) >= abs(result.thermal_force_N) else 'a plate'} "
+            f"with {worst:.3g} N (limit {limit:.3g} N, {HEATING_FORCE_FRACTION:.0%} of the kiss force): "
+            f"geometry.carrier_clearance_m = {g.carrier_clearance_m:g} m is below the paddle's growth towards "
+            f"the carrier (the sheet alone: {params.min_carrier_clearance_m():.3g} m at "
+            f"{max(params.sweep.temperatures_degC):g} degC) plus the contact law's reach; use at least "
+            f"{max(1e-5, 2 * params.min_carrier_clearance_m()):.3g} m")
 
 
 def case_key(params: SpringParams, theta_degC: float, paddles: int, ccx: str) -> str:
@@ -115,12 +150,6 @@ def case_key(params: SpringParams, theta_degC: float, paddles: int, ccx: str) ->
     return hashlib.sha256(blob.encode()).hexdigest()[:16]
 
 
-def _dask_solve(params: SpringParams, theta: float, paddles: int) -> dict:
-    """Run on a Dask worker: solve in a private temporary folder, return JSON data."""
-    with tempfile.TemporaryDirectory(prefix="cushion_ccx_") as tmp:
-        return solve_case(params, theta, Path(tmp), paddles=paddles).to_json()
-
-
 def run_sweep(params: SpringParams, *, cache_dir: Path = DEFAULT_CACHE, jobs: int | None = None,
               scheduler: str | object | None = None, paddles: int = 1,
               progress: Progress | None = None) -> dict[float, CaseOutcome]:
@@ -129,17 +158,30 @@ def run_sweep(params: SpringParams, *, cache_dir: Path = DEFAULT_CACHE, jobs: in
     Parameters
     ----------
     jobs : int, optional
-        Parallel ccx jobs on this machine (default: number of cores).
+        Parallel ccx jobs on this machine (default: number of cores). With
+        fewer cases than jobs, each ccx gets the idle cores as threads.
     scheduler : str or distributed.Client, optional
         A Dask scheduler address (``tcp://host:8786``) or client; cases then
-        run on its workers.
+        run on its workers, which are checked first (:mod:`.cluster`); the
+        client needs no ccx.
 
     Raises
     ------
     SweepError
         If any case failed; the finished ones stay in the cache.
+    ClusterError
+        If the cluster cannot run the cases (named workers) or lost all its workers.
     """
-    ccx = ccx_version()
+    if scheduler is not None:
+        from .cluster import open_cluster
+        with open_cluster(scheduler) as (client, info):
+            return _run_sweep(params, cache_dir, jobs, (client, info), paddles, progress)
+    return _run_sweep(params, cache_dir, jobs, None, paddles, progress)
+
+
+def _run_sweep(params: SpringParams, cache_dir: Path, jobs: int | None, cluster, paddles: int,
+               progress: Progress | None) -> dict[float, CaseOutcome]:
+    ccx = cluster[1].ccx_version if cluster else ccx_version()
     cache_dir = Path(cache_dir) / params.name
     todo: list[tuple[float, Path]] = []
     done: dict[float, CaseOutcome] = {}
@@ -164,21 +206,24 @@ def run_sweep(params: SpringParams, *, cache_dir: Path = DEFAULT_CACHE, jobs: in
         if progress:
             progress(theta, "done", 1.0)
 
-    if scheduler is not None and todo:
-        client = _dask_client(scheduler)
-        futures = {client.submit(_dask_solve, params, t, paddles, pure=False): (t, f) for t, f in todo}
-        from distributed import as_completed as dask_completed
-        for fut in dask_completed(futures):
-            theta, folder = futures[fut]
-            try:
-                outcome = CaseOutcome.from_json(fut.result())
-                finish(theta, folder, dataclasses.replace(outcome, from_cache=False))
-            except Exception as exc:  # noqa: BLE001 - collected and re-raised as SweepError
+    if cluster is not None and todo:
+        from .cluster import run_cases
+        folders = dict(todo)
+
+        def on_done(theta: float, data: dict | None, exc: BaseException | None) -> None:
+            if exc is None:
+                finish(theta, folders[theta], dataclasses.replace(CaseOutcome.from_json(data), from_cache=False))
+            else:
                 failures[theta] = exc
                 if progress:
                     progress(theta, "failed", 0.0)
+        run_cases(cluster[0], cluster[1], [(t, params, t, paddles) for t, _ in todo], on_done)
     elif todo:
         lock = threading.Lock()
+        slots = jobs or os.cpu_count() or 1
+        # fewer cases than cores: the idle cores become ccx threads (cache keys ignore solver.threads)
+        threads = max(params.solver.threads, min(os.cpu_count() or 1, slots // len(todo)))
+        solve_params = params.replace(solver={"threads": threads}) if threads != params.solver.threads else params
 
         def work(theta: float, folder: Path) -> CaseOutcome:
             if progress:
@@ -189,7 +234,7 @@ def run_sweep(params: SpringParams, *, cache_dir: Path = DEFAULT_CACHE, jobs: in
                     with lock:
                         progress(theta, "increment", n)
             interrupt.check()                       # cancelled while queued: do not start
-            outcome = solve_case(params, theta, folder, paddles=paddles, on_increment=inc)
+            outcome = solve_case(solve_params, theta, folder, paddles=paddles, on_increment=inc)
             with lock:                              # cached at once, so an interrupt keeps it
                 finish(theta, folder, outcome)
             return outcome
@@ -217,13 +262,6 @@ def run_sweep(params: SpringParams, *, cache_dir: Path = DEFAULT_CACHE, jobs: in
     return {t: done[t] for t in sorted(done)}
 
 
-def _dask_client(scheduler):
-    if isinstance(scheduler, str):
-        from distributed import Client
-        return Client(scheduler)
-    return scheduler
-
-
 def build_tables(params: SpringParams, outcomes: dict[float, CaseOutcome], out_dir: Path,
                  *, wall_time_s: float | None = None) -> tuple[list[Curve], dict[float, float]]:
     """Turn solved cases into a table set in ``out_dir`` (atomic), with metadata."""
@@ -235,7 +273,8 @@ def build_tables(params: SpringParams, outcomes: dict[float, CaseOutcome], out_d
     any_case = next(iter(outcomes.values()))
     metadata = {
         "generator": f"cushion_clutch {__version__} (cushion-clutch sweep)",
-        "solver": {"name": "CalculiX ccx", "version": ccx_version()},
+        "solver": {"name": "CalculiX ccx",
+                   "version": ", ".join(sorted({o.ccx_version for o in outcomes.values()}))},
         "date": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
         "host": platform.node(),
         "spring": params.to_dict(),

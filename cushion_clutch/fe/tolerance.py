@@ -16,7 +16,6 @@ import dataclasses
 import json
 import logging
 import os
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
@@ -25,9 +24,8 @@ import numpy as np
 from scipy.stats import norm, qmc
 
 from ..errors import ParameterError, StudyError
-from .ccx import ccx_version
 from .params import TOLERANCE_KEYS, SpringParams, Tolerances
-from .sweep import DEFAULT_CACHE, CaseOutcome, case_key, solve_case
+from .sweep import DEFAULT_CACHE, CaseOutcome, case_key
 
 log = logging.getLogger(__name__)
 
@@ -111,37 +109,6 @@ def case_folder(cache_dir: Path, params: SpringParams, theta: float, ccx: str, p
     return Path(cache_dir) / params.name / f"theta_{theta:g}_{case_key(params, theta, paddles, ccx)}"
 
 
-def _solve_remote(params: SpringParams, theta: float, surface: bytes | None) -> dict:
-    """On a worker: solve one case in a private folder, return the JSON data.
-
-    The fitted surface travels with the task, so workers need no shared disk.
-    """
-    with tempfile.TemporaryDirectory(prefix="cushion_tol_") as tmp:
-        if surface is not None:
-            path = Path(tmp) / "surface.npz"
-            path.write_bytes(surface)
-            params = params.replace(geometry={"surface_file": str(path)})
-        work = Path(tmp) / "ccx"
-        work.mkdir()
-        return solve_case(params, theta, work).to_json()
-
-
-def connect(scheduler: str | object | None = None, workers: int | None = None):
-    """A Dask client and the LocalCluster it owns (None for an external scheduler).
-
-    ``scheduler``: an address, a ``distributed.Client``, or None for a
-    LocalCluster of ``workers`` single-threaded processes (default: cores).
-    """
-    from distributed import Client, LocalCluster
-    if scheduler is None:
-        cluster = LocalCluster(n_workers=workers or os.cpu_count() or 1, threads_per_worker=1,
-                               processes=True, dashboard_address=None)
-        return Client(cluster), cluster
-    if isinstance(scheduler, str):
-        return Client(scheduler), None
-    return scheduler, None
-
-
 def run_study(samples: list[Sample], temperatures_degC: tuple[float, ...], *, cache_dir: Path = DEFAULT_CACHE,
               scheduler: str | object | None = None, workers: int | None = None,
               progress: StudyProgress | None = None) -> list[dict[float, CaseOutcome]]:
@@ -157,7 +124,15 @@ def run_study(samples: list[Sample], temperatures_degC: tuple[float, ...], *, ca
     StudyError
         If cases failed; the finished ones stay cached and a rerun resumes.
     """
-    ccx = ccx_version()
+    from .cluster import open_cluster
+    with open_cluster(scheduler, workers) as (client, info):
+        return _run_study(samples, temperatures_degC, cache_dir, client, info, progress)
+
+
+def _run_study(samples, temperatures_degC, cache_dir, client, info, progress):
+    """:func:`run_study` on a checked cluster (``info``: :class:`.cluster.ClusterInfo`)."""
+    from .cluster import run_cases
+    ccx = info.ccx_version                   # the workers' CalculiX, not the client's
     results: list[dict[float, CaseOutcome]] = [{} for _ in samples]
     todo = []
     for i, s in enumerate(samples):
@@ -169,43 +144,29 @@ def run_study(samples: list[Sample], temperatures_degC: tuple[float, ...], *, ca
                 todo.append((i, theta, folder))
     total = len(samples) * len(temperatures_degC)
     cached = total - len(todo)
-    done = cached
+    done = [cached]
     if progress:
-        progress(done, total, cached)
+        progress(cached, total, cached)
     failures = {}
+
+    def on_done(key, data, exc) -> None:
+        i, theta, folder = key
+        if exc is not None:
+            log.error("sample %d, theta = %g degC failed: %s", samples[i].index, theta, exc)
+            failures[(samples[i].index, theta)] = exc
+        else:
+            folder.mkdir(parents=True, exist_ok=True)
+            tmp = folder / "result.json.tmp"
+            tmp.write_text(json.dumps(data))
+            os.replace(tmp, folder / "result.json")
+            results[i][theta] = dataclasses.replace(CaseOutcome.from_json(data), from_cache=False)
+        done[0] += 1
+        if progress:
+            progress(done[0], total, cached)
+
     if todo:
-        client, cluster = connect(scheduler, workers)
-        try:
-            from distributed import as_completed
-            blobs = {}
-            futures = {}
-            for i, theta, folder in todo:
-                sf = samples[i].params.geometry.surface_file
-                if sf and sf not in blobs:
-                    blobs[sf] = client.scatter(Path(sf).read_bytes(), broadcast=True)
-                fut = client.submit(_solve_remote, samples[i].params, theta, blobs.get(sf) if sf else None,
-                                    pure=False)
-                futures[fut] = (i, theta, folder)
-            for fut in as_completed(futures):
-                i, theta, folder = futures[fut]
-                try:
-                    data = fut.result()
-                except Exception as exc:  # noqa: BLE001 - collected and raised as StudyError
-                    log.error("sample %d, theta = %g degC failed: %s", samples[i].index, theta, exc)
-                    failures[(samples[i].index, theta)] = exc
-                else:
-                    folder.mkdir(parents=True, exist_ok=True)
-                    tmp = folder / "result.json.tmp"
-                    tmp.write_text(json.dumps(data))
-                    os.replace(tmp, folder / "result.json")
-                    results[i][theta] = dataclasses.replace(CaseOutcome.from_json(data), from_cache=False)
-                done += 1
-                if progress:
-                    progress(done, total, cached)
-        finally:
-            client.close()
-            if cluster is not None:
-                cluster.close()
+        run_cases(client, info, [((i, theta, folder), samples[i].params, theta, 1) for i, theta, folder in todo],
+                  on_done)
     if failures:
         raise StudyError(failures)
     return [{t: r[t] for t in sorted(r)} for r in results]

@@ -119,7 +119,7 @@ def _simulate(args: argparse.Namespace) -> int:
 
     from .fmu.engagements import (EngagementCycle, plot_engagements, plot_thermal_step,
                               plot_torque_characteristic, simulate)
-    from .fmu.model import load_table
+    from .model import load_table
     from .outputs import OutputSet
 
     out = _guard_out(Path(args.out), args.force)
@@ -158,7 +158,7 @@ def _launch(args: argparse.Namespace) -> int:
     from rich.progress import Progress
 
     from .fmu.check import check_fmu
-    from .fmu.model import load_table
+    from .model import load_table
     from .launch.plant import build_plant_fmu
     from .launch.report import metrics_table, run_all, summary_table, write_outputs
     from .launch.scenario import load_scenario, scenario_path

@@ -2,8 +2,8 @@
 
 The wheel carries the shipped table sets (``cushion_clutch.lookup_tables``,
 the repository's ``lookup_tables/``), the spring and scenario files, and the
-FMU sources (``cushion_clutch.fmu_src``, the repository's ``fmu_src/``: the C
-model, the pythonfmu slave, the shared Python model and the test hosts).
+FMU sources (``cushion_clutch.fmu_src``, the repository's ``fmu_src/``, a data
+folder that nothing imports: the C model, the pythonfmu slave and the test hosts).
 """
 from __future__ import annotations
 
@@ -27,7 +27,7 @@ def shipped_tables(name: str = "default") -> Path:
 
 
 def fmu_sources() -> Path:
-    """Folder of the FMU sources: ``CushionClutch.c``, ``CushionClutch.py``, ``clutch_model.py``."""
+    """Folder of the FMU sources: the C model (``clutch_core.c``, ...), ``CushionClutch.py``, ``cushion_slave.py``."""
     return _folder("cushion_clutch.fmu_src")
 
 

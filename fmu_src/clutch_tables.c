@@ -1,6 +1,6 @@
 /*
  * CushionClutch model core, part 1: the table set (force_deflection.csv, kiss_point.csv, optional
- * friction.csv) read from the FMU's resources, its interpolation (as fmu_src/spring_table.py and
+ * friction.csv) read from the FMU's resources, its interpolation (as cushion_clutch/model/spring_table.py and
  * friction.py, operation for operation). The resource URI -> path conversion is in resource_uri.c.
  */
 #include "clutch_core.h"

@@ -36,7 +36,7 @@ from pythonfmu.enums import Fmi2Status
 
 from clutch_model import (OMEGA_SLIP_LIMIT, OMEGA_SLIP_START, THETA_CM_LIMIT, VARIABLES, X_TO_LIMIT,
                           ClutchParameters, SpringTable, outputs, thermal_step)
-from spring_table import table_set_x_kiss_ref
+from table_format import table_set_x_kiss_ref
 
 CAUSALITY = {"input": (Fmi2Causality.input, Fmi2Variability.continuous),
              "output": (Fmi2Causality.output, Fmi2Variability.continuous),

@@ -8,7 +8,8 @@ import tempfile
 from pathlib import Path
 
 from cushion_clutch.fmu.build import build_fmu
-from cushion_clutch.fmu.model import DEFAULT_TABLES, ClutchParameters, load_table, outputs, thermal_step
+from cushion_clutch.data import DEFAULT_TABLES
+from cushion_clutch.model import ClutchParameters, load_table, outputs, thermal_step
 
 
 @functools.cache

@@ -152,3 +152,22 @@ def test_parameter_recovery_from_noisy_fe_measurement(tmp_path):
     assert "runs test" in report_text(cal) and "1-sigma %" in report_text(cal)
     start_err = np.max(np.abs(cal.fe_start_N[0] - f)) / f.max()
     assert start_err > 0.05          # the start was really off
+
+
+@pytest.mark.ccx
+def test_a_hot_curve_is_read_from_the_reference_kiss_point(coarse, case_cache):
+    """u of a hot curve counts from the 20 degC kiss point: the hot spring, grown by delta_kiss,
+    carries the kiss force delta_kiss before it (same cases as tests/test_sweep.py's two_temps)."""
+    from cushion_clutch.fe.calibrate import _Model
+    from cushion_clutch.fe.tables import kiss_shift
+    p = coarse.replace(sweep={"temperatures_degC": (20.0, 195.0)})
+    outcomes = run_sweep(p, cache_dir=case_cache)
+    shift = kiss_shift([curve_from_case(o.result, 1, p.sweep.kiss_force_N) for o in outcomes.values()], 20.0)[195.0]
+    assert shift > 20e-6
+    u = np.array([-shift, 0.0, 0.3e-3])
+    measured = [Measured(u, np.zeros(3), "pair", 20.0), Measured(u, np.zeros(3), "pair", 195.0)]
+    cold, hot = _Model(p, fit_keys(p, ["thickness_m"]), measured, case_cache, 1, None, None).forces(
+        [p.geometry.thickness_m])
+    kiss = p.sweep.kiss_force_N
+    assert hot[0] == pytest.approx(kiss, rel=1e-6) and cold[1] == pytest.approx(kiss, rel=1e-6)
+    assert cold[0] < kiss < hot[1]

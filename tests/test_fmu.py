@@ -14,7 +14,7 @@ from scipy.io import loadmat
 
 from cushion_clutch.fmu.exports import export_mat, export_modelica, read_modelica
 from cushion_clutch.fmu.build import build_fmu
-from cushion_clutch.fmu.model import DEFAULT_TABLES
+from cushion_clutch.data import DEFAULT_TABLES
 from cushion_clutch.fe.tables import read_tables
 
 pytestmark = pytest.mark.fmu

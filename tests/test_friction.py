@@ -8,8 +8,8 @@ from fmpy.fmi2 import FMU2Slave
 
 from cushion_clutch.data import DEFAULT_TABLES
 from cushion_clutch.fmu.build import build_fmu
-from cushion_clutch.fmu.model import ClutchParameters, load_table, outputs, thermal_step
-from cushion_clutch.fmu_src.friction import FrictionTable
+from cushion_clutch.model import ClutchParameters, load_table, outputs, thermal_step
+from cushion_clutch.model.friction import FrictionTable
 
 FADE = """theta_degC,omega_slip_rad_s,mu
 300,0,0.20

@@ -6,7 +6,8 @@ import pytest
 
 from cushion_clutch.errors import ParameterError
 from cushion_clutch.fmu.build import build_fmu
-from cushion_clutch.fmu.model import DEFAULT_TABLES, load_table
+from cushion_clutch.data import DEFAULT_TABLES
+from cushion_clutch.model import load_table
 from cushion_clutch.launch.scenario import DEFAULT_SCENARIO, load_scenario
 from cushion_clutch.launch.simulate import simulate_launches
 

@@ -5,9 +5,9 @@ import numpy as np
 import pytest
 
 from cushion_clutch.fmu.build import build_fmu
-from cushion_clutch.fmu.model import DEFAULT_TABLES, load_table
-from cushion_clutch.fmu_src.clutch_model import KELVIN
-from cushion_clutch.fmu_src.friction import FrictionTable
+from cushion_clutch.data import DEFAULT_TABLES
+from cushion_clutch.model import KELVIN, load_table
+from cushion_clutch.model.friction import FrictionTable
 from cushion_clutch.launch.fmu_client import ClutchFmu
 from cushion_clutch.launch.plant import build_plant_fmu
 from cushion_clutch.launch.scenario import load_scenario, scenario_path

@@ -5,7 +5,8 @@ import pytest
 
 from cushion_clutch.cli import main
 from cushion_clutch.fmu.build import build_fmu
-from cushion_clutch.fmu.model import DEFAULT_TABLES, load_table
+from cushion_clutch.data import DEFAULT_TABLES
+from cushion_clutch.model import load_table
 from cushion_clutch.launch.metrics import METRIC_COLUMNS
 from cushion_clutch.launch.report import run_all, summary_rows, summary_table, write_outputs
 from cushion_clutch.launch.scenario import load_scenario

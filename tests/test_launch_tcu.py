@@ -7,7 +7,8 @@ import pytest
 
 from cushion_clutch.errors import FmuCallError
 from cushion_clutch.fmu.build import build_fmu
-from cushion_clutch.fmu.model import DEFAULT_TABLES, load_table
+from cushion_clutch.data import DEFAULT_TABLES
+from cushion_clutch.model import load_table
 from cushion_clutch.launch.fmu_client import ClutchFmu
 from cushion_clutch.launch.scenario import load_scenario
 from cushion_clutch.launch.tcu_params import Observer

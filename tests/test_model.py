@@ -1,4 +1,4 @@
-"""The shared pure model (fmu_src/clutch_model.py) through the Python API."""
+"""The shared pure model (cushion_clutch/model/clutch_model.py) through the Python API."""
 import math
 
 import control
@@ -6,8 +6,9 @@ import numpy as np
 import pytest
 from scipy.interpolate import PchipInterpolator
 
-from cushion_clutch.fmu.model import (KELVIN, ClutchParameters, load_table, outputs, thermal_step,
-                                  thermal_system, x_to_for_torque)
+from cushion_clutch.data import DEFAULT_TABLES
+from cushion_clutch.model import (KELVIN, ClutchParameters, load_table, outputs, thermal_step, thermal_system,
+                                  x_to_for_torque)
 from cushion_clutch.fe.tables import read_tables
 
 P = ClutchParameters()
@@ -20,7 +21,7 @@ def table():
 
 @pytest.fixture(scope="module")
 def raw():
-    return read_tables(load_table.__defaults__[0])
+    return read_tables(DEFAULT_TABLES)
 
 
 def test_interpolation_is_scipy_pchip(table, raw):

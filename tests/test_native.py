@@ -11,12 +11,11 @@ from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import FMU2Slave
 from fmpy.validation import validate_fmu
 
-from cushion_clutch.data import fmu_sources
+from cushion_clutch.data import DEFAULT_TABLES, fmu_sources
 from cushion_clutch.fmu.build import build_fmu
 from cushion_clutch.fmu.descriptions import sources
 from cushion_clutch.fmu.native import fmi2_header_dir
-from cushion_clutch.fmu_src.clutch_model import VARIABLES
-from cushion_clutch.fmu.model import DEFAULT_TABLES, ClutchParameters, load_table, outputs, thermal_step
+from cushion_clutch.model import VARIABLES, ClutchParameters, load_table, outputs, thermal_step
 from native_builds import model_final
 
 pytestmark = pytest.mark.fmu

@@ -15,7 +15,7 @@ from fmpy.fmi2 import FMU2Slave, fmi2LastSuccessfulTime, fmi2Terminated
 from fmpy.fmi3 import FMU3Slave
 
 from cushion_clutch.data import fmu_sources
-from cushion_clutch.fmu.model import ClutchParameters, load_table, outputs, thermal_step
+from cushion_clutch.model import ClutchParameters, load_table, outputs, thermal_step
 from native_builds import native_fmus
 
 pytestmark = pytest.mark.fmu

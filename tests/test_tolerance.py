@@ -130,7 +130,7 @@ def _shifted_tables(tmp_path, x_kiss_ref_m):
     """The default tables as a tolerance P5 set whose own kiss point sits at ``x_kiss_ref_m``."""
     import shutil
 
-    from cushion_clutch.fmu.model import DEFAULT_TABLES
+    from cushion_clutch.data import DEFAULT_TABLES
     tables = tmp_path / "default_p05"
     shutil.copytree(DEFAULT_TABLES, tables)
     meta = json.loads((tables / "metadata.json").read_text())

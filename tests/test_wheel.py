@@ -62,7 +62,7 @@ def test_commands_work_from_an_empty_folder(installed, tmp_path):
     assert (work / "X.fmu").stat().st_size > 0
     _run([cli, "export", "--out", "exports"], work, env)
     assert (work / "exports" / "cushion_spring_tables.mat").exists()
-    out = _run([py, "-c", "from cushion_clutch.fmu.model import load_table; print(load_table().theta_degC)"],
+    out = _run([py, "-c", "from cushion_clutch.model import load_table; print(load_table().theta_degC)"],
                work, env)
     assert "20.0" in out
     _run([cli, "launch", "--out", "out"], work, env, timeout=900)

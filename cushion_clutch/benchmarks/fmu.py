@@ -85,7 +85,7 @@ def time_c_host(host: Path, fmu: Path, n: int, python: bool, workdir: Path) -> t
 def time_builds(tmp: Path, cold: bool) -> None:
     """Print the time to build the native FMU for all platforms, per FMI version (warm, optionally cold)."""
     from cushion_clutch.fmu.build import build_fmu
-    from cushion_clutch.fmu.model import DEFAULT_TABLES
+    from cushion_clutch.data import DEFAULT_TABLES
 
     caches = [("warm zig cache", None)]
     if cold:
@@ -113,7 +113,8 @@ def time_builds(tmp: Path, cold: bool) -> None:
 
 def main(argv=None) -> None:
     from cushion_clutch.fmu.build import build_fmu
-    from cushion_clutch.fmu.model import DEFAULT_TABLES, ClutchParameters, load_table, outputs, thermal_step
+    from cushion_clutch.data import DEFAULT_TABLES
+    from cushion_clutch.model import ClutchParameters, load_table, outputs, thermal_step
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--steps", type=int, default=200_000)

@@ -49,7 +49,8 @@ def _fmu_call_us(fmu: Path, n: int = 50000) -> tuple[float, float]:
 
 
 def main(argv=None) -> None:
-    from cushion_clutch.fmu.model import DEFAULT_TABLES, load_table
+    from cushion_clutch.data import DEFAULT_TABLES
+    from cushion_clutch.model import load_table
     from cushion_clutch.launch.plant import build_plant_fmu
     from cushion_clutch.launch.scenario import DEFAULT_SCENARIO, load_scenario, scenario_path
     from cushion_clutch.launch.simulate import simulate_launches

@@ -1,24 +1,7 @@
 """From FE case results to lookup tables, written atomically.
 
-Table files (all SI):
-
-``force_deflection.csv``
-    ``theta_degC,u_m,force_N``: cushion-spring temperature (degC), compression
-    of one paddle pair measured from that temperature's own kiss point (m;
-    negative in the toe before the kiss point), axial force of the whole
-    spring (all pairs, N). Non-decreasing in u for every temperature.
-``kiss_point.csv``
-    ``theta_degC,delta_kiss_m``: growth of the spring's free height relative
-    to the reference temperature, i.e. how far the kiss point moves towards
-    the open side (m).
-``crest_growth.csv``
-    ``theta_degC,crest_growth_m``: growth of the pair's free height at the
-    wave crest (mean radius) from heating alone, relative to the reference
-    temperature (m). Unlike ``delta_kiss_m`` (where the 10 N point moves) it
-    holds no stiffness change; the two differ by how much softer the hot
-    spring is at first touch.
-``metadata.json``
-    Parameters, mesh, solver, statistics, progressivity, date and code version.
+The table-set format (file names, columns, units) is
+:mod:`cushion_clutch.model.table_format`'s; this module writes and checks sets.
 """
 from __future__ import annotations
 
@@ -33,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ResultError, TableError
-from ..fmu_src.clutch_model import load_csv
+from ..model.table_format import COLUMNS, CREST_GROWTH, FORCE_DEFLECTION, KISS_POINT, METADATA, load_csv
 from .results import CaseResult
 
 #: relative force decrease (of the case's largest force) treated as solver noise
@@ -130,24 +113,24 @@ def write_tables(out_dir: Path, curves: list[Curve], reference_degC: float,
     shifts = kiss_shift(curves, reference_degC)
     tmp = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", dir=out_dir.parent))
     try:
-        with open(tmp / "force_deflection.csv", "w", newline="") as fh:
+        with open(tmp / FORCE_DEFLECTION, "w", newline="") as fh:
             w = csv.writer(fh)
-            w.writerow(["theta_degC", "u_m", "force_N"])
+            w.writerow(COLUMNS[FORCE_DEFLECTION])
             for c in sorted(curves, key=lambda c: c.theta_degC):
                 for u, f in zip(c.u_m, c.force_N):
                     w.writerow([f"{c.theta_degC:g}", f"{u:.9e}", f"{f:.6f}"])
-        with open(tmp / "kiss_point.csv", "w", newline="") as fh:
+        with open(tmp / KISS_POINT, "w", newline="") as fh:
             w = csv.writer(fh)
-            w.writerow(["theta_degC", "delta_kiss_m"])
+            w.writerow(COLUMNS[KISS_POINT])
             for t in sorted(shifts):
                 w.writerow([f"{t:g}", f"{shifts[t]:.9e}"])
         if crest_growth_m is not None:
-            with open(tmp / "crest_growth.csv", "w", newline="") as fh:
+            with open(tmp / CREST_GROWTH, "w", newline="") as fh:
                 w = csv.writer(fh)
-                w.writerow(["theta_degC", "crest_growth_m"])
+                w.writerow(COLUMNS[CREST_GROWTH])
                 for t in sorted(crest_growth_m):
                     w.writerow([f"{t:g}", f"{crest_growth_m[t]:.9e}"])
-        (tmp / "metadata.json").write_text(json.dumps(metadata, indent=2, default=_jsonable) + "\n")
+        (tmp / METADATA).write_text(json.dumps(metadata, indent=2, default=_jsonable) + "\n")
         backup = None
         if out_dir.exists():
             backup = out_dir.with_name(f".{out_dir.name}.old")
@@ -196,9 +179,9 @@ def read_tables(table_dir: Path) -> TableSet:
     if not table_dir.is_dir():
         raise TableError(f"{table_dir}: table folder does not exist (it must hold force_deflection.csv "
                          "and kiss_point.csv)")
-    fd = _read_csv(table_dir / "force_deflection.csv", ["theta_degC", "u_m", "force_N"])
-    kp = _read_csv(table_dir / "kiss_point.csv", ["theta_degC", "delta_kiss_m"])
-    meta_path = table_dir / "metadata.json"
+    fd = _read_csv(table_dir / FORCE_DEFLECTION)
+    kp = _read_csv(table_dir / KISS_POINT)
+    meta_path = table_dir / METADATA
     try:
         metadata = json.loads(meta_path.read_text(encoding="utf-8")) if meta_path.exists() else {}
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
@@ -221,10 +204,10 @@ def read_tables(table_dir: Path) -> TableSet:
     return TableSet(thetas, tuple(us), tuple(fs), kp[order, 1], metadata)
 
 
-def _read_csv(path: Path, columns: list[str]) -> np.ndarray:
+def _read_csv(path: Path) -> np.ndarray:
     """The model's own table reader (the one the FMU uses), errors as TableError."""
     try:
-        return load_csv(path, tuple(columns))
+        return load_csv(path, COLUMNS[path.name])
     except ValueError as exc:
         raise TableError(str(exc)) from exc
 

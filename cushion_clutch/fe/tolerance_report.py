@@ -3,7 +3,7 @@
 Every sample's table set is written with the sweep's own table writer
 (``<study>/samples/s###``); the torque characteristic T(x_to, theta) of a
 sample comes from the clutch model the FMU runs
-(:func:`cushion_clutch.fmu_src.clutch_model.outputs`), with the model's
+(:func:`cushion_clutch.model.clutch_model.outputs`), with the model's
 default clutch parameters and the kiss point at the bearing moved by the
 sample's free-height deviation: ``x_kiss_ref = x_kiss_ref_nominal -
 lever_ratio * (H_sample - H_nominal)``, H the pair's free height at the
@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..fmu_src.clutch_model import KELVIN, ClutchParameters, SpringTable, outputs
+from ..model import KELVIN, ClutchParameters, SpringTable, outputs
 from .geometry import half_pair_assembly
 from .sweep import CaseOutcome, build_tables
 from .tables import curve_from_case

@@ -17,16 +17,20 @@ from xml.etree import ElementTree as ET
 
 from ..data import fmu_sources
 from ..errors import ParameterError, TableError
-from ..fmu_src.clutch_model import VARIABLES, ClutchParameters
 from ..fe.tables import read_tables
+from ..model import VARIABLES, clutch_model
+from ..model.table_format import FMU_FILES, REQUIRED_FILES
 
 log = logging.getLogger(__name__)
 
 FMU_SRC = fmu_sources()
 SLAVE = "CushionClutch"
-#: the modules the pythonfmu slave imports (siblings inside the FMU): the slave class and the numpy-only model
-MODEL_MODULES = ("cushion_slave.py", "clutch_model.py", "spring_table.py", "friction.py")
-TABLE_FILES = ("force_deflection.csv", "kiss_point.csv", "metadata.json", "friction.csv")
+#: folder of the numpy-only model modules (:mod:`cushion_clutch.model`)
+MODEL_SRC = Path(clutch_model.__file__).parent
+#: the modules the pythonfmu slave imports (siblings inside the FMU): the slave class (from ``FMU_SRC``)
+#: and the numpy-only model (from ``MODEL_SRC``)
+SLAVE_MODULES = {"cushion_slave.py": FMU_SRC, "clutch_model.py": MODEL_SRC, "spring_table.py": MODEL_SRC,
+                 "friction.py": MODEL_SRC, "table_format.py": MODEL_SRC}
 
 #: unit of each variable (from the shared model module); temperatures get degC as display unit
 UNITS = {name: unit for name, _, unit, _ in VARIABLES}
@@ -90,7 +94,7 @@ def build_fmu(tables: Path, output: Path, backend: str = "native", fmi_version: 
     """
     tables, output = Path(tables), Path(output)
     read_tables(tables)                                 # fail early, with the file's name
-    for name in TABLE_FILES[:2]:
+    for name in REQUIRED_FILES:
         if not (tables / name).exists():
             raise TableError(f"{tables / name} is missing")
     if fmi_version not in (2, 3):
@@ -107,14 +111,14 @@ def build_fmu(tables: Path, output: Path, backend: str = "native", fmi_version: 
     with tempfile.TemporaryDirectory(prefix="cushion_fmu_") as tmp:
         stage = Path(tmp)
         shutil.copy(FMU_SRC / f"{SLAVE}.py", stage / f"{SLAVE}.py")
-        for module in MODEL_MODULES:
-            shutil.copy(FMU_SRC / module, stage / module)
+        for module, folder in SLAVE_MODULES.items():
+            shutil.copy(folder / module, stage / module)
         (stage / "tables").mkdir()
-        for name in TABLE_FILES:
+        for name in FMU_FILES:
             if (tables / name).exists():
                 shutil.copy(tables / name, stage / "tables" / name)
         built = FmuBuilder.build_FMU(stage / f"{SLAVE}.py", dest=stage / "out",
-                                     project_files=[*(stage / m for m in MODEL_MODULES), stage / "tables"],
+                                     project_files=[*(stage / m for m in SLAVE_MODULES), stage / "tables"],
                                      **FMU_OPTIONS)
         _rewrite_description(Path(built), output)
     log.info("built %s from tables %s", output, tables)
@@ -147,10 +151,10 @@ def add_build_arguments(parser) -> None:
 
 def build_from_args(args) -> str:
     """Build the FMU that parsed ``build-fmu`` options describe; return a one-line report."""
-    from ..fmu_src.spring_table import table_set_x_kiss_ref
+    from ..model.table_format import table_set_x_kiss_ref
     version = getattr(args, "fmi_version", 2)
     out = build_fmu(args.tables, args.output, backend=args.backend, fmi_version=version)
     own = table_set_x_kiss_ref(args.tables)
     kiss = (f"x_kiss_ref = {own * 1e3:.4f} mm (the table set's own kiss point, metadata.json tolerance_study)"
-            if own is not None else f"x_kiss_ref = {ClutchParameters().x_kiss_ref * 1e3:.4f} mm (default)")
+            if own is not None else f"x_kiss_ref = {clutch_model.ClutchParameters().x_kiss_ref * 1e3:.4f} mm (default)")
     return f"built {out} ({args.backend}, FMI {version}.0) from {args.tables}; {kiss}"

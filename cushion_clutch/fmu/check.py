@@ -11,7 +11,7 @@ from pathlib import Path
 from xml.etree import ElementTree as ET
 
 from ..errors import FmuError
-from ..fmu_src.clutch_model import VARIABLES
+from ..model import VARIABLES
 
 
 def check_fmu(path: str | Path) -> Path:
@@ -22,7 +22,7 @@ def check_fmu(path: str | Path) -> Path:
     FmuError
         Naming the file: missing, not a zip archive, no or malformed
         ``modelDescription.xml``, not FMI 2.0 co-simulation, or a variable of
-        :data:`~cushion_clutch.fmu_src.clutch_model.VARIABLES` missing or with
+        :data:`~cushion_clutch.model.clutch_model.VARIABLES` missing or with
         another causality.
     """
     path = Path(path)

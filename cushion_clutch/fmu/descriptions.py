@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from xml.etree import ElementTree as ET
 
-from ..fmu_src.clutch_model import OMEGA_SLIP_START, VARIABLES, ClutchParameters
+from ..model import OMEGA_SLIP_START, VARIABLES, ClutchParameters
 from .build import BASE_UNITS, SLAVE
 
 #: the model core (shared) and the front end of each FMI version, as shipped in sources/

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..fmu_src.clutch_model import KELVIN, ClutchParameters, SpringTable, outputs
+from ..model import KELVIN, ClutchParameters, SpringTable, outputs
 
 
 @dataclass(frozen=True)
@@ -144,7 +144,7 @@ def plot_thermal_step(path: Path, p: ClutchParameters = ClutchParameters()) -> P
 
     from ..plotting import finish_figure
 
-    from .model import thermal_system
+    from ..model import thermal_system
 
     sys = thermal_system(p)
     t = np.linspace(0.0, 6 * p.C / (p.U + p.H), 400)

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..fmu_src.clutch_model import SpringTable
+from ..model import SpringTable
 from ..fe.tables import read_tables
 
 UNITS_NOTE = "u_m [m] compression from the kiss point; theta_degC [degC]; force_N [N] whole spring; delta_kiss_m [m]"

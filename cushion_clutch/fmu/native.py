@@ -16,8 +16,8 @@ import uuid
 import zipfile
 from pathlib import Path
 
-from ..fmu_src.spring_table import table_set_x_kiss_ref
-from .build import FMU_SRC, TABLE_FILES
+from ..model.table_format import FMU_FILES, FRICTION, table_set_x_kiss_ref
+from .build import FMU_SRC
 from .crossbuild import build_binaries
 from .descriptions import (CORE_HEADERS, CORE_SOURCES, FRONT_ENDS, fmi2_description, fmi3_build_description,
                            fmi3_description, sources)
@@ -41,7 +41,7 @@ fmi2_header_dir = fmi_header_dir
 def model_guid(tables: Path, fmi_version: int) -> str:
     """GUID / instantiationToken: a hash of the tables, the C sources and the FMI version."""
     digest = hashlib.sha256(f"fmi{fmi_version}".encode())
-    for name in TABLE_FILES:
+    for name in FMU_FILES:
         if (tables / name).exists():
             digest.update(name.encode() + (tables / name).read_bytes())
     for name in (*CORE_HEADERS, *CORE_SOURCES, FRONT_ENDS[fmi_version]):
@@ -73,7 +73,7 @@ def build_native_fmu(tables: Path, output: Path, fmi_version: int = 2,
         raise ValueError(f"fmi_version = {fmi_version!r}: allowed 2 or 3")
     tables, output = Path(tables), Path(output)
     guid = model_guid(tables, fmi_version)
-    has_friction = (tables / "friction.csv").exists()
+    has_friction = (tables / FRICTION).exists()
     x_kiss_ref = table_set_x_kiss_ref(tables)
     with tempfile.TemporaryDirectory(prefix="cushion_native_") as tmp:
         src = Path(tmp) / "sources"
@@ -89,7 +89,7 @@ def build_native_fmu(tables: Path, output: Path, fmi_version: int = 2,
                 z.write(src / name, f"sources/{name}")
             if fmi_version == 3:
                 z.writestr("sources/buildDescription.xml", fmi3_build_description())
-            for name in TABLE_FILES:
+            for name in FMU_FILES:
                 if (tables / name).exists():
                     z.write(tables / name, f"resources/tables/{name}")
         tmp_out.replace(output)

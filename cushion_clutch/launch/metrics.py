@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 
-from ..fmu_src.clutch_model import KELVIN
+from ..model import KELVIN
 
 METRIC_COLUMNS = ("tcu", "launch", "theta_cs_start_degC", "torque_error_rms_Nm", "torque_error_max_Nm",
                   "kiss_point_error_mm", "engagement_time_s", "slip_energy_kJ", "peak_jerk_m_s3",

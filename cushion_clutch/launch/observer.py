@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import random
 
-from ..fmu_src.clutch_model import ClutchParameters, thermal_step
+from ..model import ClutchParameters, thermal_step
 from .tcu_params import Observer, Sensors
 from .thermal import FacingModel
 

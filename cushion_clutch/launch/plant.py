@@ -10,9 +10,10 @@ from __future__ import annotations
 import shutil
 from pathlib import Path
 
+from ..model.table_format import FORCE_DEFLECTION, FRICTION, KISS_POINT, METADATA
 from .scenario import Scenario
 
-SPRING_FILES = ("force_deflection.csv", "kiss_point.csv", "metadata.json")
+SPRING_FILES = (FORCE_DEFLECTION, KISS_POINT, METADATA)
 
 
 def plant_tables(tables: Path, sc: Scenario, work: Path) -> Path:
@@ -25,7 +26,7 @@ def plant_tables(tables: Path, sc: Scenario, work: Path) -> Path:
     for name in SPRING_FILES:
         if (Path(tables) / name).exists():
             shutil.copy(Path(tables) / name, stage / name)
-    shutil.copy(friction, stage / "friction.csv")
+    shutil.copy(friction, stage / FRICTION)
     return stage
 
 

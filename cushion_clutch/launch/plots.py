@@ -5,7 +5,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..fmu_src.clutch_model import KELVIN
+from ..model import KELVIN
 from .simulate import LaunchResult
 
 STYLE = {"naive": "-", "aware": "--", "aware_estimated": "-.", "adaptive": ":", "adaptive_aware_estimated": (0, (5, 1, 1, 1, 1, 1))}

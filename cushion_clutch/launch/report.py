@@ -6,7 +6,7 @@ import math
 from pathlib import Path
 from typing import Callable, Iterable
 
-from ..fmu_src.clutch_model import SpringTable
+from ..model import SpringTable
 from .metrics import METRIC_COLUMNS, SUMMARY, summarise
 from .scenario import Scenario
 from .simulate import COLUMNS, LaunchResult, simulate_launches

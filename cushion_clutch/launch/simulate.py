@@ -19,7 +19,7 @@ from typing import Callable
 
 import numpy as np
 
-from ..fmu_src.clutch_model import KELVIN, ClutchParameters, SpringTable
+from ..model import KELVIN, ClutchParameters, SpringTable
 from .driveline import Driveline, Energy
 from .engine import EngineGovernor
 from .fmu_client import ClutchFmu

@@ -27,7 +27,7 @@ from __future__ import annotations
 import copy
 from dataclasses import dataclass
 
-from ..fmu_src.clutch_model import KELVIN, ClutchParameters, SpringTable, outputs, thermal_step, x_to_for_torque
+from ..model import KELVIN, ClutchParameters, SpringTable, outputs, thermal_step, x_to_for_torque
 from .adaptation import KissLearner
 from .observer import FacingObserver
 from .scenario import Scenario

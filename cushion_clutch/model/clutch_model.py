@@ -23,10 +23,12 @@ from dataclasses import dataclass, fields
 
 try:                                    # inside the pythonfmu FMU the modules are siblings
     from .friction import FrictionTable
-    from .spring_table import KELVIN, Curve, SpringTable, load_csv, pchip_slopes
+    from .spring_table import KELVIN, Curve, SpringTable, pchip_slopes
+    from .table_format import load_csv
 except ImportError:
     from friction import FrictionTable
-    from spring_table import KELVIN, Curve, SpringTable, load_csv, pchip_slopes
+    from spring_table import KELVIN, Curve, SpringTable, pchip_slopes
+    from table_format import load_csv
 
 __all__ = ["KELVIN", "VARIABLES", "ClutchParameters", "Outputs", "SpringTable", "FrictionTable", "Curve",
            "load_csv", "pchip_slopes", "thermal_step", "friction_coefficient", "outputs", "x_to_for_torque",

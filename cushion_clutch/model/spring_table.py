@@ -14,6 +14,13 @@ from pathlib import Path
 
 import numpy as np
 
+try:                                    # inside the pythonfmu FMU the modules are siblings
+    from .friction import FrictionTable
+    from .table_format import COLUMNS, FORCE_DEFLECTION, FRICTION, KISS_POINT, load_csv
+except ImportError:
+    from friction import FrictionTable
+    from table_format import COLUMNS, FORCE_DEFLECTION, FRICTION, KISS_POINT, load_csv
+
 KELVIN = 273.15
 #: largest accepted table force, N (a clutch clamp load is kN; larger values are corrupt tables)
 FORCE_LIMIT_N = 1e9
@@ -127,23 +134,19 @@ class SpringTable:
             With the file name, if a file is malformed.
         """
         folder = Path(folder)
-        fd = load_csv(folder / "force_deflection.csv", ("theta_degC", "u_m", "force_N"))
-        kp = load_csv(folder / "kiss_point.csv", ("theta_degC", "delta_kiss_m"))
+        fd = load_csv(folder / FORCE_DEFLECTION, COLUMNS[FORCE_DEFLECTION])
+        kp = load_csv(folder / KISS_POINT, COLUMNS[KISS_POINT])
         thetas = np.unique(fd[:, 0])
         if not np.array_equal(np.sort(kp[:, 0]), thetas):
-            raise ValueError(f"{folder}: kiss_point.csv and force_deflection.csv temperatures differ")
+            raise ValueError(f"{folder}: {KISS_POINT} and {FORCE_DEFLECTION} temperatures differ")
         kp = kp[np.argsort(kp[:, 0])]
         try:
             table = cls(thetas, [fd[fd[:, 0] == t, 1] for t in thetas],
                         [fd[fd[:, 0] == t, 2] for t in thetas], kp[:, 1])
         except ValueError as exc:
-            raise ValueError(f"{folder / 'force_deflection.csv'}: {exc}") from exc
-        if (folder / "friction.csv").exists():
-            try:
-                from .friction import FrictionTable
-            except ImportError:
-                from friction import FrictionTable
-            table.friction = FrictionTable.from_csv(folder / "friction.csv")
+            raise ValueError(f"{folder / FORCE_DEFLECTION}: {exc}") from exc
+        if (folder / FRICTION).exists():
+            table.friction = FrictionTable.from_csv(folder / FRICTION)
         return table
 
     def _bracket(self, theta_degC: float) -> tuple[int, float]:
@@ -181,38 +184,3 @@ class SpringTable:
     def first_contact(self, theta_degC: float) -> float:
         """Compression below which F is its first (zero) value at this temperature, m (<= 0)."""
         return min(c.x_min for c in self._active(theta_degC))
-
-
-def load_csv(path: Path, columns: tuple[str, ...]) -> np.ndarray:
-    """Rows of a table CSV with exactly ``columns`` as header; ValueError names the file."""
-    try:
-        with open(path) as fh:
-            header = fh.readline().strip().split(",")
-            data = np.loadtxt(fh, delimiter=",", ndmin=2)
-    except (OSError, ValueError) as exc:
-        raise ValueError(f"{path}: {exc}") from exc
-    if tuple(h.strip() for h in header) != columns or data.shape[1] != len(columns):
-        raise ValueError(f"{path}: header must be {','.join(columns)}")
-    if not np.all(np.isfinite(data)):
-        raise ValueError(f"{path}: non-finite value")
-    return data
-
-
-def table_set_x_kiss_ref(folder: str | Path) -> float | None:
-    """The FMU parameter ``x_kiss_ref`` (m) a table set asks for, or None for the model default.
-
-    A tolerance study's P5/P95 set measures u from its own spring's kiss point;
-    ``metadata.json`` then holds ``tolerance_study.x_kiss_ref_m``, the bearing
-    position of that kiss point against the nominal spring's.
-    """
-    import json
-    path = Path(folder) / "metadata.json"
-    if not path.exists():
-        return None
-    value = json.loads(path.read_text()).get("tolerance_study", {}).get("x_kiss_ref_m")
-    if value is None:
-        return None
-    value = float(value)
-    if not (math.isfinite(value) and -1.0 <= value <= 1.0):
-        raise ValueError(f"{path}: tolerance_study.x_kiss_ref_m = {value!r}: allowed -1..1 m")
-    return value

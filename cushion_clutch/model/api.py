@@ -1,8 +1,8 @@
-"""Python API of the clutch model, on the same module the FMU runs (``cushion_clutch.fmu_src.clutch_model``).
+"""Python API of the clutch model, on the same module the pythonfmu FMU runs (:mod:`.clutch_model`).
 
 Examples
 --------
->>> from cushion_clutch.fmu.model import load_table, ClutchParameters, outputs, x_to_for_torque
+>>> from cushion_clutch.model import load_table, ClutchParameters, outputs, x_to_for_torque
 >>> table, p = load_table(), ClutchParameters()
 >>> out = outputs(x_to=0.0055, theta_cs=468.15, table=table, p=p)      # 195 degC
 >>> x = x_to_for_torque(out.torque, 468.15, table, p)                   # the TCU's inverse
@@ -11,16 +11,16 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..data import DEFAULT_TABLES
-from ..fmu_src.clutch_model import (KELVIN, ClutchParameters, Outputs, SpringTable, outputs,
-                                   thermal_step, x_to_for_torque)
+from .clutch_model import ClutchParameters, SpringTable, outputs
 
-__all__ = ["KELVIN", "ClutchParameters", "Outputs", "SpringTable", "outputs", "thermal_step",
-           "x_to_for_torque", "load_table", "torque", "thermal_system", "DEFAULT_TABLES"]
+__all__ = ["load_table", "torque", "thermal_system"]
 
 
-def load_table(folder: str | Path = DEFAULT_TABLES) -> SpringTable:
-    """The F(u, theta) and kiss-point tables of a table folder."""
+def load_table(folder: str | Path | None = None) -> SpringTable:
+    """The F(u, theta) and kiss-point tables of a table folder (default: the shipped default set)."""
+    if folder is None:
+        from ..data import DEFAULT_TABLES       # package data: only where the package is installed
+        folder = DEFAULT_TABLES
     return SpringTable.from_dir(folder)
 
 

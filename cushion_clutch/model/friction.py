@@ -15,12 +15,12 @@ from pathlib import Path
 
 import numpy as np
 
-try:
-    from .spring_table import load_csv
+try:                                    # inside the pythonfmu FMU the modules are siblings
+    from .table_format import COLUMNS as TABLE_COLUMNS, FRICTION, load_csv
 except ImportError:
-    from spring_table import load_csv
+    from table_format import COLUMNS as TABLE_COLUMNS, FRICTION, load_csv
 
-COLUMNS = ("theta_degC", "omega_slip_rad_s", "mu")
+COLUMNS = TABLE_COLUMNS[FRICTION]
 #: largest accepted friction coefficient in a table, 1
 MU_LIMIT = 2.0
 

@@ -111,7 +111,7 @@ def test_no_worker_at_all_fails_within_the_check_time(cluster, tmp_path):
 def test_remote_case_equals_local_with_no_ccx_on_the_client_and_a_lost_worker_is_reported(
         cluster, coarse, case_cache, tmp_path, monkeypatch):
     from cushion_clutch.fe.cluster import open_cluster, run_cases
-    from cushion_clutch.fe.sweep import case_key, run_sweep
+    from cushion_clutch.fe.sweep import case_key, run_sweep, solve_shipped
     p = coarse.replace(solver={"compression_increments": 30}, sweep={"temperatures_degC": (20.0,)})
     local = run_sweep(p, cache_dir=case_cache, jobs=1)[20.0]
     worker = cluster.worker("good")
@@ -135,6 +135,20 @@ def test_remote_case_equals_local_with_no_ccx_on_the_client_and_a_lost_worker_is
         threading.Thread(target=kill_soon, daemon=True).start()
         start = time.monotonic()
         with pytest.raises(ClusterError, match=r"all Dask workers of .* were lost \(tcp://127\.0\.0\.1:\d+\)"):
-            run_cases(client, info, [("c", p.replace(solver={"compression_increments": 60}), 80.0, 1)],
+            run_cases(client, info, solve_shipped, [("c", p.replace(solver={"compression_increments": 60}), 80.0, 1)],
                       lambda *a: done.append(a), lost_grace_s=2.0)
         assert time.monotonic() - start < 20.0 and done == []
+
+
+def test_idle_cores_become_threads(monkeypatch):
+    from cushion_clutch.fe.cluster import ClusterInfo, WorkerInfo
+    from cushion_clutch.fe.sweep import idle_threads
+    monkeypatch.setattr(os, "cpu_count", lambda: 16)
+    monkeypatch.setattr(os, "getloadavg", lambda: (0.2, 0.2, 0.2))
+    assert [idle_threads(16, n) for n in (1, 5, 16, 40)] == [16, 3, 1, 1]
+    assert idle_threads(2, 1) == 2
+    monkeypatch.setattr(os, "getloadavg", lambda: (12.0, 12.0, 12.0))     # others keep 12 cores busy
+    assert idle_threads(16, 1) == 4 and idle_threads(16, 5) == 3
+    workers = tuple(WorkerInfo(f"tcp://h:{i}", "h", 1, 8, "x", "2.20", ()) for i in range(16))
+    info = ClusterInfo("tcp://h:8786", workers, "2.20")
+    assert info.slots == 16 and [info.threads_per_case(n) for n in (1, 5, 16)] == [8, 3, 1]

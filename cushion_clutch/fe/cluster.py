@@ -15,7 +15,6 @@ from __future__ import annotations
 import contextlib
 import logging
 import os
-import tempfile
 import time
 import weakref
 from concurrent.futures import ThreadPoolExecutor
@@ -208,27 +207,16 @@ def open_cluster(scheduler=None, workers: int | None = None,
             own_cluster.close()
 
 
-def solve_remote(params, theta_degC: float, paddles: int, surface: bytes | None, threads: int) -> dict:
-    """On a worker: solve one case in a private folder with its shipped input files; return its JSON data."""
-    from .sweep import solve_case
-    with tempfile.TemporaryDirectory(prefix="cushion_case_") as tmp:
-        if surface is not None:
-            path = Path(tmp) / "surface.npz"
-            path.write_bytes(surface)
-            params = params.replace(geometry={"surface_file": str(path)})
-        params = params.replace(solver={"threads": threads})
-        work = Path(tmp) / "ccx"
-        work.mkdir()
-        return solve_case(params, theta_degC, work, paddles=paddles).to_json()
-
-
-def run_cases(client, info: ClusterInfo, cases: Sequence[tuple[Hashable, object, float, int]],
+def run_cases(client, info: ClusterInfo, solve: Callable[..., dict],
+              cases: Sequence[tuple[Hashable, object, float, int]],
               on_done: Callable[[Hashable, dict | None, BaseException | None], None], *,
               lost_grace_s: float = LOST_GRACE_S) -> None:
     """Run ``(key, params, theta_degC, paddles)`` cases on the cluster, calling ``on_done`` as each ends.
 
-    Every case gets ``info.threads_per_case(len(cases))`` ccx threads and its
-    scanned surface (if any) as bytes. ``on_done(key, data, None)`` for a
+    ``solve(params, theta_degC, paddles, surface_bytes, threads)`` runs on a
+    worker (:func:`cushion_clutch.fe.sweep.solve_shipped`). Every case gets
+    ``info.threads_per_case(len(cases))`` ccx threads and its scanned surface
+    (if any) as bytes. ``on_done(key, data, None)`` for a
     solved case, ``on_done(key, None, exc)`` for a failed one (a case whose
     workers died is reported as such).
 
@@ -247,8 +235,7 @@ def run_cases(client, info: ClusterInfo, cases: Sequence[tuple[Hashable, object,
         sf = params.geometry.surface_file
         if sf and sf not in blobs:
             blobs[sf] = client.scatter(Path(sf).read_bytes(), broadcast=True)
-        fut = client.submit(solve_remote, params, theta, paddles, blobs.get(sf) if sf else None, threads,
-                            pure=False)
+        fut = client.submit(solve, params, theta, paddles, blobs.get(sf) if sf else None, threads, pure=False)
         futures[fut] = key
     known = set(client.nthreads())
     lost: list[str] = []

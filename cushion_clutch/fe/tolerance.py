@@ -25,7 +25,7 @@ from scipy.stats import norm, qmc
 
 from ..errors import ParameterError, StudyError
 from .params import TOLERANCE_KEYS, SpringParams, Tolerances
-from .sweep import DEFAULT_CACHE, CaseOutcome, case_key
+from .sweep import DEFAULT_CACHE, CaseOutcome, case_key, solve_shipped
 
 log = logging.getLogger(__name__)
 
@@ -165,8 +165,8 @@ def _run_study(samples, temperatures_degC, cache_dir, client, info, progress):
             progress(done[0], total, cached)
 
     if todo:
-        run_cases(client, info, [((i, theta, folder), samples[i].params, theta, 1) for i, theta, folder in todo],
-                  on_done)
+        run_cases(client, info, solve_shipped,
+                  [((i, theta, folder), samples[i].params, theta, 1) for i, theta, folder in todo], on_done)
     if failures:
         raise StudyError(failures)
     return [{t: r[t] for t in sorted(r)} for r in results]

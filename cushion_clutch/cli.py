@@ -86,7 +86,8 @@ def _sweep(args: argparse.Namespace) -> int:
 
 
 def _calibrate(args: argparse.Namespace) -> int:
-    from .fe.calibrate import calibrate, parse_bounds, parse_measured
+    from .fe.calibrate import calibrate, parse_bounds
+    from .fe.measured import parse_measured
     from .fe.calibration_report import calibrated_params, params_toml, plot_calibration, report_text
     from .fe.params import load_params
 

@@ -28,7 +28,7 @@ TRUTH = {"wave_height_m": 1.08, "thickness_m": 0.95, "far_end_stiffness_N_per_m"
 
 def synthetic_curves(truth, temperatures, cache: Path, noise: float = 0.01, points: int = 30, seed: int = 1):
     """Noisy FE 'measurements' of ``truth`` at ``temperatures``, u from the reference kiss point."""
-    from cushion_clutch.fe.calibrate import Measured
+    from cushion_clutch.fe.measured import Measured
     from cushion_clutch.fe.sweep import run_sweep
     from cushion_clutch.fe.tables import curve_from_case, kiss_shift
 

@@ -118,8 +118,8 @@ def _calibrate(args: argparse.Namespace) -> int:
 def _simulate(args: argparse.Namespace) -> int:
     import csv
 
-    from .fmu.engagements import (EngagementCycle, plot_engagements, plot_thermal_step,
-                              plot_torque_characteristic, simulate)
+    from .launch.engagements import (EngagementCycle, plot_engagements, plot_thermal_step,
+                                     plot_torque_characteristic, simulate)
     from .model import load_table
     from .outputs import OutputSet
 
@@ -196,7 +196,7 @@ def _launch(args: argparse.Namespace) -> int:
 
 
 def _export(args: argparse.Namespace) -> int:
-    from .fmu.exports import export_mat, export_modelica
+    from .fe.exports import export_mat, export_modelica
 
     from .fe.tables import read_tables
     from .outputs import OutputSet

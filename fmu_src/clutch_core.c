@@ -3,8 +3,8 @@
  * step (Co-Simulation) and derivative (Model Exchange), the state machine checks shared by both
  * FMI versions, and the saved state (versioned, checksummed, validated).
  */
+#define CC_DEFINE_VARIABLE_TABLE /* CC_VARIABLES (cushion_variables.h) is defined in this file */
 #include "clutch_core.h"
-#include "cushion_guid.h" /* CC_GUID and CC_X_KISS_REF_START, generated when the FMU is built */
 
 #include <math.h>
 #include <stdarg.h>
@@ -12,29 +12,18 @@
 #include <string.h>
 
 #define KELVIN 273.15
-#define X_TO_LIMIT 1.0
-#define THETA_CM_LIMIT 2000.0
-#define OMEGA_SLIP_LIMIT 1e4
+/* X_TO_LIMIT, THETA_CM_LIMIT, OMEGA_SLIP_LIMIT and the variable table CC_VARIABLES (names, causalities,
+   start values, parameter ranges) come from cushion_variables.h, generated from clutch_model */
+#define VAR_NAME(vr) (CC_VARIABLES[vr].name)
 
-static const char *VAR_NAMES[CC_NVARS] = {
-    "x_to", "theta_cm", "torque", "force", "theta_cs", "u_f", "x_kiss", "n_surfaces", "mu",
-    "R_eq", "U", "H", "C", "theta_a", "theta_cs_start", "x_kiss_ref", "lever_ratio", "omega_slip",
-    "der(theta_cs)"};
+static int is_input(unsigned int vr) { return vr < CC_NVARS && CC_VARIABLES[vr].causality == CC_INPUT; }
+static int is_parameter(unsigned int vr) { return vr < CC_NVARS && CC_VARIABLES[vr].causality == CC_PARAMETER; }
 
-/* defaults: inputs, outputs (start), parameters (clutch_model.ClutchParameters) */
-static const double DEFAULTS[CC_NVARS] = {
-    0.0, 293.15, 0.0, 0.0, 293.15, 0.0, 0.004, 2.0, 0.28, 0.089, 0.1, 0.04, 1.0, 293.15, 293.15,
-    0.004, 3.0, 0.0, 0.0};
-
-/* allowed parameter ranges: low, high, low open, high open (clutch_model.ClutchParameters.RANGES) */
-static const double RANGES[CC_NVARS][4] = {
-    {0}, {0}, {0}, {0}, {0}, {0}, {0},
-    {1.0, 16.0, 0, 0}, {0.0, 2.0, 0, 0}, {0.0, 1.0, 1, 0}, {0.0, 1e4, 0, 0}, {0.0, 1e4, 0, 0},
-    {0.0, 1e6, 1, 0}, {0.0, 2000.0, 1, 0}, {0.0, 2000.0, 1, 0}, {-1.0, 1.0, 0, 0},
-    {0.0, 100.0, 1, 0}, {0}, {0}};
-
-static int is_input(unsigned int vr) { return vr == VR_X_TO || vr == VR_THETA_CM || vr == VR_OMEGA_SLIP; }
-static int is_parameter(unsigned int vr) { return vr >= VR_N_SURFACES && vr <= VR_LEVER_RATIO; }
+/* every variable at its start value (parameters: their defaults) */
+static void set_starts(double *r) {
+    int k;
+    for (k = 0; k < CC_NVARS; ++k) r[k] = CC_VARIABLES[k].start;
+}
 
 static const char *phase_name(int phase) {
     switch (phase) {
@@ -69,22 +58,13 @@ int cc_allowed(CcModel *m, int mask, const char *fn) {
 }
 
 /* ------------------------------------------------------------ instantiation */
-/* the defaults, with the table set's own kiss point at the bearing (a tolerance P5/P95 set's metadata) */
-static void set_defaults(CcModel *m) {
-    memcpy(m->r, DEFAULTS, sizeof m->r);
-#ifdef CC_X_KISS_REF_START
-    m->r[VR_X_KISS_REF] = CC_X_KISS_REF_START;
-    m->r[VR_X_KISS] = CC_X_KISS_REF_START;
-#endif
-}
-
 int cc_instantiate(CcModel *m, const char *dir, int me, CcLogger logger, void *ctx, int logging_on) {
     memset(m, 0, sizeof *m);
     m->logger = logger;
     m->log_ctx = ctx;
     m->logging_on = logging_on;
     m->me = me;
-    set_defaults(m);
+    set_starts(m->r);
     m->phase = PH_INSTANTIATED;
     m->dirty = 1;
     m->table_ok = cc_table_load(&m->table, dir, m->table_error, sizeof m->table_error) == 0;
@@ -95,7 +75,7 @@ int cc_instantiate(CcModel *m, const char *dir, int me, CcLogger logger, void *c
 void cc_free(CcModel *m) { cc_table_free(&m->table); }
 
 void cc_reset(CcModel *m) {
-    set_defaults(m);
+    set_starts(m->r);
     m->range_warned = 0;
     m->terminated = 0;
     m->time = 0.0;
@@ -105,17 +85,17 @@ void cc_reset(CcModel *m) {
 
 /* ------------------------------------------------------------------- checks */
 static int range_ok(int k, double v) {
-    const double *g = RANGES[k];
+    const double *g = CC_VARIABLES[k].range;
     return isfinite(v) && (g[2] ? v > g[0] : v >= g[0]) && (g[3] ? v < g[1] : v <= g[1]);
 }
 
 /* every parameter problem is logged (prefix names the call); returns 1 if all are valid */
 static int check_parameters(CcModel *m, const double *r, const char *fn) {
     int k, ok = 1;
-    for (k = VR_N_SURFACES; k <= VR_LEVER_RATIO; ++k) {
-        const double *g = RANGES[k];
-        if (!range_ok(k, r[k])) {
-            cc_log(m, CC_ERROR, "%s: parameter %s = %g is out of range %c%g, %g%c", fn, VAR_NAMES[k], r[k],
+    for (k = 0; k < CC_NVARS; ++k) {
+        const double *g = CC_VARIABLES[k].range;
+        if (is_parameter((unsigned int)k) && !range_ok(k, r[k])) {
+            cc_log(m, CC_ERROR, "%s: parameter %s = %g is out of range %c%g, %g%c", fn, VAR_NAME(k), r[k],
                    g[2] ? '(' : '[', g[0], g[1], g[3] ? ')' : ']');
             ok = 0;
         }
@@ -200,11 +180,11 @@ int cc_set_real(CcModel *m, const unsigned int vr[], size_t n, const double v[],
         }
         if (!is_input(vr[k]) && !is_parameter(vr[k])) {
             cc_log(m, CC_ERROR, "%s: %s (value reference %u) is not an input or parameter and cannot be set", fn,
-                   VAR_NAMES[vr[k]], vr[k]);
+                   VAR_NAME(vr[k]), vr[k]);
             return CC_ERROR;
         }
         if (is_parameter(vr[k]) && after_init) {
-            cc_log(m, CC_ERROR, "%s: parameter %s is fixed after initialization", fn, VAR_NAMES[vr[k]]);
+            cc_log(m, CC_ERROR, "%s: parameter %s is fixed after initialization", fn, VAR_NAME(vr[k]));
             return CC_ERROR;
         }
     }
@@ -358,7 +338,7 @@ int cc_state_check(CcModel *m, const void *bytes, size_t size, const char *fn) {
     }
     for (k = 0; k < CC_NVARS; ++k)
         if (!isfinite(s.r[k])) {
-            cc_log(m, CC_ERROR, "%s: the state's %s = %g is not finite", fn, VAR_NAMES[k], s.r[k]);
+            cc_log(m, CC_ERROR, "%s: the state's %s = %g is not finite", fn, VAR_NAME(k), s.r[k]);
             return 0;
         }
     if (!isfinite(s.time) || !(s.r[VR_THETA_CS] > 0.0 && s.r[VR_THETA_CS] < THETA_CM_LIMIT) ||

@@ -34,14 +34,16 @@ from pathlib import Path
 from pythonfmu import Fmi2Causality, Fmi2Slave, Fmi2Variability, Real
 from pythonfmu.enums import Fmi2Status
 
-from clutch_model import (OMEGA_SLIP_LIMIT, OMEGA_SLIP_START, THETA_CM_LIMIT, VARIABLES, X_TO_LIMIT,
-                          ClutchParameters, SpringTable, outputs, thermal_step)
+from clutch_model import (OMEGA_SLIP_LIMIT, THETA_CM_LIMIT, VARIABLES, X_TO_LIMIT, ClutchParameters, SpringTable,
+                          outputs, start_values, thermal_step)
 from table_format import table_set_x_kiss_ref
 
 CAUSALITY = {"input": (Fmi2Causality.input, Fmi2Variability.continuous),
              "output": (Fmi2Causality.output, Fmi2Variability.continuous),
              "parameter": (Fmi2Causality.parameter, Fmi2Variability.fixed)}
 PARAMETERS = [name for name, causality, _, _ in VARIABLES if causality == "parameter"]
+#: the outputs that clutch_model.outputs() returns (fields of Outputs): every output but the state theta_cs
+OUTPUTS = [name for name, causality, _, _ in VARIABLES if causality == "output" and name != "theta_cs"]
 #: tag of a serialized state; bump when the state's content changes
 STATE_FORMAT = "cushion_clutch.pythonfmu.state/1"
 PHASES = ("instantiated", "initialization", "stepping", "terminated")
@@ -87,14 +89,8 @@ class CushionClutch(Fmi2Slave):
         except ValueError as exc:
             x_kiss_ref, table_error = None, str(exc)
         defaults = ClutchParameters() if x_kiss_ref is None else ClutchParameters(x_kiss_ref=x_kiss_ref)
-        self.x_to = 0.0
-        self.theta_cm = defaults.theta_a
-        self.omega_slip = OMEGA_SLIP_START
-        for name in PARAMETERS:
-            setattr(self, name, float(getattr(defaults, name)))
-        self.theta_cs = defaults.theta_cs_start
-        self.torque = self.force = self.u_f = 0.0
-        self.x_kiss = defaults.x_kiss_ref
+        for name, value in start_values(defaults).items():
+            setattr(self, name, value)
         self._range_warned = False
         self._params = defaults
         self._problems: list[str] = []
@@ -287,7 +283,8 @@ class CushionClutch(Fmi2Slave):
         self._set_outputs(out)
 
     def _set_outputs(self, out) -> None:
-        self.torque, self.force, self.u_f, self.x_kiss = out.torque, out.force, out.u_f, out.x_kiss
+        for name in OUTPUTS:
+            setattr(self, name, getattr(out, name))
         if out.clamped and not self._range_warned:
             self._range_warned = True
             self.log(f"theta_cs = {self.theta_cs:.2f} K is outside the table range "

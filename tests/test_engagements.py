@@ -3,7 +3,7 @@ import math
 import numpy as np
 import pytest
 
-from cushion_clutch.fmu.engagements import EngagementCycle
+from cushion_clutch.launch.engagements import EngagementCycle
 
 
 def test_facing_temperature_is_the_exact_piecewise_solution():

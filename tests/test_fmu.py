@@ -12,7 +12,7 @@ from fmpy.validation import validate_fmu
 from scipy.interpolate import PchipInterpolator
 from scipy.io import loadmat
 
-from cushion_clutch.fmu.exports import export_mat, export_modelica, read_modelica
+from cushion_clutch.fe.exports import export_mat, export_modelica, read_modelica
 from cushion_clutch.fmu.build import build_fmu
 from cushion_clutch.data import DEFAULT_TABLES
 from cushion_clutch.fe.tables import read_tables

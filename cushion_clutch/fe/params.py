@@ -14,6 +14,7 @@ from typing import Any, Iterable
 
 from ..config import Checked, build_checked, load_toml, range_problem
 from ..data import DEFAULT_SPRING
+from .surface import load_surface
 
 
 @dataclass(frozen=True)
@@ -125,7 +126,6 @@ class Geometry(Checked):
         if not isinstance(self.surface_file, str):
             yield f"geometry.surface_file = {self.surface_file!r}: must be a file name (string)"
         elif self.surface_file:
-            from .surface import surface_problems
             yield from surface_problems(self)
             if self.wave_tilt_m != 0.0 or self.wave_profile != "cosine" or self.waves != 1:
                 yield ("geometry.surface_file: the fitted surface carries the whole wave shape; leave "
@@ -163,6 +163,31 @@ class Geometry(Checked):
         """Largest wave height of the paddle (the higher edge), m."""
         return max(self.edge_heights_m())
 
+
+
+def surface_problems(geom: Geometry):
+    """Problems of ``geom.surface_file`` as parameter messages (file, content, sector coverage)."""
+    key = f"geometry.surface_file = {geom.surface_file!r}"
+    try:
+        surf = load_surface(geom.surface_file)
+    except FileNotFoundError:
+        yield f"{key}: file not found (a relative path is taken from the TOML file's folder)"
+        return
+    except (OSError, ValueError) as exc:
+        yield f"{key}: not a fitted surface (.npz from cushion-clutch import-scan): {exc}"
+        return
+    tol = 1e-9
+    try:
+        covers = (surf.r_m[0] <= geom.inner_radius_m + tol and surf.r_m[-1] >= geom.outer_radius_m - tol
+                  and surf.phi_deg[0] <= tol and surf.phi_deg[-1] >= geom.span_deg - tol)
+    except TypeError:
+        return          # the radii themselves are wrong; reported with their keys
+    if not covers:
+        yield (f"{key}: covers r = {surf.r_m[0]:g}..{surf.r_m[-1]:g} m, phi = {surf.phi_deg[0]:g}.."
+               f"{surf.phi_deg[-1]:g} deg; the paddle needs r = {geom.inner_radius_m:g}.."
+               f"{geom.outer_radius_m:g} m, phi = 0..{geom.span_deg:g} deg")
+    if surf.peak_m <= 0:
+        yield f"{key}: the surface has no height above its rivet zone (peak {surf.peak_m:g} m)"
 
 @dataclass(frozen=True)
 class Carrier(Checked):

@@ -14,8 +14,6 @@ from pathlib import Path
 import numpy as np
 from scipy.interpolate import RegularGridInterpolator
 
-from .params import Geometry
-
 
 @dataclass(frozen=True)
 class Surface:
@@ -66,33 +64,11 @@ def _load(path: str, _mtime: int, _size: int) -> Surface:
     return Surface(r, phi, w, h.hexdigest()[:16])
 
 
-def surface_problems(geom: Geometry):
-    """Problems of ``geom.surface_file`` as parameter messages (file, content, sector coverage)."""
-    key = f"geometry.surface_file = {geom.surface_file!r}"
-    try:
-        surf = load_surface(geom.surface_file)
-    except FileNotFoundError:
-        yield f"{key}: file not found (a relative path is taken from the TOML file's folder)"
-        return
-    except (OSError, ValueError) as exc:
-        yield f"{key}: not a fitted surface (.npz from cushion-clutch import-scan): {exc}"
-        return
-    tol = 1e-9
-    try:
-        covers = (surf.r_m[0] <= geom.inner_radius_m + tol and surf.r_m[-1] >= geom.outer_radius_m - tol
-                  and surf.phi_deg[0] <= tol and surf.phi_deg[-1] >= geom.span_deg - tol)
-    except TypeError:
-        return          # the radii themselves are wrong; reported with their keys
-    if not covers:
-        yield (f"{key}: covers r = {surf.r_m[0]:g}..{surf.r_m[-1]:g} m, phi = {surf.phi_deg[0]:g}.."
-               f"{surf.phi_deg[-1]:g} deg; the paddle needs r = {geom.inner_radius_m:g}.."
-               f"{geom.outer_radius_m:g} m, phi = 0..{geom.span_deg:g} deg")
-    if surf.peak_m <= 0:
-        yield f"{key}: the surface has no height above its rivet zone (peak {surf.peak_m:g} m)"
+def surface_height(r_m, phi_deg, geom) -> np.ndarray:
+    """w(r, phi) of ``geom.surface_file``, scaled so that its peak is ``geom.wave_height_m``, m.
 
-
-def surface_height(r_m, phi_deg, geom: Geometry) -> np.ndarray:
-    """w(r, phi) of ``geom.surface_file``, scaled so that its peak is ``geom.wave_height_m``, m."""
+    ``geom`` is the spring's :class:`~cushion_clutch.fe.params.Geometry`.
+    """
     surf = load_surface(geom.surface_file)
     r, phi = np.broadcast_arrays(np.asarray(r_m, dtype=float), np.asarray(phi_deg, dtype=float))
     w = surf.interpolate(np.column_stack([r.ravel(), phi.ravel()])).reshape(r.shape)

@@ -1,82 +1,18 @@
 """Build the CushionClutch FMU from a table set: the front door for both backends.
 
 :func:`build_fmu` checks the tables and hands over to the native C backend
-(:mod:`cushion_clutch.fmu.native`, the default) or to pythonfmu. For the
-latter, pythonfmu writes the binaries and a bare modelDescription.xml; this module
-stages the slave, the shared model module and the tables, then completes the
-description: SI units on every variable (temperatures in K with degC as
-display unit) and the ``InitialUnknowns`` that FMI 2.0 requires for outputs.
+(:mod:`.native`, the default) or to the pythonfmu backend (:mod:`.pythonfmu_backend`).
 """
 from __future__ import annotations
 
 import logging
-import shutil
-import tempfile
 from pathlib import Path
-from xml.etree import ElementTree as ET
 
-from ..data import fmu_sources
 from ..errors import ParameterError, TableError
 from ..fe.tables import read_tables
-from ..model import VARIABLES, clutch_model
-from ..model.table_format import FMU_FILES, REQUIRED_FILES
+from ..model.table_format import REQUIRED_FILES
 
 log = logging.getLogger(__name__)
-
-FMU_SRC = fmu_sources()
-SLAVE = "CushionClutch"
-#: folder of the numpy-only model modules (:mod:`cushion_clutch.model`)
-MODEL_SRC = Path(clutch_model.__file__).parent
-#: the modules the pythonfmu slave imports (siblings inside the FMU): the slave class (from ``FMU_SRC``)
-#: and the numpy-only model (from ``MODEL_SRC``)
-SLAVE_MODULES = {"cushion_slave.py": FMU_SRC, "clutch_model.py": MODEL_SRC, "spring_table.py": MODEL_SRC,
-                 "friction.py": MODEL_SRC, "table_format.py": MODEL_SRC}
-
-#: unit of each variable (from the shared model module); temperatures get degC as display unit
-UNITS = {name: unit for name, _, unit, _ in VARIABLES}
-#: SI base-unit exponents of each unit
-BASE_UNITS = {
-    "m": {"m": "1"}, "K": {"K": "1"}, "N": {"kg": "1", "m": "1", "s": "-2"},
-    "N.m": {"kg": "1", "m": "2", "s": "-2"}, "W/K": {"kg": "1", "m": "2", "s": "-3", "K": "-1"},
-    "J/K": {"kg": "1", "m": "2", "s": "-2", "K": "-1"}, "1": {}, "rad/s": {"s": "-1", "rad": "1"},
-}
-
-FMU_OPTIONS = dict(needsExecutionTool=False, canHandleVariableCommunicationStepSize=True,
-                   canInterpolateInputs=False, canBeInstantiatedOnlyOncePerProcess=False,
-                   canGetAndSetFMUstate=True, canSerializeFMUstate=True)
-
-
-def complete_model_description(xml_text: str) -> str:
-    """Add unit definitions, variable units and InitialUnknowns to pythonfmu's XML."""
-    root = ET.fromstring(xml_text)
-    units = ET.Element("UnitDefinitions")
-    for name, base in BASE_UNITS.items():
-        unit = ET.SubElement(units, "Unit", name=name)
-        ET.SubElement(unit, "BaseUnit", base)
-        if name == "K":
-            ET.SubElement(unit, "DisplayUnit", name="degC", offset="-273.15")
-    cosim = root.find("CoSimulation")
-    root.insert(list(root).index(cosim) + 1, units)
-    outputs = []
-    for index, var in enumerate(root.find("ModelVariables"), start=1):
-        real = var.find("Real")
-        name = var.get("name")
-        if real is None or name not in UNITS:
-            raise ValueError(f"variable {name!r} has no unit in fmu_build.UNITS")
-        real.set("unit", UNITS[name])
-        if UNITS[name] == "K":
-            real.set("displayUnit", "degC")
-        if var.get("causality") == "output":
-            outputs.append(index)
-    structure = root.find("ModelStructure")
-    for old in structure.findall("InitialUnknowns"):
-        structure.remove(old)
-    if outputs:
-        init = ET.SubElement(structure, "InitialUnknowns")
-        for index in outputs:
-            ET.SubElement(init, "Unknown", index=str(index))
-    ET.indent(root)
-    return '<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
 
 
 def build_fmu(tables: Path, output: Path, backend: str = "native", fmi_version: int = 2) -> Path:
@@ -107,27 +43,10 @@ def build_fmu(tables: Path, output: Path, backend: str = "native", fmi_version: 
         raise ValueError(f"backend = {backend!r}: allowed 'python' or 'native'")
     if fmi_version != 2:
         raise ParameterError(["fmi_version = 3 needs backend 'native' (the pythonfmu backend writes FMI 2.0)"])
-    from pythonfmu.builder import FmuBuilder
-    with tempfile.TemporaryDirectory(prefix="cushion_fmu_") as tmp:
-        stage = Path(tmp)
-        shutil.copy(FMU_SRC / f"{SLAVE}.py", stage / f"{SLAVE}.py")
-        for module, folder in SLAVE_MODULES.items():
-            shutil.copy(folder / module, stage / module)
-        (stage / "tables").mkdir()
-        for name in FMU_FILES:
-            if (tables / name).exists():
-                shutil.copy(tables / name, stage / "tables" / name)
-        built = FmuBuilder.build_FMU(stage / f"{SLAVE}.py", dest=stage / "out",
-                                     project_files=[*(stage / m for m in SLAVE_MODULES), stage / "tables"],
-                                     **FMU_OPTIONS)
-        _rewrite_description(Path(built), output)
+    from .pythonfmu_backend import build_python_fmu
+    build_python_fmu(tables, output)
     log.info("built %s from tables %s", output, tables)
     return output
-
-
-def _rewrite_description(src: Path, dst: Path) -> None:
-    from .guard import guard_fmu
-    guard_fmu(src, dst, complete_model_description)
 
 
 def add_backend(parser) -> None:

@@ -6,8 +6,7 @@ Each FMI version has its platform folders (FMI 2.0: ``linux64``, ``win64``,
 cache makes later builds fast); without ziglang, gcc builds the host platform only.
 Only the FMI API is exported: ``-fvisibility=hidden`` plus the FMI headers'
 export macros (``__declspec(dllexport)`` on Windows).
-
-    python -m cushion_clutch.fmu.crossbuild    # warm zig's cache (CI install step)
+(``python -m cushion_clutch.fmu.native`` warms zig's cache: the CI install step.)
 """
 from __future__ import annotations
 
@@ -16,7 +15,6 @@ import logging
 import shutil
 import subprocess
 import sys
-import tempfile
 from pathlib import Path
 
 log = logging.getLogger(__name__)
@@ -83,15 +81,3 @@ def build_binaries(src: Path, files: tuple[str, ...], fmi_version: int, out_dir:
         raise RuntimeError("compiling the native FMU failed:\n" + "\n".join(failed))
     return {p: out for p, (_, out, _) in jobs.items()}
 
-
-def warm_cache() -> None:
-    """Build the default FMUs once (both FMI versions) so that zig's cache holds every target's libc."""
-    from ..data import DEFAULT_TABLES
-    from .native import build_native_fmu
-    with tempfile.TemporaryDirectory() as tmp:
-        for version in (2, 3):
-            build_native_fmu(DEFAULT_TABLES, Path(tmp) / f"fmi{version}.fmu", fmi_version=version)
-
-
-if __name__ == "__main__":
-    warm_cache()

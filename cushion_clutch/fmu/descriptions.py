@@ -1,39 +1,39 @@
 """modelDescription.xml (FMI 2.0 and 3.0) and buildDescription.xml of the native FMU.
 
 Both FMI versions carry Co-Simulation and Model Exchange. The variables are
-``clutch_model.VARIABLES`` (value reference = position) plus the state
-derivative ``der(theta_cs)`` [K/s] (value reference 18) and, in FMI 3.0, the
-independent variable ``time`` [s] (value reference 19). In Model Exchange
-``theta_cs`` is the continuous state; torque, force, u_f and x_kiss depend
-directly on the inputs (ModelStructure lists the dependencies).
+``clutch_model.VARIABLES`` (value reference = position; start values from
+``clutch_model.start_values``) plus the state derivative ``der(theta_cs)`` [K/s]
+(value reference ``len(VARIABLES)``, today 18) and, in FMI 3.0, the independent
+variable ``time`` [s] (the next one, today 19). In Model Exchange ``theta_cs`` is
+the continuous state; torque, force, u_f and x_kiss depend directly on the inputs
+(ModelStructure lists the dependencies). The model is read when a description
+is written, so the descriptions follow ``VARIABLES`` as it stands.
 """
 from __future__ import annotations
 
 from xml.etree import ElementTree as ET
 
-from ..model import OMEGA_SLIP_START, VARIABLES, ClutchParameters
-from .build import BASE_UNITS, SLAVE
+from ..model import clutch_model
+from .constants import BASE_UNITS, SLAVE, sources
 
-#: the model core (shared) and the front end of each FMI version, as shipped in sources/
-CORE_HEADERS = ("clutch_core.h", "resource_uri.h")
-CORE_SOURCES = ("clutch_core.c", "clutch_tables.c", "resource_uri.c")
-FRONT_ENDS = {2: "fmi2_frontend.c", 3: "fmi3_frontend.c"}
-#: value references beyond clutch_model.VARIABLES
-VR_DER = len(VARIABLES)
-VR_TIME = VR_DER + 1
 UNITS = dict(BASE_UNITS, **{"K/s": {"K": "1", "s": "-1"}, "s": {"s": "1"}})
 DESCRIPTION = ("Dry-clutch torque T = n*mu*R_eq*F(u_f(x_to, theta_cs), theta_cs) with the cushion-spring "
                "thermal ODE C dtheta_cs/dt = U (theta_cm - theta_cs) + H (theta_a - theta_cs); F from "
                "CalculiX tables (native C; Co-Simulation and Model Exchange)")
 
 
-def sources(fmi_version: int) -> tuple[str, ...]:
-    """C files compiled into the FMI ``fmi_version`` binary."""
-    return (*CORE_SOURCES, FRONT_ENDS[fmi_version])
+def vr_der() -> int:
+    """Value reference of der(theta_cs): the first after the model's variables."""
+    return len(clutch_model.VARIABLES)
+
+
+def vr_time() -> int:
+    """Value reference of the independent variable time (FMI 3.0)."""
+    return vr_der() + 1
 
 
 def _vr(name: str) -> int:
-    return [v[0] for v in VARIABLES].index(name)
+    return [v[0] for v in clutch_model.VARIABLES].index(name)
 
 
 def dependencies(has_friction: bool) -> dict[int, list[int]]:
@@ -41,21 +41,19 @@ def dependencies(has_friction: bool) -> dict[int, list[int]]:
     x_to, theta_cm, theta_cs, omega = _vr("x_to"), _vr("theta_cm"), _vr("theta_cs"), _vr("omega_slip")
     torque = [x_to, theta_cs] + ([theta_cm, omega] if has_friction else [])
     return {_vr("torque"): sorted(torque), _vr("force"): [x_to, theta_cs], theta_cs: [theta_cs],
-            _vr("u_f"): [x_to, theta_cs], _vr("x_kiss"): [theta_cs], VR_DER: [theta_cm, theta_cs]}
+            _vr("u_f"): [x_to, theta_cs], _vr("x_kiss"): [theta_cs], vr_der(): [theta_cm, theta_cs]}
 
 
 def _variables(x_kiss_ref_m: float | None = None):
-    """(vr, name, causality, unit, description, start) of every variable but time.
+    """(vr, name, causality, unit, description, start) of every variable but time (start: inputs and parameters).
 
     ``x_kiss_ref_m``: the table set's own start value of ``x_kiss_ref`` (m), None for the default.
     """
-    defaults = ClutchParameters() if x_kiss_ref_m is None else ClutchParameters(x_kiss_ref=x_kiss_ref_m)
-    starts = {"x_to": 0.0, "theta_cm": defaults.theta_a, "omega_slip": OMEGA_SLIP_START}
-    for vr, (name, causality, unit, desc) in enumerate(VARIABLES):
-        start = starts.get(name) if causality == "input" else (
-            float(getattr(defaults, name)) if causality == "parameter" else None)
-        yield vr, name, causality, unit, desc, start
-    yield VR_DER, "der(theta_cs)", "local", "K/s", "rate of change of theta_cs (paper eq. 3)", None
+    p = None if x_kiss_ref_m is None else clutch_model.ClutchParameters(x_kiss_ref=x_kiss_ref_m)
+    starts = clutch_model.start_values(p)
+    for vr, (name, causality, unit, desc) in enumerate(clutch_model.VARIABLES):
+        yield vr, name, causality, unit, desc, starts[name] if causality in ("input", "parameter") else None
+    yield vr_der(), "der(theta_cs)", "local", "K/s", "rate of change of theta_cs (paper eq. 3)", None
 
 
 def _units(root: ET.Element) -> None:
@@ -103,7 +101,7 @@ def fmi2_description(guid: str, has_friction: bool, x_kiss_ref_m: float | None =
         real = ET.SubElement(ET.SubElement(variables, "ScalarVariable", attrs), "Real", unit=unit)
         if unit == "K":
             real.set("displayUnit", "degC")
-        if vr == VR_DER:
+        if vr == vr_der():
             real.set("derivative", str(_vr("theta_cs") + 1))
         if start is not None:
             real.set("start", repr(start))
@@ -111,11 +109,11 @@ def fmi2_description(guid: str, has_friction: bool, x_kiss_ref_m: float | None =
     index = lambda vrs: " ".join(str(v + 1) for v in vrs)  # noqa: E731
     structure = ET.SubElement(root, "ModelStructure")
     outputs = ET.SubElement(structure, "Outputs")
-    for vr, (_, causality, _, _) in enumerate(VARIABLES):
+    for vr, (_, causality, _, _) in enumerate(clutch_model.VARIABLES):
         if causality == "output":
             ET.SubElement(outputs, "Unknown", index=str(vr + 1), dependencies=index(deps[vr]))
-    ET.SubElement(ET.SubElement(structure, "Derivatives"), "Unknown", index=str(VR_DER + 1),
-                  dependencies=index(deps[VR_DER]))
+    ET.SubElement(ET.SubElement(structure, "Derivatives"), "Unknown", index=str(vr_der() + 1),
+                  dependencies=index(deps[vr_der()]))
     init = ET.SubElement(structure, "InitialUnknowns")
     for vr in sorted(deps):
         ET.SubElement(init, "Unknown", index=str(vr + 1))
@@ -134,7 +132,7 @@ def fmi3_description(token: str, has_friction: bool, x_kiss_ref_m: float | None 
     _units(root)
     _log_categories(root)
     variables = ET.SubElement(root, "ModelVariables")
-    ET.SubElement(variables, "Float64", name="time", valueReference=str(VR_TIME), causality="independent",
+    ET.SubElement(variables, "Float64", name="time", valueReference=str(vr_time()), causality="independent",
                   variability="continuous", unit="s", description="simulation time [s]")
     for vr, name, causality, unit, desc, start in _variables(x_kiss_ref_m):
         attrs = dict(name=name, valueReference=str(vr), description=f"{desc} [{unit}]", causality=causality)
@@ -143,18 +141,18 @@ def fmi3_description(token: str, has_friction: bool, x_kiss_ref_m: float | None 
         attrs["unit"] = unit
         if unit == "K":
             attrs["displayUnit"] = "degC"
-        if vr == VR_DER:
+        if vr == vr_der():
             attrs["derivative"] = str(_vr("theta_cs"))
         if start is not None:
             attrs["start"] = repr(start)
         ET.SubElement(variables, "Float64", attrs)
     deps = dependencies(has_friction)
     structure = ET.SubElement(root, "ModelStructure")
-    for vr, (_, causality, _, _) in enumerate(VARIABLES):
+    for vr, (_, causality, _, _) in enumerate(clutch_model.VARIABLES):
         if causality == "output":
             ET.SubElement(structure, "Output", valueReference=str(vr), dependencies=" ".join(map(str, deps[vr])))
-    ET.SubElement(structure, "ContinuousStateDerivative", valueReference=str(VR_DER),
-                  dependencies=" ".join(map(str, deps[VR_DER])))
+    ET.SubElement(structure, "ContinuousStateDerivative", valueReference=str(vr_der()),
+                  dependencies=" ".join(map(str, deps[vr_der()])))
     for vr in sorted(deps):
         ET.SubElement(structure, "InitialUnknown", valueReference=str(vr))
     return _finish(root)

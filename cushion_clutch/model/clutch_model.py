@@ -32,7 +32,7 @@ except ImportError:
 
 __all__ = ["KELVIN", "VARIABLES", "ClutchParameters", "Outputs", "SpringTable", "FrictionTable", "Curve",
            "load_csv", "pchip_slopes", "thermal_step", "friction_coefficient", "outputs", "x_to_for_torque",
-           "OMEGA_SLIP_START", "OMEGA_SLIP_LIMIT"]
+           "OMEGA_SLIP_START", "OMEGA_SLIP_LIMIT", "start_values"]
 
 #: The FMU interface, in value-reference order: (name, causality, unit, description).
 #: Both FMUs (pythonfmu and native C) expose exactly these; parameters take
@@ -112,6 +112,35 @@ class ClutchParameters:
         if not out and self.U + self.H <= 0.0:
             out.append("U + H must be > 0 (the cushion spring needs a heat path)")
         return out
+
+
+def start_values(p: ClutchParameters | None = None) -> dict[str, float]:
+    """Value of every variable of :data:`VARIABLES` before initialisation, in their order.
+
+    Parameters take theirs from ``p`` (default: :class:`ClutchParameters`'s
+    defaults); the inputs x_to = 0, theta_cm = theta_a and omega_slip =
+    ``OMEGA_SLIP_START``; the outputs theta_cs = theta_cs_start, x_kiss =
+    x_kiss_ref and 0 otherwise. Both FMUs start from these values.
+
+    Raises
+    ------
+    KeyError
+        Naming an input of ``VARIABLES`` that has no start value here.
+    """
+    p = p or ClutchParameters()
+    inputs = {"x_to": 0.0, "theta_cm": p.theta_a, "omega_slip": OMEGA_SLIP_START}
+    outputs_ = {"theta_cs": p.theta_cs_start, "x_kiss": p.x_kiss_ref}
+    out = {}
+    for name, causality, _, _ in VARIABLES:
+        if causality == "parameter":
+            out[name] = float(getattr(p, name))
+        elif causality == "input":
+            if name not in inputs:
+                raise KeyError(f"input {name!r} has no start value in clutch_model.start_values")
+            out[name] = float(inputs[name])
+        else:
+            out[name] = float(outputs_.get(name, 0.0))
+    return out
 
 
 #: allowed ranges of the function arguments: (low, high, low_open, high_open)

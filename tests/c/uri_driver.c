@@ -3,7 +3,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-#include "clutch_core.h"
+#include "resource_uri.h"
 
 int main(int argc, char **argv) {
     char out[4096], err[600];

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from ..model import SpringTable
-from ..fe.tables import read_tables
+from .tables import read_tables
 
 UNITS_NOTE = "u_m [m] compression from the kiss point; theta_degC [degC]; force_N [N] whole spring; delta_kiss_m [m]"
 

@@ -1,0 +1,142 @@
+"""The FMI variable table is written once (clutch_model.VARIABLES): a parameter appended at the end shows up,
+with its start value and range, in the generated C table and in both FMUs (native C and pythonfmu)."""
+import dataclasses
+import json
+import re
+import shutil
+import subprocess
+import sys
+
+import pytest
+from fmpy import read_model_description
+
+from cushion_clutch.data import DEFAULT_TABLES
+from cushion_clutch.fmu import constants
+from cushion_clutch.fmu.build import build_fmu
+from cushion_clutch.fmu.native import build_native_fmu
+from cushion_clutch.fmu.variable_table import enum_name, variable_header
+from cushion_clutch.model import clutch_model
+
+EXTRA = ("k_extra", "parameter", "1", "a parameter appended at the end for this test")
+EXTRA_START, EXTRA_RANGE = 0.5, (0.0, 1.0, False, False)
+
+
+def test_header_lists_every_variable_in_value_reference_order():
+    text = variable_header()
+    body = text[text.index("enum {"):text.index("};")]
+    names = [line.strip().rstrip(",") for line in body.splitlines()[1:] if line.strip()]
+    assert names == [*(enum_name(n) for n, _, _, _ in clutch_model.VARIABLES), "CC_VR_DER_THETA_CS", "CC_NVARS"]
+    starts = clutch_model.start_values()
+    for name, causality, _, _ in clutch_model.VARIABLES:
+        row = next(line for line in text.splitlines() if line.startswith(f'    {{"{name}", '))
+        assert f"CC_{causality.upper()}, {starts[name]!r}, " in row
+        if causality == "parameter":
+            lo, hi, lo_open, hi_open = clutch_model.ClutchParameters.RANGES[name]
+            assert row.endswith(f"{{{lo!r}, {hi!r}, {int(lo_open)}, {int(hi_open)}}}}},")
+
+
+def test_a_parameter_without_a_range_is_refused(monkeypatch):
+    monkeypatch.setattr(clutch_model, "VARIABLES", clutch_model.VARIABLES + (EXTRA,))
+    monkeypatch.setattr(clutch_model, "ClutchParameters", _params_with_extra(ranged=False))
+    with pytest.raises(ValueError, match="k_extra: no range"):
+        variable_header()
+
+
+def _params_with_extra(ranged=True):
+    cls = dataclasses.make_dataclass("ClutchParameters", [(EXTRA[0], float, EXTRA_START)],
+                                     bases=(clutch_model.ClutchParameters,))
+    cls.RANGES = dict(clutch_model.ClutchParameters.RANGES, **({EXTRA[0]: EXTRA_RANGE} if ranged else {}))
+    return cls
+
+
+@pytest.fixture(scope="module")
+def extended_fmus(tmp_path_factory):
+    """Both FMUs built from a model whose VARIABLES end with EXTRA (this process and the pythonfmu copy)."""
+    tmp = tmp_path_factory.mktemp("extended")
+    model_src = tmp / "model"
+    model_src.mkdir()
+    for module, folder in constants.SLAVE_MODULES.items():
+        if folder == constants.MODEL_SRC:
+            shutil.copy(folder / module, model_src / module)
+    text = (model_src / "clutch_model.py").read_text()
+    last = [line for line in text.splitlines() if line.startswith('    ("omega_slip", "input"')][0]
+    text = text.replace(last, last + f"\n    {EXTRA!r},")
+    field = [line for line in text.splitlines() if line.startswith("    lever_ratio: float = ")][0]
+    text = text.replace(field, field + f"\n    {EXTRA[0]}: float = {EXTRA_START!r}")
+    text = text.replace('        "lever_ratio": (0.0, 100.0, True, False),\n',
+                        f'        "lever_ratio": (0.0, 100.0, True, False),\n        "{EXTRA[0]}": {EXTRA_RANGE!r},\n')
+    assert text.count(EXTRA[0]) == 3
+    (model_src / "clutch_model.py").write_text(text)
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(clutch_model, "VARIABLES", clutch_model.VARIABLES + (EXTRA,))
+        mp.setattr(clutch_model, "ClutchParameters", _params_with_extra())
+        mp.setitem(constants.SLAVE_MODULES, "clutch_model.py", model_src)
+        fmus = {"native": build_native_fmu(DEFAULT_TABLES, tmp / "native.fmu", 2, platforms=("linux64",)),
+                "python": build_fmu(DEFAULT_TABLES, tmp / "python.fmu", backend="python")}
+    return {k: (p, read_model_description(str(p))) for k, p in fmus.items()}
+
+
+#: run in a fresh interpreter: a pythonfmu FMU imports its model modules into the host process, where
+#: another FMU's (the default model's) may already sit
+RUN = """
+import json, sys
+from fmpy import extract, read_model_description
+from fmpy.fmi1 import FMICallException
+from fmpy.fmi2 import FMU2Slave
+path, value = sys.argv[1], float(sys.argv[2])
+md = read_model_description(path)
+vr = {v.name: v.valueReference for v in md.modelVariables}
+s = FMU2Slave(guid=md.guid, unzipDirectory=extract(path), modelIdentifier=md.coSimulation.modelIdentifier,
+              instanceName="extended")
+s.instantiate(loggingOn=True)
+s.setupExperiment(startTime=0.0)
+s.setReal([vr["k_extra"]], [value])
+s.enterInitializationMode()
+try:
+    s.exitInitializationMode()   # native: fmi2Error on a bad parameter; pythonfmu: refused, the step discarded
+    s.setReal([vr["x_to"]], [0.0055])
+    s.doStep(0.0, 0.1)
+    out = {"k_extra": s.getReal([vr["k_extra"]])[0], "torque": s.getReal([vr["torque"]])[0]}
+except FMICallException as exc:
+    out = {"refused": str(exc)}
+print(json.dumps(out))
+"""
+
+
+def _run(fmu, value):
+    res = subprocess.run([sys.executable, "-c", RUN, str(fmu[0]), repr(value)], capture_output=True, text=True,
+                         timeout=300)
+    assert res.returncode == 0, res.stderr[-3000:]
+    return json.loads(res.stdout.strip().splitlines()[-1]), res.stdout + res.stderr
+
+
+@pytest.mark.fmu
+@pytest.mark.parametrize("backend", ["native", "python"])
+def test_appended_parameter_is_exposed(extended_fmus, backend):
+    md = extended_fmus[backend][1]
+    var = {v.name: v for v in md.modelVariables}[EXTRA[0]]
+    assert (var.valueReference, var.causality, var.variability, var.unit) == (
+        len(clutch_model.VARIABLES), "parameter", "fixed", "1")
+    assert float(var.start) == EXTRA_START
+    names = [v.name for v in md.modelVariables]
+    assert names[:len(clutch_model.VARIABLES) + 1] == [*(n for n, _, _, _ in clutch_model.VARIABLES), EXTRA[0]]
+    out, log = _run(extended_fmus[backend], 0.75)
+    assert out.get("k_extra") == 0.75, log
+    assert out["torque"] > 0.0
+
+
+@pytest.mark.fmu
+@pytest.mark.parametrize("backend", ["native", "python"])
+def test_appended_parameter_range_is_checked(extended_fmus, backend):
+    out, log = _run(extended_fmus[backend], 1.5)
+    assert "refused" in out, log
+    assert re.search("discard|error", out["refused"], re.I), out
+    assert "k_extra" in log and "1.5" in log
+
+
+@pytest.mark.fmu
+def test_native_description_puts_the_derivative_after_the_appended_parameter(extended_fmus):
+    md = extended_fmus["native"][1]
+    der = {v.name: v for v in md.modelVariables}["der(theta_cs)"]
+    assert der.valueReference == len(clutch_model.VARIABLES) + 1
+    assert [d.variable.name for d in md.derivatives] == ["der(theta_cs)"]

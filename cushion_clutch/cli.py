@@ -8,7 +8,7 @@ import time
 from pathlib import Path
 
 from .data import DEFAULT_TABLES, tables_root
-from .errors import (CalculixNotFoundError, FmuError, ParameterError, RunInterrupted, SweepError,
+from .errors import (CalculixNotFoundError, ClusterError, FmuError, ParameterError, RunInterrupted, SweepError,
                      TableError)
 
 
@@ -86,26 +86,32 @@ def _sweep(args: argparse.Namespace) -> int:
 
 
 def _calibrate(args: argparse.Namespace) -> int:
-    from .fe.studies.calibrate import calibrate, parse_bounds, read_measured
-    from .fe.studies.calibration_report import params_toml, plot_calibration, report_text
+    from .fe.studies.calibrate import calibrate, parse_bounds
+    from .fe.studies.calibration_report import calibrated_params, params_toml, plot_calibration, report_text
+    from .fe.studies.measured import parse_measured
     from .fe.params import load_params
 
     params = load_params(args.spring)
     if args.mesh_size is not None:
         params = params.replace(mesh={"element_size_m": args.mesh_size})
-    measured = read_measured(args.measured, args.basis)
+    measured = parse_measured(args.measured, args.basis, params.material.reference_temperature_degC)
     out = Path(args.out)
     cal = calibrate(params, measured, [n.strip() for n in args.fit.split(",") if n.strip()],
                     parse_bounds(args.bounds), cache_dir=Path(args.cache), jobs=args.jobs,
                     scheduler=args.scheduler,
                     on_case=lambda n: print(f"FE case {n} done", file=sys.stderr, flush=True))
     report = report_text(cal)
+    result = calibrated_params(cal, args.name or f"{params.name}_calibrated")
     out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(params_toml(cal.params, f"calibrated by cushion-clutch calibrate to {args.measured}\n"
-                               + report), encoding="utf-8")
+    out.write_text(params_toml(result, f"calibrated by cushion-clutch calibrate to "
+                                       f"{', '.join(m.source for m in measured)}\n" + report), encoding="utf-8")
     out.with_suffix(".txt").write_text(report, encoding="utf-8")
-    png = plot_calibration(cal, out.with_suffix(".png"), f"Spring '{params.name}': FE against {Path(args.measured).name}")
-    print(report + f"wrote {out}, {out.with_suffix('.txt')} and {png}")
+    png = plot_calibration(cal, out.with_suffix(".png"),
+                           f"Spring '{params.name}': FE against {', '.join(Path(m.source).name for m in measured)}")
+    print(report + f"wrote {out} (spring '{result.name}'), {out.with_suffix('.txt')} and {png}")
+    warnings = cal.warnings()
+    if warnings:
+        print("warning: calibration not to be trusted as is: " + "; ".join(warnings), file=sys.stderr)
     return 0
 
 
@@ -233,7 +239,10 @@ def _import_scan(args: argparse.Namespace) -> int:
           f"({fr.rivet_points} points, flatness RMS {fr.rivet_rms_m * 1e6:.2f} um)")
     print(f"mid-surface fit residual: RMS {f.rms_m * 1e6:.2f} um, max {f.max_m * 1e6:.2f} um; "
           f"peak height {f.peak_m * 1e3:.4f} mm")
-    print(f"wrote {res.toml}, {res.surface} and {res.plot}")
+    c = res.coverage
+    print(f"coverage: {len(c.gaps)} gap(s) (nodes > {c.distance_limit_m * 1e3:.2f} mm from every point), "
+          + (f"largest {c.gaps[0].describe()}" if c.gaps else "none") + "; none on the wave beyond the limits")
+    print(f"wrote {res.toml}, {res.surface}, {res.plot} and {res.coverage_plot}")
     return 0
 
 
@@ -280,8 +289,12 @@ def _tolerance(args: argparse.Namespace) -> int:
         print(f"{label}: P5 {p5:.4g}, P50 {p50:.4g}, P95 {p95:.4g} {unit}; band width P95-P5 "
               f"{p95 - p5:.4g} {unit}")
     for q, (index, value, target) in res.picks.items():
+        x_ref = next(s.x_kiss_ref_m for s in res.summaries if s.sample.index == index)
         print(f"P{q:02.0f} table set {res.sets[q]}: sample {index} (value {value:.4g}, P{q:02.0f} {target:.4g}; "
-              f"ranked by {RANK_BY[args.rank_by]})")
+              f"ranked by {RANK_BY[args.rank_by]}); its own x_kiss_ref = {x_ref * 1e3:.4f} mm "
+              f"(build-fmu takes it from metadata.json)")
+    for w in res.warnings:
+        print(f"warning: {w}", file=sys.stderr)
     print("wrote " + ", ".join(str(f) for f in res.files))
     return 0
 
@@ -308,13 +321,17 @@ def build_parser() -> argparse.ArgumentParser:
     sw.set_defaults(func=_sweep)
 
     ca = sub.add_parser("calibrate", help="fit spring parameters to a measured load-deflection curve")
-    ca.add_argument("--measured", required=True, help="CSV u_m,force_N from the kiss point (room temperature)")
+    ca.add_argument("--measured", required=True, action="append",
+                    help="CSV u_m,force_N, u from the reference temperature's kiss point, as measured (noise "
+                         "kept): FILE (reference temperature) or THETA_DEGC=FILE; repeat for hot curves, "
+                         "e.g. --measured 20=bench20.csv --measured 195=bench195.csv")
     ca.add_argument("--basis", choices=("pair", "spring"), default="pair",
                     help="the measured force is of one paddle pair (default) or the whole spring")
     ca.add_argument("--spring", default=DEFAULT_SPRING, help="start parameter TOML")
     ca.add_argument("--fit", required=True, help="comma-separated keys, e.g. wave_height_m,thickness_m")
     ca.add_argument("--bounds", help="NAME=LOWER:UPPER,... (default: start value +-30 %%)")
     ca.add_argument("--out", required=True, help="calibrated TOML (report .txt and .png beside it)")
+    ca.add_argument("--name", help="name of the calibrated spring (default: <spring name>_calibrated)")
     ca.add_argument("--mesh-size", type=float, help="override mesh.element_size_m [m]")
     ca.add_argument("--jobs", type=int, default=2, help="parallel ccx jobs")
     ca.add_argument("--scheduler", help="Dask scheduler address, e.g. tcp://host:8786")
@@ -355,7 +372,8 @@ def build_parser() -> argparse.ArgumentParser:
     im.add_argument("scan", help="point cloud CSV (x,y,z header) or STL/PLY/OBJ surface")
     im.add_argument("--spring", default=DEFAULT_SPRING, help="base spring TOML (plan shape, rivet zone, material)")
     im.add_argument("--out", required=True, help="spring TOML to write (the surface .npz and PNG go next to it)")
-    im.add_argument("--unit", choices=("mm", "m"), default="mm", help="length unit of the scan (default mm)")
+    im.add_argument("--unit", choices=("um", "mm", "cm", "in", "m"), default="mm",
+                    help="length unit of the scan (default mm)")
     im.add_argument("--face", choices=("top", "bottom", "mid"), default="top",
                     help="scanned face: top (away from the carrier, default), bottom, or mid-surface")
     im.add_argument("--datum", choices=("rigid", "offset"), default="rigid",
@@ -408,7 +426,7 @@ def main(argv: list[str] | None = None) -> int:
             raise
         print(f"error: {_one_message(exc)}", file=sys.stderr)
         return 2
-    except SweepError as exc:
+    except (SweepError, ClusterError) as exc:
         if args.debug:
             raise
         print(f"error: {exc}", file=sys.stderr)

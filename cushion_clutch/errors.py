@@ -134,8 +134,10 @@ class ScanError(ParameterError):
     Like :class:`ParameterError`, it lists every problem found.
     """
 
-    def __init__(self, problems: Sequence[str], source: str | None = None):
+    def __init__(self, problems: Sequence[str], source: str | None = None, coverage=None):
         super().__init__(problems, source)
+        #: the scan's point coverage (:class:`cushion_clutch.fe.scan.fit.Coverage`) when gaps refused it
+        self.coverage = coverage
         where = f" {source}" if source else ""
         lines = "\n  - ".join(self.problems)
         self.args = (f"cannot import the scan{where}:\n  - {lines}",)
@@ -159,6 +161,12 @@ class StudyError(SweepError):
         RuntimeError.__init__(
             self, f"{len(failures)} case(s) of the tolerance study failed; finished cases are cached "
                   f"(a rerun resumes) and no band was written:\n{lines}")
+
+
+class ClusterError(RuntimeError):
+    """A Dask cluster cannot run the FE cases: no worker, a worker that lacks the
+    package or ccx, workers with different ccx versions, or workers lost mid-study.
+    The message names every worker concerned; finished cases stay cached."""
 
 
 class FmuCallError(RuntimeError):

@@ -35,6 +35,7 @@ from pythonfmu.enums import Fmi2Status
 
 from clutch_model import (OMEGA_SLIP_LIMIT, THETA_CM_LIMIT, VARIABLES, X_TO_LIMIT, ClutchParameters, SpringTable,
                           outputs, start_values, thermal_step)
+from table_format import table_set_x_kiss_ref
 
 CAUSALITY = {"input": (Fmi2Causality.input, Fmi2Variability.continuous),
              "output": (Fmi2Causality.output, Fmi2Variability.continuous),
@@ -80,7 +81,13 @@ class CushionClutch(Fmi2Slave):
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
         _tidy_sys_path(self.resources)
-        defaults = ClutchParameters()
+        folder = Path(self.resources) / "tables" if self.resources else None
+        table_error = None
+        try:                                # a tolerance P5/P95 set places its own kiss point at the bearing
+            x_kiss_ref = table_set_x_kiss_ref(folder) if folder is not None and folder.is_dir() else None
+        except ValueError as exc:
+            x_kiss_ref, table_error = None, str(exc)
+        defaults = ClutchParameters() if x_kiss_ref is None else ClutchParameters(x_kiss_ref=x_kiss_ref)
         for name, value in start_values(defaults).items():
             setattr(self, name, value)
         self._range_warned = False
@@ -90,17 +97,16 @@ class CushionClutch(Fmi2Slave):
         self._phase = "instantiated"
         self._time: float | None = None
         self._table = None
-        self._table_error = None
+        self._table_error = table_error
         for name, causality, unit, desc in VARIABLES:
             kind, variability = CAUSALITY[causality]
             self.register_variable(Real(name, causality=kind, variability=variability,
                                         description=f"{desc} [{unit}]"))
         self._names = {vr: var.name for vr, var in self.vars.items()}
         self._kinds = {vr: dict((n, c) for n, c, _, _ in VARIABLES)[var.name] for vr, var in self.vars.items()}
-        folder = Path(self.resources) / "tables" if self.resources else None
         if folder is None or not folder.is_dir():
             self._table_error = f"resources folder {self.resources!r} has no tables/ folder"
-        else:
+        elif table_error is None:
             try:
                 self._table = SpringTable.from_dir(folder)
             except Exception as exc:  # noqa: BLE001 - reported at initialisation, never raised

@@ -58,15 +58,17 @@ def test_remote_solve_uses_the_shipped_surface_not_the_path(coarse, tmp_path):
 @pytest.mark.ccx
 def test_dask_run_closes_the_client_it_made_and_caches_with_the_workers_version(coarse, tmp_path, monkeypatch):
     distributed = pytest.importorskip("distributed")
+    import contextlib
     made = []
-    connect = cases.connect
+    open_cluster = cases.open_cluster
 
+    @contextlib.contextmanager
     def spy(scheduler, workers):
-        client, owned, cluster = connect(scheduler, workers)
-        made.append((client, cluster))
-        return client, owned, cluster
+        with open_cluster(scheduler, workers) as (client, info):
+            made.append((client, client.cluster))
+            yield client, info
 
-    monkeypatch.setattr(cases, "connect", spy)
+    monkeypatch.setattr(cases, "open_cluster", spy)
     p = coarse.replace(sweep={"temperatures_degC": (20.0,)})
     outcomes, failures = run_cases([Case(p, 20.0, 1, "t")], cache_dir=tmp_path, jobs=1, local_cluster=True)
     assert failures == {} and outcomes[0] is not None and not outcomes[0].from_cache

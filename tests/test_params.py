@@ -91,3 +91,30 @@ def test_old_penalty_key_is_rejected_and_new_ones_checked():
         params_from_dict({"solver": {"surface_penalty_Pa_per_m": 10}})
     with pytest.raises(ParameterError, match=r"mesh\.element_type = 'S3': allowed"):
         params_from_dict({"mesh": {"element_type": "S3"}})
+
+
+def test_a_carrier_clearance_below_the_thermal_growth_is_refused_with_the_minimum():
+    p = load_params()
+    need = p.material.expansion_coefficient_per_K * (300.0 - 20.0) * 0.5 * p.geometry.thickness_m
+    assert p.min_carrier_clearance_m() == pytest.approx(need)
+    with pytest.raises(ParameterError, match=rf"carrier_clearance_m = 0: below the sheet's thermal growth .* "
+                                             rf"at 300 degC .*allowed >= {need:.3g} m"):
+        p.replace(geometry={"carrier_clearance_m": 0.0})
+    # no heating above the reference, or no thermal distortion: no minimum
+    assert p.replace(geometry={"carrier_clearance_m": 0.0}, sweep={"temperatures_degC": (20.0,)})
+    assert p.replace(geometry={"carrier_clearance_m": 0.0}, sweep={"thermal_distortion": False})
+
+
+def test_a_case_whose_plates_take_force_from_heating_alone_is_refused():
+    import numpy as np
+
+    from cushion_clutch.errors import ResultError
+    from cushion_clutch.fe.results import CaseResult
+    from cushion_clutch.fe.cases import check_heating
+    p = load_params().replace(geometry={"carrier_clearance_m": 1e-6})
+    ok = CaseResult(300.0, 1, 1e-4, np.zeros(3), np.zeros(3), 0.0, 0.0)
+    check_heating(ok, p)
+    bad = CaseResult(300.0, 1, 1e-4, np.zeros(3), np.zeros(3), 0.0, 54.5)   # measured at 1 um, 2 mm mesh
+    with pytest.raises(ResultError, match=r"theta = 300 degC: heating alone pressed the paddle on the carrier "
+                                          r"with 54.5 N .*geometry.carrier_clearance_m = 1e-06 m"):
+        check_heating(bad, p)

@@ -119,6 +119,11 @@ def test_stl_surface_via_meshio(tmp_path):
     ("nan", "mm", r"1 point\(s\) with NaN or infinite coordinates \(data rows 7\)"),
     ("units", "m", r"the paddle is 99\dx too large.*probably 'mm', not --unit 'm'"),
     ("holes", "mm", r"the points cover \d+% of the paddle sector"),
+    ("inch", "mm", r"0.039\dx too small.*probably 'in', not --unit 'mm'"),
+    ("cm", "mm", r"0.0\d+x too small.*probably 'cm', not --unit 'mm'"),
+    ("rim", "mm", r"a gap of \d+\.\d mm\^2 \(limit 4 mm\^2\) on the wave's crest \(outer rim\) at r = 10[5-7]\.\d\.\.108\.0 mm"),
+    ("crest_hole", "mm", r"a gap of \d+\.\d mm\^2 \(limit 4 mm\^2\) on the wave's crest at r = 9\d"),
+    ("flank_hole", "mm", r"a gap of \d+\.\d mm\^2 \(limit 10 mm\^2\) on the wave's flank at"),
 ])
 def test_malformed_scans_get_one_clear_message(case, unit, message, tmp_path, capsys):
     geom = load_params().geometry
@@ -130,7 +135,14 @@ def test_malformed_scans_get_one_clear_message(case, unit, message, tmp_path, ca
         pts[6, 1] = np.nan
     elif case == "holes":
         pts = pts[np.degrees(np.arctan2(pts[:, 1], pts[:, 0])) < 9.0]
-    write_csv(tmp_path / "scan.csv", pts)
+    r, phi = np.hypot(pts[:, 0], pts[:, 1]), np.degrees(np.arctan2(pts[:, 1], pts[:, 0]))
+    if case == "rim":               # the outer 1.8 mm over the wave: 4 % of the area
+        pts = pts[~((r > 0.1062) & (phi > 5) & (phi < 20))]
+    elif case == "crest_hole":      # 8 mm x 5 deg over the crest: 6 % of the area
+        pts = pts[~((np.abs(r - 0.100) < 4e-3) & (np.abs(phi - 12.5) < 2.5))]
+    elif case == "flank_hole":      # 6 mm x 2.6 deg on the rising flank: 2 % of the area
+        pts = pts[~((np.abs(r - 0.085) < 3e-3) & (np.abs(phi - 6.2) < 1.3))]
+    write_csv(tmp_path / "scan.csv", pts, unit_m={"inch": 0.0254, "cm": 0.01}.get(case, 1e-3))
     code = main(["import-scan", str(tmp_path / "scan.csv"), "--out", str(tmp_path / "s.toml"), "--unit", unit])
     err = capsys.readouterr().err
     assert code == 2 and "Traceback" not in err
@@ -138,6 +150,21 @@ def test_malformed_scans_get_one_clear_message(case, unit, message, tmp_path, ca
     import re
     assert re.search(message, err), err
     assert not (tmp_path / "s.toml").exists()
+    if case.endswith(("rim", "hole")):     # the coverage map shows where to rescan
+        assert f"coverage map: {tmp_path / 's_coverage.png'}" in err
+        assert (tmp_path / "s_coverage.png").stat().st_size > 10000
+
+
+def test_a_gap_on_the_flat_far_zone_is_mapped_and_accepted(tmp_path):
+    geom = load_params().geometry
+    pts = synthetic_scan(geom, n=5000)
+    r, phi = np.hypot(pts[:, 0], pts[:, 1]), np.degrees(np.arctan2(pts[:, 1], pts[:, 0]))
+    write_csv(tmp_path / "scan.csv", pts[~((np.abs(r - 0.090) < 3e-3) & (phi > 20.5))])
+    res = import_scan(tmp_path / "scan.csv", DEFAULT_SPRING, tmp_path / "s.toml")
+    assert res.coverage.refused == [] and len(res.coverage.gaps) >= 1
+    g = res.coverage.gaps[0]
+    assert g.region.startswith("the flat zone") and g.area_m2 > 4e-6 and g.phi_deg[1] == pytest.approx(22.0)
+    assert res.coverage_plot.stat().st_size > 20000
 
 
 def test_unreadable_and_wrong_columns(tmp_path):

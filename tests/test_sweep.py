@@ -164,3 +164,9 @@ def test_tilted_wave_is_more_progressive_than_plain_cosine(coarse, case_cache):
         c = curve_from_case(case.result, p.n_pairs, p.sweep.kiss_force_N)
         ratios[name] = progressivity(c.u_m, c.force_N)["k90_over_k20"]
     assert ratios["tilted"] > 1.5 * ratios["cosine"], ratios
+
+
+def test_heating_alone_loads_no_plate(two_temps, case_cache):
+    """The plates are held while the paddle heats: no force on the carrier or the facing plate."""
+    for theta, o in run_sweep(two_temps, cache_dir=case_cache).items():
+        assert abs(o.result.thermal_force_lower_N) < 0.05 and abs(o.result.thermal_force_N) < 0.05, theta

@@ -64,6 +64,7 @@ def test_deviations_apply_and_never_enter_the_cache_key():
 @pytest.mark.fmu
 def test_study_on_a_local_cluster_equals_one_by_one_and_resumes(coarse, tmp_path, capsys):
     """2 drawn samples + nominal at 20 degC on a LocalCluster of 2 single-threaded workers."""
+    from fmpy import read_model_description
     from fmpy.validation import validate_fmu
 
     from cushion_clutch.cli import main
@@ -91,8 +92,10 @@ def test_study_on_a_local_cluster_equals_one_by_one_and_resumes(coarse, tmp_path
     assert main(["tolerance", "--spring", str(spring), "--samples", "2", "--seed", "5", "--temperatures", "20",
                  "--mesh-size", str(coarse.mesh.element_size_m), "--out", str(out),
                  "--cache", str(tmp_path / "study")]) == 0
-    text = capsys.readouterr().out
+    captured = capsys.readouterr()
+    text = captured.out
     assert "3 FE cases (3 from the cache)" in text
+    assert "warning: only 2 samples: P5 and P95" in captured.err
     meta = json.loads((out / "default_tolerance" / "study.json").read_text())
     assert meta["cases_from_cache"] == 3
     rows = (out / "default_tolerance" / "samples.csv").read_text().splitlines()
@@ -101,8 +104,11 @@ def test_study_on_a_local_cluster_equals_one_by_one_and_resumes(coarse, tmp_path
         tables = read_tables(out / f"default_{q}")
         pick = tables.metadata["tolerance_study"]
         assert pick["sample"] in (1, 2) and pick["percentile"] in (5.0, 95.0)
+        assert pick["warnings"] and f"its own x_kiss_ref = {pick['x_kiss_ref_m'] * 1e3:.4f} mm" in text
         fmu = build_fmu(out / f"default_{q}", tmp_path / f"{q}.fmu")
         assert validate_fmu(str(fmu)) == []
+        start = {v.name: v.start for v in read_model_description(str(fmu)).modelVariables}
+        assert float(start["x_kiss_ref"]) == pytest.approx(pick["x_kiss_ref_m"], abs=1e-15)
     assert (out / "default_tolerance" / "tolerance_bands.png").stat().st_size > 20000
 
 
@@ -118,3 +124,43 @@ def test_cli_refuses_a_spring_without_tolerances_and_the_package_tables(tmp_path
     assert "shipped with cushion-clutch" in capsys.readouterr().err
     assert main(["tolerance", "--samples", "4", "--temperatures", "195", "--out", str(tmp_path)]) == 2
     assert "must include material.reference_temperature_degC = 20" in capsys.readouterr().err
+
+
+def _shifted_tables(tmp_path, x_kiss_ref_m):
+    """The default tables as a tolerance P5 set whose own kiss point sits at ``x_kiss_ref_m``."""
+    import shutil
+
+    from cushion_clutch.data import DEFAULT_TABLES
+    tables = tmp_path / "default_p05"
+    shutil.copytree(DEFAULT_TABLES, tables)
+    meta = json.loads((tables / "metadata.json").read_text())
+    meta["tolerance_study"] = {"percentile": 5.0, "sample": 3, "x_kiss_ref_m": x_kiss_ref_m}
+    (tables / "metadata.json").write_text(json.dumps(meta))
+    return tables
+
+
+@pytest.mark.fmu
+@pytest.mark.parametrize("backend, version", [("native", 2), ("native", 3), ("python", 2)])
+def test_a_percentile_set_builds_an_fmu_with_its_own_kiss_point(tmp_path, capsys, backend, version):
+    """build-fmu takes x_kiss_ref from the set's metadata: in the description and in the running FMU."""
+    from fmpy import read_model_description, simulate_fmu
+
+    from cushion_clutch.cli import main
+    tables = _shifted_tables(tmp_path, 4.22e-3)
+    fmu = tmp_path / "p05.fmu"
+    assert main(["build-fmu", "--tables", str(tables), "-o", str(fmu), "--backend", backend,
+                 "--fmi-version", str(version)]) == 0
+    assert "x_kiss_ref = 4.2200 mm (the table set's own kiss point" in capsys.readouterr().out
+    md = read_model_description(str(fmu))
+    start = {v.name: v.start for v in md.modelVariables}
+    assert float(start["x_kiss_ref"]) == pytest.approx(4.22e-3, abs=1e-12)
+    # at 20 degC (the tables' reference) the kiss point at the bearing is x_kiss_ref itself
+    res = simulate_fmu(str(fmu), stop_time=0.01, output_interval=0.01, output=["x_kiss", "u_f"],
+                       start_values={"x_to": 5e-3, "theta_cm": 293.15})
+    assert res["x_kiss"][-1] == pytest.approx(4.22e-3, abs=1e-9)
+    assert res["u_f"][-1] == pytest.approx((5e-3 - 4.22e-3) / 3.0, rel=1e-9)
+
+
+def test_fewer_than_20_samples_warn_that_p5_p95_are_the_extremes():
+    from cushion_clutch.fe.studies.tolerance_report import percentile_warnings
+    assert "only 4 samples" in percentile_warnings(4)[0] and percentile_warnings(20) == []

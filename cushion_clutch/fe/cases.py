@@ -13,11 +13,17 @@ Every study that runs ccx goes through :func:`run_cases`: the temperature sweep
   written atomically (a temporary file renamed into place) as soon as a case
   finishes, so an interrupted run keeps what it finished and resumes.
 - **Where cases run**: on this machine, one thread per running case (each waits
-  on one ccx process; Ctrl-C drops the queue and ends running ccx), or on Dask:
-  an external scheduler (address or client) or a ``LocalCluster`` of
-  single-threaded worker processes. Every input file a case needs (today a
+  on one ccx process, with the idle cores as ccx threads when there are fewer
+  cases than jobs, :func:`idle_threads`; Ctrl-C drops the queue and ends running
+  ccx), or on Dask through the one choke point :mod:`.cluster`: an external
+  scheduler (address or client) or a ``LocalCluster`` of single-threaded worker
+  processes. Every worker is checked first (package importable at this version,
+  ccx runs, one ccx version; what a worker lacks is named), lost workers are
+  reported, and the client needs no ccx. Every input file a case needs (today a
   scanned surface) travels with the task, so workers need no shared disk. A
   client or cluster made here is closed here.
+- **Heating check** (:func:`check_heating`): a case whose plates carry force
+  from heating alone (carrier clearance too small) is refused.
 """
 from __future__ import annotations
 
@@ -38,6 +44,8 @@ import numpy as np
 from .. import __version__, interrupt
 from ..errors import CalculixNotFoundError, CcxVersionError
 from .ccx import RunStats, ccx_version, run_ccx
+from .cluster import open_cluster
+from .cluster import run_cases as run_on_cluster
 from .deck import paddle_deck
 from .geometry import half_pair_assembly, pair_assembly
 from .params import SpringParams
@@ -74,19 +82,23 @@ class CaseOutcome:
     n_nodes: int
     n_elements: int
     from_cache: bool = False
+    ccx_version: str = "unknown"
+    """the CalculiX version that solved it (on whichever machine ran it)"""
 
     def to_json(self) -> dict:
         r = self.result
         return {"theta_degC": r.theta_degC, "paddles": r.paddles, "crest_rise_m": r.crest_rise_m,
                 "travel_m": r.travel_m.tolist(), "force_N": r.force_N.tolist(),
-                "thermal_force_N": r.thermal_force_N, "stats": vars(self.stats),
-                "n_nodes": self.n_nodes, "n_elements": self.n_elements}
+                "thermal_force_N": r.thermal_force_N, "thermal_force_lower_N": r.thermal_force_lower_N,
+                "stats": vars(self.stats),
+                "n_nodes": self.n_nodes, "n_elements": self.n_elements, "ccx_version": self.ccx_version}
 
     @classmethod
     def from_json(cls, d: dict) -> "CaseOutcome":
         r = CaseResult(d["theta_degC"], d["paddles"], d["crest_rise_m"], np.array(d["travel_m"]),
-                       np.array(d["force_N"]), d["thermal_force_N"])
-        return cls(r, RunStats(**d["stats"]), d["n_nodes"], d["n_elements"], from_cache=True)
+                       np.array(d["force_N"]), d["thermal_force_N"], d.get("thermal_force_lower_N", 0.0))
+        return cls(r, RunStats(**d["stats"]), d["n_nodes"], d["n_elements"], from_cache=True,
+                   ccx_version=d.get("ccx_version", "unknown"))
 
 
 def solve_case(params: SpringParams, theta_degC: float, workdir: Path, *, paddles: int = 1,
@@ -120,8 +132,55 @@ def solve_case(params: SpringParams, theta_degC: float, workdir: Path, *, paddle
     stats = run_ccx(deck, Path(workdir), threads=params.solver.threads,
                     theta_degC=theta_degC, on_line=on_line)
     result = parse_case(Path(workdir) / "case.dat", theta_degC, assembly.paddles)
+    check_heating(result, params)
     n_nodes = assembly.mesh.n_nodes
-    return CaseOutcome(result, stats, n_nodes, assembly.mesh.n_elements)
+    return CaseOutcome(result, stats, n_nodes, assembly.mesh.n_elements, ccx_version=ccx_version())
+
+
+#: heating alone may load a plate by at most this fraction of the kiss force (contact noise)
+HEATING_FORCE_FRACTION = 0.1
+
+
+def check_heating(result: CaseResult, params: SpringParams) -> None:
+    """Refuse a case in which heating alone pressed the paddle on a plate (a spurious force).
+
+    The plates are held during heating, so any force on them then is an
+    artefact: the carrier clearance is below the paddle's growth towards the
+    carrier (or within the contact law's reach of it).
+
+    Raises
+    ------
+    ResultError
+        Naming the force, the clearance and the least clearance to try.
+    """
+    from ..errors import ResultError
+    limit = HEATING_FORCE_FRACTION * params.sweep.kiss_force_N
+    worst = max(abs(result.thermal_force_N), abs(result.thermal_force_lower_N))
+    if worst > limit:
+        g = params.geometry
+        raise ResultError(
+            f"theta = {result.theta_degC:g} degC: heating alone pressed the paddle on "
+            f"{'the carrier' if abs(result.thermal_force_lower_N) >= abs(result.thermal_force_N) else 'a plate'} "
+            f"with {worst:.3g} N (limit {limit:.3g} N, {HEATING_FORCE_FRACTION:.0%} of the kiss force): "
+            f"geometry.carrier_clearance_m = {g.carrier_clearance_m:g} m is below the paddle's growth towards "
+            f"the carrier (the sheet alone: {params.min_carrier_clearance_m():.3g} m at "
+            f"{max(params.sweep.temperatures_degC):g} degC) plus the contact law's reach; use at least "
+            f"{max(1e-5, 2 * params.min_carrier_clearance_m()):.3g} m")
+
+
+def idle_threads(slots: int, n_cases: int) -> int:
+    """ccx threads per case when ``n_cases`` run on ``slots`` jobs: the idle cores shared out.
+
+    Cores that other processes keep busy (the 1-minute load average) do not
+    count: on a loaded machine extra threads only contend (2 threads ran 0.69x as
+    fast as 1 at load 15-19 on 2 cores). Cache keys ignore ``solver.threads``.
+    """
+    cores = os.cpu_count() or 1
+    try:
+        idle = max(1, int(cores - os.getloadavg()[0] + 0.5))
+    except OSError:                                 # no load average on this platform
+        idle = cores
+    return max(1, min(idle, cores, slots // max(1, n_cases)))
 
 
 def case_key(params: SpringParams, theta_degC: float, paddles: int, ccx: str) -> str:
@@ -163,54 +222,35 @@ def input_files(params: SpringParams) -> list[str]:
     return [params.geometry.surface_file] if params.geometry.surface_file else []
 
 
+def solve_shipped(params: SpringParams, theta_degC: float, paddles: int, surface: bytes | None,
+                  threads: int) -> dict:
+    """On a Dask worker: solve one case in a private folder with its shipped surface; return its JSON data.
+
+    The function :func:`.cluster.run_cases` submits; the data carry the
+    worker's ccx version (``ccx_version``), so the client needs no ccx.
+    """
+    with tempfile.TemporaryDirectory(prefix="cushion_case_") as tmp:
+        if params.geometry.surface_file:
+            if surface is None:
+                raise ValueError(f"{params.geometry.surface_file}: the scanned surface was not shipped")
+            path = Path(tmp) / "surface.npz"
+            path.write_bytes(surface)
+            params = params.replace(geometry={"surface_file": str(path)})
+        work = Path(tmp) / "ccx"
+        work.mkdir()
+        return solve_case(params.replace(solver={"threads": threads}), theta_degC, work,
+                          paddles=paddles).to_json()
+
+
 def solve_remote(params: SpringParams, theta_degC: float, paddles: int, files: dict[str, bytes]) -> tuple[dict, str]:
-    """On a worker: solve one case in a private folder; return its JSON data and the worker's ccx version.
+    """:func:`solve_shipped` with the input files as a dict; return its JSON data and the worker's ccx version.
 
     ``files`` maps each input file name of :func:`input_files` to its content;
     they are written into the private folder, so workers need no shared disk.
     """
-    with tempfile.TemporaryDirectory(prefix="cushion_case_") as tmp:
-        if params.geometry.surface_file:
-            path = Path(tmp) / "surface.npz"
-            path.write_bytes(files[params.geometry.surface_file])
-            params = params.replace(geometry={"surface_file": str(path)})
-        work = Path(tmp) / "ccx"
-        work.mkdir()
-        return solve_case(params, theta_degC, work, paddles=paddles).to_json(), ccx_version()
-
-
-def connect(scheduler: str | object | None = None, workers: int | None = None):
-    """A Dask client, the client to close (None if the caller's) and the LocalCluster made here (or None).
-
-    ``scheduler``: an address, a ``distributed.Client``, or None for a
-    LocalCluster of ``workers`` single-threaded processes (default: cores).
-    """
-    from distributed import Client, LocalCluster
-    if scheduler is None:
-        cluster = LocalCluster(n_workers=workers or os.cpu_count() or 1, threads_per_worker=1,
-                               processes=True, dashboard_address=None)
-        client = Client(cluster)
-        return client, client, cluster
-    if isinstance(scheduler, str):
-        client = Client(scheduler)
-        return client, client, None
-    return scheduler, None, None
-
-
-def workers_ccx_version(client) -> str:
-    """The ccx version every worker of ``client`` reports (waits for a first worker).
-
-    Raises
-    ------
-    CcxVersionError
-        If the workers report different versions.
-    """
-    client.wait_for_workers(1)
-    versions = client.run(ccx_version)
-    if len(set(versions.values())) != 1:
-        raise CcxVersionError("Dask workers report different ccx versions, so their cases would not be "
-                              f"comparable: {versions}")
-    return next(iter(versions.values()))
+    sf = params.geometry.surface_file
+    data = solve_shipped(params, theta_degC, paddles, files[sf] if sf else None, params.solver.threads)
+    return data, data["ccx_version"]
 
 
 def run_cases(cases: list[Case], *, cache_dir: Path = DEFAULT_CACHE, jobs: int | None = None,
@@ -225,7 +265,7 @@ def run_cases(cases: list[Case], *, cache_dir: Path = DEFAULT_CACHE, jobs: int |
         processes (default: number of cores).
     scheduler : str or distributed.Client, optional
         Run on this Dask scheduler's workers (an address or a client; a client
-        made here is closed here).
+        made here is closed here), checked first by :func:`.cluster.open_cluster`.
     local_cluster : bool
         Without ``scheduler``: run on a LocalCluster of ``jobs`` processes
         instead of threads.
@@ -236,6 +276,12 @@ def run_cases(cases: list[Case], *, cache_dir: Path = DEFAULT_CACHE, jobs: int |
     -------
     outcomes, failures
         Per case its outcome (None if it failed), and case index to exception.
+
+    Raises
+    ------
+    ClusterError
+        If the Dask workers cannot run the cases (each worker named with what
+        it lacks) or all of them were lost (finished cases stay cached).
     """
     cache_dir = Path(cache_dir)
 
@@ -246,28 +292,20 @@ def run_cases(cases: list[Case], *, cache_dir: Path = DEFAULT_CACHE, jobs: int |
     use_dask = scheduler is not None or local_cluster
     outcomes: list[CaseOutcome | None] = [None] * len(cases)
     failures: dict[int, BaseException] = {}
-    client = owned = cluster = None
-    try:
-        # the key holds the solving machine's ccx version: this machine's, or (Dask) the workers'
-        # once they are asked, which only happens if a case is not cached under this machine's version
-        ccx = _local_ccx(required=not use_dask)
-        todo = _lookup(cases, cache_dir, ccx, range(len(cases)), outcomes, emit) if ccx else list(range(len(cases)))
-        if todo and use_dask:
-            client, owned, cluster = connect(scheduler, jobs)
-            workers = workers_ccx_version(client)
-            if workers != ccx:
-                ccx = workers
+    # the key holds the solving machine's ccx version: this machine's, or (Dask) the workers'
+    # once they are checked, which only happens if a case is not cached under this machine's version
+    ccx = _local_ccx(required=not use_dask)
+    todo = _lookup(cases, cache_dir, ccx, range(len(cases)), outcomes, emit) if ccx else list(range(len(cases)))
+    if todo and use_dask:
+        with open_cluster(scheduler, jobs) as (client, info):
+            if info.ccx_version != ccx:
+                ccx = info.ccx_version
                 todo = _lookup(cases, cache_dir, ccx, todo, outcomes, emit)
-            _run_dask(client, cases, [(i, case_folder(cache_dir, cases[i], ccx)) for i in todo], ccx,
+            _run_dask(client, info, cases, [(i, case_folder(cache_dir, cases[i], ccx)) for i in todo],
                       outcomes, failures, emit)
-        elif todo:
-            _run_threads(cases, [(i, case_folder(cache_dir, cases[i], ccx)) for i in todo], jobs,
-                         outcomes, failures, emit)
-    finally:
-        if owned is not None:
-            owned.close()
-        if cluster is not None:
-            cluster.close()
+    elif todo:
+        _run_threads(cases, [(i, case_folder(cache_dir, cases[i], ccx)) for i in todo], jobs,
+                     outcomes, failures, emit)
     return outcomes, failures
 
 
@@ -302,53 +340,50 @@ def _failed(case: Case, i: int, exc: BaseException, failures: dict, emit) -> Non
     emit(i, "failed", 0.0)
 
 
-def _run_dask(client, cases, todo, ccx, outcomes, failures, emit) -> None:
-    from distributed import as_completed as dask_completed
-    blobs: dict[str, object] = {}
-    futures = {}
-    for i, folder in todo:
-        case = cases[i]
-        names = input_files(case.params)
-        for name in names:
-            if name not in blobs:
-                blobs[name] = client.scatter(Path(name).read_bytes(), broadcast=True)
-        fut = client.submit(solve_remote, case.params, case.theta_degC, case.paddles,
-                            {name: blobs[name] for name in names}, pure=False)
-        futures[fut] = (i, folder)
-    for fut in dask_completed(futures):
-        i, folder = futures[fut]
-        try:
-            data, version = fut.result()
-            if version != ccx:
-                raise CcxVersionError(f"solved by ccx {version}, not {ccx} (the version of its cache key); "
-                                      "not cached")
-        except Exception as exc:  # noqa: BLE001 - collected and returned
+def _run_dask(client, info, cases, todo, outcomes, failures, emit) -> None:
+    """Solve ``todo`` on the checked cluster (:func:`.cluster.run_cases`), caching each as it ends."""
+    folders = dict(todo)
+    ccx = info.ccx_version
+
+    def on_done(i: int, data: dict | None, exc: BaseException | None) -> None:
+        if exc is None and data.get("ccx_version") != ccx:
+            exc = CcxVersionError(f"solved by ccx {data.get('ccx_version')}, not {ccx} (the version of its "
+                                  "cache key); not cached")
+        if exc is not None:
             _failed(cases[i], i, exc, failures, emit)
-        else:
-            store(folder, data)
-            outcomes[i] = dataclasses.replace(CaseOutcome.from_json(data), from_cache=False)
-            emit(i, "done", 1.0)
+            return
+        store(folders[i], data)
+        outcomes[i] = dataclasses.replace(CaseOutcome.from_json(data), from_cache=False)
+        emit(i, "done", 1.0)
+
+    run_on_cluster(client, info, solve_shipped,
+                   [(i, cases[i].params, cases[i].theta_degC, cases[i].paddles) for i, _ in todo], on_done)
 
 
 def _run_threads(cases, todo, jobs, outcomes, failures, emit) -> None:
     lock = threading.Lock()
+    slots = jobs or os.cpu_count() or 1
+    threads = idle_threads(slots, len(todo))       # fewer cases than jobs: the idle cores as ccx threads
 
     def work(i: int, folder: Path) -> CaseOutcome:
         case = cases[i]
+        params = case.params
+        if threads > params.solver.threads:
+            params = params.replace(solver={"threads": threads})
         emit(i, "start", 0.0)
 
         def inc(n: int) -> None:
             with lock:
                 emit(i, "increment", n)
         interrupt.check()                       # cancelled while queued: do not start
-        outcome = solve_case(case.params, case.theta_degC, folder, paddles=case.paddles, on_increment=inc)
+        outcome = solve_case(params, case.theta_degC, folder, paddles=case.paddles, on_increment=inc)
         with lock:                              # cached at once, so an interrupt keeps it
             store(folder, outcome.to_json())
             outcomes[i] = outcome
             emit(i, "done", 1.0)
         return outcome
 
-    pool = ThreadPoolExecutor(max_workers=jobs or os.cpu_count() or 1)
+    pool = ThreadPoolExecutor(max_workers=slots)
     try:
         futs = {pool.submit(work, i, f): i for i, f in todo}
         for fut in as_completed(futs):

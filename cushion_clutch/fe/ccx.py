@@ -66,7 +66,12 @@ def ccx_version() -> str:
 @functools.lru_cache(maxsize=None)
 def _version_of(executable: str) -> str:
     out = subprocess.run([executable, "-v"], capture_output=True, text=True, timeout=30)
-    m = re.search(r"Version\s+([\w.]+)", out.stdout + out.stderr)
+    return parse_version(out.stdout + out.stderr)
+
+
+def parse_version(text: str) -> str:
+    """The version in the output of ``ccx -v`` (``unknown`` if none is printed)."""
+    m = re.search(r"Version\s+([\w.]+)", text)
     return m.group(1) if m else "unknown"
 
 

@@ -415,6 +415,29 @@ class SpringParams(Checked):
         if not isinstance(self.name, str) or not self.name or not all(
                 c.isalnum() or c in "-_." for c in self.name):
             yield f"name = {self.name!r}: must be a non-empty name of letters, digits, '-', '_', '.'"
+        try:
+            need, clearance = self.min_carrier_clearance_m(), float(self.geometry.carrier_clearance_m)
+        except (TypeError, ValueError):
+            return                                   # the sections name their own bad values
+        if clearance < need:
+            yield (f"geometry.carrier_clearance_m = {clearance:g}: below the sheet's thermal growth towards the "
+                   f"carrier at {max(self.sweep.temperatures_degC):g} degC (alpha * (theta - theta_ref) * "
+                   f"thickness / 2 = {need:.3g} m); heating alone would press the paddle on the carrier "
+                   f"(a spurious force); allowed >= {need:.3g} m")
+
+    def min_carrier_clearance_m(self) -> float:
+        """Least carrier clearance heating alone does not close, m.
+
+        The sheet thickens by ``alpha (theta_max - theta_ref) t``, half of it
+        towards the carrier, at the hottest sweep temperature (0 without thermal
+        distortion). The contact law reaches a little further: a case whose plates
+        take a force from heating alone is refused after solving
+        (:func:`cushion_clutch.fe.cases.check_heating`).
+        """
+        if not self.sweep.thermal_distortion:
+            return 0.0
+        dt = max(float(t) for t in self.sweep.temperatures_degC) - float(self.material.reference_temperature_degC)
+        return max(0.0, float(self.material.expansion_coefficient_per_K) * dt * 0.5 * float(self.geometry.thickness_m))
 
     def replace(self, **sections: Any) -> "SpringParams":
         """Return a copy with top-level fields or whole sections replaced.

@@ -41,6 +41,9 @@ class CaseResult:
         Axial plate force during step 2 (compression > 0), N, per increment.
     thermal_force_N : float
         Plate force at the end of heating (contact during heating), N.
+    thermal_force_lower_N : float
+        Force on the lower plate (the carrier plane in the half-pair model) at
+        the end of heating, N; heating alone should leave it at zero.
     """
 
     theta_degC: float
@@ -49,6 +52,7 @@ class CaseResult:
     travel_m: np.ndarray
     force_N: np.ndarray
     thermal_force_N: float
+    thermal_force_lower_N: float = 0.0
 
     @property
     def pair_travel_m(self) -> np.ndarray:
@@ -103,6 +107,7 @@ def parse_case(dat_path: Path, theta_degC: float, paddles: int) -> CaseResult:
         up_u = blocks[("displacements", "REF_UPPER")]
         up_f = blocks[("forces", "REF_UPPER")]
         lo_u = blocks[("displacements", "REF_LOWER")]
+        lo_f = blocks[("forces", "REF_LOWER")]
         crest = blocks[("displacements", "CREST")]
     except KeyError as exc:
         raise ResultError(f"{dat_path}: missing output block {exc}") from exc
@@ -122,4 +127,5 @@ def parse_case(dat_path: Path, theta_degC: float, paddles: int) -> CaseResult:
         travel_m=np.concatenate([[0.0], travel]),
         force_N=np.concatenate([[-fz_up[i1]], force]),
         thermal_force_N=float(-fz_up[i1]),
+        thermal_force_lower_N=float(lo_f[i1][1][0, 2]),
     )

@@ -17,7 +17,6 @@ from typing import Callable
 from .. import __version__
 from ..errors import SweepError
 from .cases import DEFAULT_CACHE, Case, CaseOutcome, run_cases
-from .ccx import ccx_version
 from .params import SpringParams
 from .tables import Curve, curve_from_case, kiss_shift, progressivity, write_tables
 
@@ -37,15 +36,19 @@ def run_sweep(params: SpringParams, *, cache_dir: Path = DEFAULT_CACHE, jobs: in
     Parameters
     ----------
     jobs : int, optional
-        Parallel ccx jobs on this machine (default: number of cores).
+        Parallel ccx jobs on this machine (default: number of cores). With
+        fewer cases than jobs, each ccx gets the idle cores as threads.
     scheduler : str or distributed.Client, optional
         A Dask scheduler address (``tcp://host:8786``) or client; cases then
-        run on its workers (a scanned surface is shipped to them).
+        run on its workers, which are checked first (:mod:`.cluster`; a scanned
+        surface is shipped to them); the client needs no ccx.
 
     Raises
     ------
     SweepError
         If any case failed; the finished ones stay in the cache.
+    ClusterError
+        If the cluster cannot run the cases (named workers) or lost all its workers.
     """
     thetas = list(params.sweep.temperatures_degC)
     cases = [Case(params, t, paddles, f"theta = {t:g} degC") for t in thetas]
@@ -72,7 +75,8 @@ def build_tables(params: SpringParams, outcomes: dict[float, CaseOutcome], out_d
     any_case = next(iter(outcomes.values()))
     metadata = {
         "generator": f"cushion_clutch {__version__} (cushion-clutch sweep)",
-        "solver": {"name": "CalculiX ccx", "version": ccx_version()},
+        "solver": {"name": "CalculiX ccx",
+                   "version": ", ".join(sorted({o.ccx_version for o in outcomes.values()}))},
         "date": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
         "host": platform.node(),
         "spring": params.to_dict(),

@@ -47,9 +47,13 @@ def dependencies(has_friction: bool) -> dict[int, list[int]]:
             vr_der(): [theta_cm, theta_cs]}
 
 
-def _variables():
-    """(vr, name, causality, unit, description, start) of every variable but time (start: inputs and parameters)."""
-    starts = clutch_model.start_values()
+def _variables(x_kiss_ref_m: float | None = None):
+    """(vr, name, causality, unit, description, start) of every variable but time (start: inputs and parameters).
+
+    ``x_kiss_ref_m``: the table set's own start value of ``x_kiss_ref`` (m), None for the default.
+    """
+    p = None if x_kiss_ref_m is None else clutch_model.ClutchParameters(x_kiss_ref=x_kiss_ref_m)
+    starts = clutch_model.start_values(p)
     for vr, (name, causality, unit, desc) in enumerate(clutch_model.VARIABLES):
         yield vr, name, causality, unit, desc, starts[name] if causality in ("input", "parameter") else None
     yield vr_der(), "der(theta_cs)", "local", "K/s", "rate of change of theta_cs (paper eq. 3)", None
@@ -75,7 +79,7 @@ def _finish(root: ET.Element) -> str:
     return '<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
 
 
-def fmi2_description(guid: str, has_friction: bool) -> str:
+def fmi2_description(guid: str, has_friction: bool, x_kiss_ref_m: float | None = None) -> str:
     """FMI 2.0 modelDescription.xml: ME and CS, SourceFiles, ModelStructure with dependencies."""
     root = ET.Element("fmiModelDescription", fmiVersion="2.0", modelName=SLAVE, guid=guid, description=DESCRIPTION,
                       generationTool="cushion_clutch (native C)", variableNamingConvention="flat",
@@ -93,7 +97,7 @@ def fmi2_description(guid: str, has_friction: bool) -> str:
     _units(root)
     _log_categories(root)
     variables = ET.SubElement(root, "ModelVariables")
-    for vr, name, causality, unit, desc, start in _variables():
+    for vr, name, causality, unit, desc, start in _variables(x_kiss_ref_m):
         attrs = dict(name=name, valueReference=str(vr), description=f"{desc} [{unit}]", causality=causality)
         attrs.update(variability="fixed", initial="exact") if causality == "parameter" else attrs.update(
             variability="continuous")
@@ -119,7 +123,7 @@ def fmi2_description(guid: str, has_friction: bool) -> str:
     return _finish(root)
 
 
-def fmi3_description(token: str, has_friction: bool) -> str:
+def fmi3_description(token: str, has_friction: bool, x_kiss_ref_m: float | None = None) -> str:
     """FMI 3.0 modelDescription.xml: ME and CS, independent variable time, ModelStructure."""
     root = ET.Element("fmiModelDescription", fmiVersion="3.0", modelName=SLAVE, instantiationToken=token,
                       description=DESCRIPTION, generationTool="cushion_clutch (native C)",
@@ -133,7 +137,7 @@ def fmi3_description(token: str, has_friction: bool) -> str:
     variables = ET.SubElement(root, "ModelVariables")
     ET.SubElement(variables, "Float64", name="time", valueReference=str(vr_time()), causality="independent",
                   variability="continuous", unit="s", description="simulation time [s]")
-    for vr, name, causality, unit, desc, start in _variables():
+    for vr, name, causality, unit, desc, start in _variables(x_kiss_ref_m):
         attrs = dict(name=name, valueReference=str(vr), description=f"{desc} [{unit}]", causality=causality)
         attrs.update(variability="fixed", initial="exact") if causality == "parameter" else attrs.update(
             variability="continuous")

@@ -32,8 +32,11 @@ def _c_double(v: float) -> str:
     return repr(float(v))
 
 
-def variable_header() -> str:
+def variable_header(p: "clutch_model.ClutchParameters | None" = None) -> str:
     """Text of ``cushion_variables.h`` for the model's ``VARIABLES`` as they stand (read at each call).
+
+    Start values from ``p`` (default: the model's defaults); a tolerance P5/P95
+    table set passes its own ``x_kiss_ref``.
 
     Raises
     ------
@@ -43,7 +46,7 @@ def variable_header() -> str:
     """
     model = clutch_model
     variables = model.VARIABLES
-    starts = model.start_values()
+    starts = model.start_values(p)
     ranges = model.ClutchParameters.RANGES
     names = [enum_name(n) for n, _, _, _ in variables]
     problems = [f"{n}: causality {c!r} (allowed {', '.join(CAUSALITIES)})"

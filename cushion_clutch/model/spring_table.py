@@ -207,4 +207,3 @@ class SpringTable:
     def first_contact(self, theta_degC: float) -> float:
         """Compression below which F is its first (zero) value at this temperature, m (<= 0)."""
         return min(c.x_min for c in self._active(theta_degC))
-

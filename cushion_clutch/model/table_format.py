@@ -24,6 +24,8 @@ from here; the pythonfmu FMU carries this module beside the model.
 """
 from __future__ import annotations
 
+import json
+import math
 from pathlib import Path
 
 import numpy as np
@@ -48,8 +50,9 @@ UNITS = {"theta_degC": "degC", "u_m": "m", "force_N": "N", "delta_kiss_m": "m", 
 REQUIRED_FILES = (FORCE_DEFLECTION, KISS_POINT)
 #: files an FMU carries in ``resources/tables`` (those present)
 FMU_FILES = (FORCE_DEFLECTION, KISS_POINT, METADATA, FRICTION)
-#: top-level keys of ``metadata.json`` that readers use: per-temperature progressivity and kiss-point growth
-METADATA_KEYS = ("progressivity", "kiss_point")
+#: top-level keys of ``metadata.json`` that readers use: per-temperature progressivity and kiss-point growth;
+#: a tolerance study's P5/P95 set adds ``tolerance_study`` (its own ``x_kiss_ref_m``)
+METADATA_KEYS = ("progressivity", "kiss_point", "tolerance_study")
 
 
 def load_csv(path: Path, columns: tuple[str, ...]) -> np.ndarray:
@@ -65,3 +68,27 @@ def load_csv(path: Path, columns: tuple[str, ...]) -> np.ndarray:
     if not np.all(np.isfinite(data)):
         raise ValueError(f"{path}: non-finite value")
     return data
+
+
+def table_set_x_kiss_ref(folder: str | Path) -> float | None:
+    """The FMU parameter ``x_kiss_ref`` (m) a table set asks for, or None for the model default.
+
+    A tolerance study's P5/P95 set measures u from its own spring's kiss point;
+    ``metadata.json`` then holds ``tolerance_study.x_kiss_ref_m``, the bearing
+    position of that kiss point against the nominal spring's.
+
+    Raises
+    ------
+    ValueError
+        A value that is not a number in -1..1 m (the file named).
+    """
+    path = Path(folder) / METADATA
+    if not path.exists():
+        return None
+    value = json.loads(path.read_text()).get("tolerance_study", {}).get("x_kiss_ref_m")
+    if value is None:
+        return None
+    value = float(value)
+    if not (math.isfinite(value) and -1.0 <= value <= 1.0):
+        raise ValueError(f"{path}: tolerance_study.x_kiss_ref_m = {value!r}: allowed -1..1 m")
+    return value

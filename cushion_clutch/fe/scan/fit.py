@@ -27,7 +27,7 @@ from ...errors import ScanError
 from ..params import Geometry
 
 #: length of one scan unit, m
-UNITS = {"mm": 1e-3, "m": 1.0}
+UNITS = {"um": 1e-6, "mm": 1e-3, "cm": 1e-2, "in": 0.0254, "m": 1.0}
 MESH_SUFFIXES = (".stl", ".ply", ".obj")
 SECTOR_MARGIN_M = 1.0e-3       #: points this close outside the sector still count as on it
 MAX_OUTSIDE_FRACTION = 0.10    #: more points off the sector than this: wrong frame (unless crop)
@@ -35,6 +35,12 @@ COVERAGE_CELL_M = 2.0e-3       #: cell size of the coverage check
 MIN_COVERAGE = 0.90            #: fraction of the sector's cells that must hold points
 OUTLIER_MADS = 5.0             #: outlier threshold in robust standard deviations (1.4826 MAD)
 POINTS_PER_COEFFICIENT = 4
+SCALE_TOLERANCE = 1.6          #: scan radii this many times too large or small: a unit mix-up
+GAP_GRID_M = 0.25e-3           #: grid of the gap map (radius and arc length)
+GAP_SPACINGS = 3.0             #: a grid node farther than this many mean point spacings from every point is in a gap
+MIN_GAP_DISTANCE_M = 0.5e-3    #: ... and never closer than this
+MAX_CREST_GAP_M2 = 4e-6        #: largest gap accepted on the wave's crest (upper half of the wave), m^2
+MAX_WAVE_GAP_M2 = 10e-6        #: largest gap accepted elsewhere on the wave, m^2
 MIN_POINTS = 1000              #: fewest points accepted on the paddle sector
 
 
@@ -83,6 +89,124 @@ def polar(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.hypot(points[:, 0], points[:, 1]), np.degrees(np.arctan2(points[:, 1], points[:, 0]))
 
 
+def unit_hint(ratio: float, unit: str) -> str:
+    """What a scan ``ratio`` times too large says about its unit (one unit of the file = UNITS[unit] / ratio m)."""
+    length = UNITS[unit] / ratio
+    guess = min(UNITS, key=lambda u: abs(np.log(UNITS[u] / length)))
+    if abs(np.log(UNITS[guess] / length)) < np.log(1.25) and guess != unit:
+        return f"the scan's unit is probably {guess!r}, not --unit {unit!r}"
+    return (f"one scan unit would be {length:.3g} m, which is none of the units {', '.join(UNITS)}; check "
+            "the scan's unit and the base spring's radii")
+
+
+@dataclass(frozen=True)
+class Gap:
+    """A connected region of the paddle without scan points.
+
+    Its nodes farther than ``Coverage.distance_limit_m`` from every point,
+    grown back by that distance (a hole's edge lies that far out): about the
+    hole's own area for a convex hole.
+    """
+
+    area_m2: float
+    r_m: tuple
+    phi_deg: tuple
+    region: str
+    limit_m2: float | None
+
+    @property
+    def refused(self) -> bool:
+        return self.limit_m2 is not None and self.area_m2 > self.limit_m2
+
+    def describe(self) -> str:
+        lim = f" (limit {self.limit_m2 * 1e6:g} mm^2)" if self.limit_m2 is not None else ""
+        return (f"a gap of {self.area_m2 * 1e6:.1f} mm^2{lim} on {self.region} at r = {self.r_m[0] * 1e3:.1f}.."
+                f"{self.r_m[1] * 1e3:.1f} mm, phi = {self.phi_deg[0]:.1f}..{self.phi_deg[1]:.1f} deg")
+
+
+@dataclass(frozen=True)
+class Coverage:
+    """Point coverage of the paddle sector on a polar grid.
+
+    Attributes
+    ----------
+    r_m, phi_deg : ndarray
+        Grid axes (about ``GAP_GRID_M`` apart in radius and arc length).
+    distance_m : ndarray, shape (nr, nphi)
+        Distance from each node to the nearest scan point (in the plane), m.
+    distance_limit_m : float
+        Nodes farther than this are gaps: ``GAP_SPACINGS`` mean point spacings.
+    region : ndarray of int, shape (nr, nphi)
+        0 rivet zone / flat, 1 wave flank, 2 wave crest (upper half of the base spring's wave).
+    gap_mask : ndarray of bool, shape (nr, nphi)
+        Nodes in a gap.
+    gaps : list of Gap
+        Every gap, largest first.
+    """
+
+    r_m: np.ndarray
+    phi_deg: np.ndarray
+    distance_m: np.ndarray
+    distance_limit_m: float
+    region: np.ndarray
+    gap_mask: np.ndarray
+    gaps: list
+
+    @property
+    def refused(self) -> list:
+        return [g for g in self.gaps if g.refused]
+
+
+def coverage_map(points: np.ndarray, geom: Geometry) -> Coverage:
+    """Map where the scan has points: distance from a polar grid to the nearest point, and the gaps.
+
+    A gap on the wave's crest larger than ``MAX_CREST_GAP_M2`` or elsewhere on
+    the wave larger than ``MAX_WAVE_GAP_M2`` would leave the fitted spline to
+    extrapolate the shape that carries the load; gaps on the flat zones are
+    listed but accepted. Holes narrower than twice the distance limit (3 mean
+    point spacings, at least 0.5 mm) are not seen.
+    """
+    from scipy.ndimage import distance_transform_edt, label
+    from scipy.spatial import cKDTree
+
+    from ..geometry import wave_height
+    r_pts, phi_pts = polar(points)
+    r_mean = 0.5 * (geom.inner_radius_m + geom.outer_radius_m)
+    area = 0.5 * np.radians(geom.span_deg) * (geom.outer_radius_m ** 2 - geom.inner_radius_m ** 2)
+    limit = max(MIN_GAP_DISTANCE_M, GAP_SPACINGS * np.sqrt(area / max(len(points), 1)))
+    r = np.linspace(geom.inner_radius_m, geom.outer_radius_m,
+                    int(round((geom.outer_radius_m - geom.inner_radius_m) / GAP_GRID_M)) + 1)
+    phi = np.linspace(0.0, geom.span_deg, int(round(np.radians(geom.span_deg) * r_mean / GAP_GRID_M)) + 1)
+    rr, pp = np.meshgrid(r, phi, indexing="ij")
+    nodes = np.column_stack([(rr * np.cos(np.radians(pp))).ravel(), (rr * np.sin(np.radians(pp))).ravel()])
+    dist = cKDTree(points[:, :2]).query(nodes)[0].reshape(rr.shape)
+    analytic = geom.__class__(**{**vars(geom), "surface_file": ""}) if geom.surface_file else geom
+    w = wave_height(rr, pp, analytic)
+    crest = w >= 0.5 * np.max(w, axis=1, keepdims=True)
+    on_wave = (pp >= geom.wave_start_deg) & (pp <= geom.wave_end_deg)
+    region = np.where(on_wave & crest & (w > 0), 2, np.where(on_wave, 1, 0))
+    cell = (r[1] - r[0]) * np.radians(phi[1] - phi[0]) * rr      # node area, m^2
+    core = dist > limit
+    grown = core | (distance_transform_edt(~core, sampling=(r[1] - r[0], np.radians(phi[1] - phi[0]) * r_mean))
+                    <= limit) if core.any() else core
+    labels, n = label(grown)
+    gaps = []
+    for k in range(1, n + 1):
+        m = labels == k
+        worst = int(region[m].max())
+        name = {2: "the wave's crest", 1: "the wave's flank",
+                0: "the flat zone (rivet zone or far zone)"}[worst]
+        if worst and np.any(rr[m] >= geom.outer_radius_m - 1e-9):
+            name += " (outer rim)"
+        elif worst and np.any(rr[m] <= geom.inner_radius_m + 1e-9):
+            name += " (inner rim)"
+        gaps.append(Gap(float(cell[m].sum()), (float(rr[m].min()), float(rr[m].max())),
+                        (float(pp[m].min()), float(pp[m].max())), name,
+                        {2: MAX_CREST_GAP_M2, 1: MAX_WAVE_GAP_M2, 0: None}[worst]))
+    gaps.sort(key=lambda g: -g.area_m2)
+    return Coverage(r, phi, dist, limit, region, grown, gaps)
+
+
 def check_points(points: np.ndarray, geom: Geometry, unit: str, source: str,
                  crop: bool = False) -> np.ndarray:
     """Reject malformed scans, collecting every problem; return the points on the sector.
@@ -104,12 +228,11 @@ def check_points(points: np.ndarray, geom: Geometry, unit: str, source: str,
     r, phi = polar(points)
     r_hi = float(np.percentile(r, 99))
     ratio = r_hi / geom.outer_radius_m
-    if ratio > 10 or ratio < 0.1:
-        guess = min(UNITS, key=lambda u: abs(np.log10(ratio * UNITS[u] / UNITS[unit])))
+    if ratio > SCALE_TOLERANCE or ratio < 1.0 / SCALE_TOLERANCE:
         problems.append(
             f"the paddle is {ratio:.3g}x {'too large' if ratio > 1 else 'too small'}: scan radii reach "
-            f"{r_hi:.4g} m where geometry.outer_radius_m = {geom.outer_radius_m:g} m; the scan's "
-            f"unit is probably {guess!r}, not --unit {unit!r}")
+            f"{r_hi:.4g} m where geometry.outer_radius_m = {geom.outer_radius_m:g} m; "
+            f"{unit_hint(ratio, unit)}")
         raise ScanError(problems, source)
     on = ((r >= geom.inner_radius_m - SECTOR_MARGIN_M) & (r <= geom.outer_radius_m + SECTOR_MARGIN_M)
           & (phi * np.radians(1) * r >= -SECTOR_MARGIN_M)
@@ -134,8 +257,13 @@ def check_points(points: np.ndarray, geom: Geometry, unit: str, source: str,
     if coverage < MIN_COVERAGE:
         problems.append(f"the points cover {coverage:.0%} of the paddle sector (cells of "
                         f"{COVERAGE_CELL_M * 1e3:g} mm; need {MIN_COVERAGE:.0%})")
+    gaps = coverage_map(points, geom)
+    for g in gaps.refused:
+        problems.append(f"{g.describe()}: the spline would extrapolate the shape that carries the load "
+                        f"(nodes farther than {gaps.distance_limit_m * 1e3:.2f} mm from every point); "
+                        "rescan that region")
     if problems:
-        raise ScanError(problems, source)
+        raise ScanError(problems, source, coverage=gaps)
     return points
 
 

@@ -18,8 +18,8 @@ import numpy as np
 
 from ...errors import ParameterError, ScanError
 from ..params import SpringParams, load_params
-from .fit import FrameFit, SurfaceFit, check_points, fit_mid_surface, place_in_frame, polar, read_scan, \
-    write_surface
+from .fit import Coverage, FrameFit, SurfaceFit, check_points, coverage_map, fit_mid_surface, place_in_frame, \
+    polar, read_scan, write_surface
 
 log = logging.getLogger(__name__)
 
@@ -31,6 +31,8 @@ class ScanImport:
     toml: Path
     surface: Path
     plot: Path
+    coverage_plot: Path
+    coverage: Coverage
     params: SpringParams
     fit: SurfaceFit
     frame: FrameFit
@@ -74,7 +76,15 @@ def import_scan(scan: str | Path, spring: str | Path, out_toml: str | Path, *, u
     base = load_params(spring)
     geom = base.geometry
     raw = read_scan(scan, unit)
-    pts = check_points(raw, geom, unit, str(scan), crop=crop)
+    coverage_png = out_toml.with_name(f"{out_toml.stem}_coverage.png")
+    try:
+        pts = check_points(raw, geom, unit, str(scan), crop=crop)
+    except ScanError as exc:
+        if exc.coverage is None:
+            raise
+        out_toml.parent.mkdir(parents=True, exist_ok=True)
+        plot_coverage(exc.coverage, None, None, geom, coverage_png, scan.name)
+        raise ScanError([*exc.problems, f"coverage map: {coverage_png}"], str(scan)) from None
     try:
         placed, frame = place_in_frame(pts, geom, datum)
         fit = fit_mid_surface(placed, geom, face)
@@ -94,8 +104,10 @@ def import_scan(scan: str | Path, spring: str | Path, out_toml: str | Path, *, u
     out_toml.write_text(text, encoding="utf-8")
     params = load_params(out_toml)           # the written file must load as a spring
     plot = plot_scan_fit(placed, fit, geom, out_toml.with_name(f"{stem}_surface.png"), scan.name)
+    coverage = coverage_map(pts, geom)
+    plot_coverage(coverage, placed, fit, geom, coverage_png, scan.name)
     log.info("scan %s: %d points, RMS %.2f um", scan, len(pts), fit.rms_m * 1e6)
-    return ScanImport(out_toml, surface, plot, params, fit, frame, len(raw), len(pts))
+    return ScanImport(out_toml, surface, plot, coverage_png, coverage, params, fit, frame, len(raw), len(pts))
 
 
 # keys of the analytic wave that the fitted surface replaces (it carries tilt, profile and waves)
@@ -178,6 +190,42 @@ def plot_scan_fit(points: np.ndarray, fit: SurfaceFit, geom, path: Path, label: 
     ax.set(xlabel="φ [deg]", ylabel="r [mm]", title=f"Fitted mid-surface height w(r, φ), peak "
                                                      f"{fit.peak_m * 1e3:.4f} mm")
     return finish_figure(fig, axes[:1], path)
+
+
+def plot_coverage(cov: Coverage, points: np.ndarray | None, fit: SurfaceFit | None, geom, path: Path,
+                  label: str) -> Path:
+    """Coverage map (distance to the nearest point, wave and crest outlined, gaps marked) and residual map."""
+    from ...plotting import finish_figure, plt
+
+    fig, axes = plt.subplots(2 if fit is not None else 1, 1, figsize=(8, 8 if fit is not None else 4.5),
+                             squeeze=False)
+    ax = axes[0, 0]
+    pm = ax.pcolormesh(cov.phi_deg, cov.r_m * 1e3, cov.distance_m * 1e3, cmap="magma_r", shading="auto",
+                       vmin=0.0, vmax=max(2.0 * cov.distance_limit_m, float(cov.distance_m.max())) * 1e3)
+    fig.colorbar(pm, ax=ax, label="distance to the nearest point [mm]")
+    ax.contour(cov.phi_deg, cov.r_m * 1e3, cov.region, levels=[0.5, 1.5], colors=["C0", "C2"], linewidths=1)
+    if cov.gap_mask.any():
+        ax.contour(cov.phi_deg, cov.r_m * 1e3, cov.gap_mask.astype(float), levels=[0.5], colors="red",
+                   linewidths=1.5)
+    ax.plot([], [], "C0-", label="wave")
+    ax.plot([], [], "C2-", label="crest (upper half of the wave)")
+    ax.plot([], [], "r-", label=f"gap (its core > {cov.distance_limit_m * 1e3:.2f} mm from every point)")
+    refused = cov.refused
+    ax.set(xlabel="φ [deg]", ylabel="r [mm]",
+           title=f"Scan {label}: point coverage; " + (f"{len(refused)} gap(s) beyond the limits: REFUSED"
+                                                      if refused else f"{len(cov.gaps)} gap(s), none refused"))
+    ax.legend(loc="upper right", fontsize=7)
+    if fit is not None:
+        ax = axes[1, 0]
+        r_mid, phi_mid = polar(fit.mid_points)
+        res = (fit.mid_points[:, 2] - fit.datum_m) - _grid_eval(fit, r_mid, phi_mid)
+        lim = max(3 * fit.rms_m, 1e-9) * 1e6
+        sc = ax.scatter(phi_mid[fit.inliers], r_mid[fit.inliers] * 1e3, c=res[fit.inliers] * 1e6, s=2,
+                        cmap="coolwarm", vmin=-lim, vmax=lim)
+        fig.colorbar(sc, ax=ax, label="residual [µm]")
+        ax.set(xlabel="φ [deg]", ylabel="r [mm]",
+               title=f"Fit residual: RMS {fit.rms_m * 1e6:.2f} µm, max {fit.max_m * 1e6:.2f} µm")
+    return finish_figure(fig, [], path)
 
 
 def _grid_eval(fit: SurfaceFit, r, phi) -> np.ndarray:

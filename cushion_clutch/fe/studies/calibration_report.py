@@ -3,6 +3,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
+
 from ...config import toml_document
 from ...plotting import finish_figure, plt
 from .calibrate import Calibration
@@ -14,31 +16,52 @@ def params_toml(params: SpringParams, header: str = "") -> str:
     return toml_document(params.to_dict(), header)
 
 
+def calibrated_params(cal: Calibration, name: str) -> SpringParams:
+    """The calibrated spring under its own ``name``, described by what it was fitted to."""
+    curves = ", ".join(f"{m.source or 'a curve given in code'} ({m.theta_degC:g} degC, {len(m.u_m)} points)"
+                       for m in cal.measured)
+    fitted = ", ".join(f"{n} = {v:.6g}" for n, v in zip(cal.names, cal.values))
+    return cal.params.replace(name=name, description=(
+        f"'{cal.params.name}' calibrated by cushion-clutch calibrate to {curves}: {fitted}; RMS error "
+        f"{cal.rms_pct:.2f} % of the largest measured force"))
+
+
 def report_text(cal: Calibration) -> str:
-    """Human-readable calibration report."""
-    m = cal.measured
-    lines = [f"calibration to {len(m.u_m)} measured points ({m.basis} force), FE at "
-             f"{cal.params.material.reference_temperature_degC:g} degC, mesh "
+    """Human-readable calibration report, ending with every warning (bound, identifiability, residual)."""
+    curves = ", ".join(f"{len(m.u_m)} points at {m.theta_degC:g} degC" for m in cal.measured)
+    lines = [f"calibration to {curves} ({cal.measured[0].basis} force), mesh "
              f"{cal.params.mesh.element_size_m * 1e3:g} mm {cal.params.mesh.element_type}",
-             f"{'parameter':<28}{'start':>12}{'fitted':>12}{'1-sigma':>11}{'dlnF/dlnp':>11}"]
-    for n, a, b, s, k in zip(cal.names, cal.start, cal.values, cal.std, cal.sensitivity):
-        lines.append(f"{n:<28}{a:>12.5g}{b:>12.5g}{s:>11.2g}{k:>11.2f}")
+             f"{'parameter':<36}{'start':>12}{'fitted':>12}{'1-sigma':>11}{'1-sigma %':>10}"
+             f"{'dlnF/dlnp':>11}  bounds"]
+    for n, a, b, s, k, (lo, hi) in zip(cal.names, cal.start, cal.values, cal.std, cal.sensitivity, cal.bounds):
+        lines.append(f"{n:<36}{a:>12.5g}{b:>12.5g}{s:>11.2g}{100 * s / abs(b) if b else float('inf'):>10.1f}"
+                     f"{k:>11.2f}  {lo:.5g}:{hi:.5g}")
+    if len(cal.names) > 1:
+        lines.append("correlation: " + "; ".join(
+            f"{cal.names[i]} / {cal.names[j]} {cal.correlation[i, j]:+.3f}"
+            for i in range(len(cal.names)) for j in range(i + 1, len(cal.names))))
     lines += [f"RMS error {cal.rms_N:.2f} N ({cal.rms_pct:.2f} % of the largest measured force), "
               f"max error {cal.max_N:.2f} N ({cal.max_pct:.2f} %)",
+              f"residual: {cal.runs} runs of one sign ({cal.runs_expected:.1f} expected for noise, runs test "
+              f"p = {cal.runs_p:.2g}), lag-1 autocorrelation {cal.lag1_autocorrelation:+.2f}",
               f"FE cases {cal.fe_cases} ({cal.cached_cases} from the cache), wall time "
               f"{cal.wall_time_s:.1f} s; optimiser: {cal.message}"]
+    warnings = cal.warnings()
+    lines += [f"WARNING: {w}" for w in warnings] or ["no parameter at a bound or unidentifiable; residual "
+                                                     "consistent with noise"]
     return "\n".join(lines) + "\n"
 
 
 def plot_calibration(cal: Calibration, path: Path, title: str = "") -> Path:
-    """FE (start and calibrated) against the measured curve, like the paper's Fig. 9."""
-    m = cal.measured
+    """FE (start and calibrated) against the measured curves, like the paper's Fig. 9."""
     fig, ax = plt.subplots(figsize=(6.5, 4.5))
-    ax.plot(m.u_m * 1e3, m.force_N, "o", ms=4, mfc="none", color="k", label="measured")
-    ax.plot(m.u_m * 1e3, cal.fe_start_N, "--", color="tab:gray", label="FE, start parameters")
-    ax.plot(m.u_m * 1e3, cal.fe_fit_N, "-", color="tab:red",
-            label=f"FE, calibrated (RMS {cal.rms_pct:.1f} %)")
-    ax.set(xlabel="compression from the kiss point u [mm]",
-           ylabel=f"force of {'one paddle pair' if m.basis == 'pair' else 'the whole spring'} [N]",
-           title=title or "Cushion spring: FE against measurement")
+    for i, (m, f0, f1) in enumerate(zip(cal.measured, cal.fe_start_N, cal.fe_fit_N)):
+        order = np.argsort(m.u_m, kind="stable")
+        u = m.u_m[order] * 1e3
+        ax.plot(u, m.force_N[order], "o", ms=4, mfc="none", color=f"C{i}", label=f"measured, {m.theta_degC:g} degC")
+        ax.plot(u, f0[order], "--", color=f"C{i}", alpha=0.5, label=f"FE start, {m.theta_degC:g} degC")
+        ax.plot(u, f1[order], "-", color=f"C{i}", label=f"FE calibrated, {m.theta_degC:g} degC")
+    ax.set(xlabel="compression from the reference kiss point u [mm]",
+           ylabel=f"force of {'one paddle pair' if cal.measured[0].basis == 'pair' else 'the whole spring'} [N]",
+           title=title or f"Cushion spring: FE against measurement (RMS {cal.rms_pct:.1f} %)")
     return finish_figure(fig, ax, path)

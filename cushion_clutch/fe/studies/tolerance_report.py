@@ -28,6 +28,18 @@ from ..tables import curve_from_case
 from .tolerance import Sample
 
 PERCENTILES = (5.0, 50.0, 95.0)
+#: fewer drawn samples than this make P5 and P95 (nearly) the extremes of the draw
+MIN_SAMPLES_FOR_PERCENTILES = 20
+
+
+def percentile_warnings(samples: int) -> list[str]:
+    """Why the P5/P95 of ``samples`` drawn springs should not be read as percentiles (empty if fine)."""
+    if samples >= MIN_SAMPLES_FOR_PERCENTILES:
+        return []
+    return [f"only {samples} samples: P5 and P95 of fewer than {MIN_SAMPLES_FOR_PERCENTILES} draws are "
+            f"close to the smallest and largest drawn values (linear interpolation between order "
+            f"statistics), not estimates of the production P5/P95; use --samples "
+            f"{MIN_SAMPLES_FOR_PERCENTILES} or more"]
 RANK_BY = {"torque": "torque at the nominal half-engaged bearing position at the reference temperature",
            "force": "force at full compression at the reference temperature",
            "kiss": "kiss-point shift at the kiss temperature (a larger shift is ranked lower: less torque)"}
@@ -192,7 +204,7 @@ def write_outputs(bands: Bands, summ: list[SampleSummary], study_dir: Path) -> l
 
 
 def write_percentile_set(summ: list[SampleSummary], outcomes: list[dict[float, CaseOutcome]], pick: tuple,
-                         q: float, rank_by: str, out_dir: Path) -> Path:
+                         q: float, rank_by: str, out_dir: Path, warnings: list[str] = ()) -> Path:
     """The table set of the sample closest to percentile ``q``, with that choice in metadata.json."""
     index, value, target = pick
     k = next(i for i, s in enumerate(summ) if s.sample.index == index)
@@ -205,9 +217,10 @@ def write_percentile_set(summ: list[SampleSummary], outcomes: list[dict[float, C
         "percentile": q, "sample": index, "rank_by": RANK_BY[rank_by], "sample_value": value,
         "percentile_value": target, "deviations": s.sample.deviations,
         "free_height_offset_m": s.free_height_m - summ[0].free_height_m,
-        "x_kiss_ref_m": s.x_kiss_ref_m,
-        "note": "u and delta_kiss are relative to this sample's own kiss point; set the FMU parameter "
-                "x_kiss_ref to x_kiss_ref_m to place it against the nominal spring's kiss point"}
+        "x_kiss_ref_m": s.x_kiss_ref_m, "warnings": list(warnings),
+        "note": "u and delta_kiss are relative to this sample's own kiss point; build-fmu takes "
+                "x_kiss_ref_m as the start value of the FMU parameter x_kiss_ref, which places it "
+                "against the nominal spring's kiss point"}
     tmp = meta_path.with_suffix(".json.tmp")
     tmp.write_text(json.dumps(meta, indent=2) + "\n")
     os.replace(tmp, meta_path)
@@ -224,6 +237,7 @@ class StudyResult:
     picks: dict
     sets: dict
     files: list
+    warnings: list
     cases: int
     cases_from_cache: int
     wall_time_s: float
@@ -258,16 +272,20 @@ def tolerance_study(params, *, samples: int, temperatures: tuple, out: Path, met
     files.append(plot_bands(bands, summ, study_dir / "tolerance_bands.png",
                             f"Spring '{params.name}': {samples} samples ({method.upper()}, seed {seed})"))
     picks = pick_percentile_samples(bands, rank_by)
+    warnings = percentile_warnings(samples)
     sets = {q: write_percentile_set(summ, outcomes, picks[q], q, rank_by,
-                                    Path(out) / f"{params.name}_p{int(q):02d}") for q in picks}
+                                    Path(out) / f"{params.name}_p{int(q):02d}", warnings) for q in picks}
     n_cached = sum(o.from_cache for r in outcomes for o in r.values())
     (study_dir / "study.json").write_text(json.dumps({
         "spring": params.name, "samples": samples, "method": method, "seed": seed,
         "temperatures_degC": list(temperatures), "mesh_element_size_m": params.mesh.element_size_m,
         "tolerances_sd": params.tolerances.declared(), "truncated_at_sd": 3.0, "rank_by": RANK_BY[rank_by],
         "percentile_sets": {f"p{int(q):02d}": {"sample": v[0], "value": v[1], "percentile_value": v[2],
-                                               "folder": str(sets[q])} for q, v in picks.items()},
-        "cases": len(drawn) * len(temperatures), "cases_from_cache": n_cached, "wall_time_s": wall},
-        indent=2) + "\n")
-    return StudyResult(study_dir, bands, summ, picks, sets, files, len(drawn) * len(temperatures),
+                                               "folder": str(sets[q]),
+                                               "x_kiss_ref_m": next(x.x_kiss_ref_m for x in summ
+                                                                    if x.sample.index == v[0])}
+                           for q, v in picks.items()},
+        "cases": len(drawn) * len(temperatures), "cases_from_cache": n_cached, "wall_time_s": wall,
+        "warnings": warnings}, indent=2) + "\n")
+    return StudyResult(study_dir, bands, summ, picks, sets, files, warnings, len(drawn) * len(temperatures),
                        n_cached, wall)

@@ -1,0 +1,134 @@
+"""Measured load-deflection curves for calibration: read and checked, kept as measured.
+
+A curve (CSV ``u_m,force_N``) is the compression of one paddle pair (or the
+whole spring) from the kiss point at the reference temperature and its force,
+at one spring temperature. Noise, points where the force falls, repeated or
+backward compressions and a small zero offset are kept: the fit
+(:mod:`cushion_clutch.fe.studies.calibrate`) sees the curve as measured.
+"""
+from __future__ import annotations
+
+import csv
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Sequence
+
+import numpy as np
+
+from ...errors import ParameterError, TableError
+
+#: a raw curve may start this far before the kiss point (zero offset of the bench's travel), m
+U_OFFSET_LIMIT_M = 0.2e-3
+#: ... and its force may dip this far below zero (load-cell zero offset), fraction of its largest force
+F_OFFSET_LIMIT = 0.05
+
+
+@dataclass(frozen=True)
+class Measured:
+    """A measured load-deflection curve, SI, as measured (noise and non-monotone points kept).
+
+    Attributes
+    ----------
+    u_m : ndarray
+        Compression from the reference temperature's kiss point, m, in the order measured;
+        may repeat or go back and start slightly below zero (a zero offset).
+    force_N : ndarray
+        Force, N, as measured (not smoothed, not made monotone).
+    basis : str
+        ``"pair"`` (one paddle pair) or ``"spring"`` (the whole spring).
+    theta_degC : float
+        Temperature of the spring during the measurement, degC.
+    source : str
+        The file it was read from ("" if built in code).
+    """
+
+    u_m: np.ndarray
+    force_N: np.ndarray
+    basis: str = "pair"
+    theta_degC: float = 20.0
+    source: str = ""
+
+
+def read_measured(path: str | Path, basis: str = "pair", theta_degC: float = 20.0) -> Measured:
+    """Read and check a measured curve CSV with the header ``u_m,force_N``, keeping it as measured.
+
+    Noise, points where the force falls, repeated or backward u and a small
+    zero offset (u down to ``-U_OFFSET_LIMIT_M``, force down to
+    ``-F_OFFSET_LIMIT`` of the largest force) are accepted and fitted as they are.
+
+    Raises
+    ------
+    TableError
+        Missing file, wrong header, non-numeric, non-finite or too few rows,
+        u beyond the zero-offset limit, force below it, no force above zero.
+    """
+    path = Path(path)
+    if basis not in ("pair", "spring"):
+        raise TableError(f"measured basis = {basis!r}: allowed 'pair' or 'spring'")
+    try:
+        with open(path, newline="", encoding="utf-8") as fh:
+            rows = [r for r in csv.reader(fh) if r and not r[0].lstrip().startswith("#")]
+    except OSError as exc:
+        raise TableError(f"{path}: cannot read the measured curve ({exc.strerror})") from exc
+    if not rows or [c.strip() for c in rows[0]] != ["u_m", "force_N"]:
+        raise TableError(f"{path}: the first line must be the header 'u_m,force_N', got "
+                         f"{','.join(rows[0]) if rows else 'an empty file'!r}")
+    data = []
+    for i, row in enumerate(rows[1:], start=2):
+        try:
+            vals = [float(v) for v in row]
+        except ValueError:
+            raise TableError(f"{path}, line {i}: not two numbers: {','.join(row)!r}") from None
+        if len(vals) != 2 or not all(math.isfinite(v) for v in vals):
+            raise TableError(f"{path}, line {i}: need two finite numbers u_m,force_N, got {row}")
+        data.append(vals)
+    if len(data) < 4:
+        raise TableError(f"{path}: need at least 4 data rows, got {len(data)}")
+    a = np.array(data)
+    f_max = float(np.max(a[:, 1]))
+    if f_max <= 0:
+        raise TableError(f"{path}: force_N never rises above 0 N")
+    if np.min(a[:, 0]) < -U_OFFSET_LIMIT_M:
+        i = int(np.argmin(a[:, 0])) + 2
+        raise TableError(f"{path}, line {i}: u_m = {a[i - 2, 0]:g} m; u_m is the compression from the kiss "
+                         f"point, allowed >= {-U_OFFSET_LIMIT_M:g} m (a small zero offset)")
+    if np.min(a[:, 1]) < -F_OFFSET_LIMIT * f_max:
+        i = int(np.argmin(a[:, 1])) + 2
+        raise TableError(f"{path}, line {i}: force_N = {a[i - 2, 1]:g} N, below the allowed zero offset "
+                         f"{-F_OFFSET_LIMIT * f_max:.3g} N ({F_OFFSET_LIMIT:.0%} of the largest force)")
+    return Measured(a[:, 0], a[:, 1], basis, float(theta_degC), str(path))
+
+
+def parse_measured(items: Sequence[str], basis: str = "pair",
+                   reference_degC: float = 20.0) -> list[Measured]:
+    """``--measured`` values: ``FILE`` (at the reference temperature) or ``THETA=FILE`` (degC).
+
+    Raises
+    ------
+    ParameterError
+        Bad temperature, a temperature given twice, no curve at the reference temperature.
+    """
+    out, problems, seen = [], [], set()
+    for item in items:
+        theta, sep, file = item.partition("=")
+        if not sep:
+            theta, file = f"{reference_degC:g}", item
+        try:
+            t = float(theta)
+        except ValueError:
+            problems.append(f"--measured {item!r}: expected FILE or THETA_DEGC=FILE")
+            continue
+        if not -60.0 <= t <= 400.0:
+            problems.append(f"--measured {item!r}: temperature {t:g} degC outside -60..400 degC")
+        elif t in seen:
+            problems.append(f"--measured {item!r}: {t:g} degC given twice")
+        else:
+            seen.add(t)
+            out.append((t, file))
+    if out and reference_degC not in seen:
+        problems.append(f"--measured: no curve at the reference temperature {reference_degC:g} degC "
+                        "(hot curves are measured from its kiss point)")
+    if problems:
+        raise ParameterError(problems)
+    return [read_measured(f, basis, t) for t, f in out]

@@ -28,5 +28,5 @@ def model_final(steps: int, h: float) -> list[float]:
         x = 0.003 + 0.005 * ((k * 7919) % 1000) / 1000.0
         th = 300.0 + 300.0 * ((k * 104729) % 1000) / 1000.0
         theta = thermal_step(theta, th, h, p)
-    o = outputs(x, theta, table, p)
+    o = outputs(x, theta, table, p, theta_cm=th)        # the FMU grows the stack at its input theta_cm
     return [o.torque, o.force, theta, o.u_f, o.x_kiss]

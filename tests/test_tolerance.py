@@ -155,8 +155,9 @@ def test_a_percentile_set_builds_an_fmu_with_its_own_kiss_point(tmp_path, capsys
     start = {v.name: v.start for v in md.modelVariables}
     assert float(start["x_kiss_ref"]) == pytest.approx(4.22e-3, abs=1e-12)
     # at 20 degC (the tables' reference) the kiss point at the bearing is x_kiss_ref itself
+    # a stiff release system (compliance 0): the cover's map is the paper's constant lever 3
     res = simulate_fmu(str(fmu), stop_time=0.01, output_interval=0.01, output=["x_kiss", "u_f"],
-                       start_values={"x_to": 5e-3, "theta_cm": 293.15})
+                       start_values={"x_to": 5e-3, "theta_cm": 293.15, "release_compliance_m_per_N": 0.0})
     assert res["x_kiss"][-1] == pytest.approx(4.22e-3, abs=1e-9)
     assert res["u_f"][-1] == pytest.approx((5e-3 - 4.22e-3) / 3.0, rel=1e-9)
 

@@ -59,8 +59,10 @@ def extended_fmus(tmp_path_factory):
         if folder == constants.MODEL_SRC:
             shutil.copy(folder / module, model_src / module)
     text = (model_src / "clutch_model.py").read_text()
-    last = [line for line in text.splitlines() if line.startswith('    ("omega_slip", "input"')][0]
-    text = text.replace(last, last + f"\n    {EXTRA!r},")
+    # the last row of the table (the line before the closing parenthesis of VARIABLES)
+    head, rest = text.split("\nVARIABLES = (\n", 1)
+    rows, tail = rest.split("\n)\n", 1)
+    text = head + "\nVARIABLES = (\n" + rows + f"\n    {EXTRA!r},\n)\n" + tail
     field = [line for line in text.splitlines() if line.startswith("    lever_ratio: float = ")][0]
     text = text.replace(field, field + f"\n    {EXTRA[0]}: float = {EXTRA_START!r}")
     text = text.replace('        "lever_ratio": (0.0, 100.0, True, False),\n',

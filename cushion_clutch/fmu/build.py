@@ -70,10 +70,11 @@ def add_build_arguments(parser) -> None:
 
 def build_from_args(args) -> str:
     """Build the FMU that parsed ``build-fmu`` options describe; return a one-line report."""
+    from ..model.clutch_model import ClutchParameters
     from ..model.table_format import table_set_x_kiss_ref
     version = getattr(args, "fmi_version", 2)
     out = build_fmu(args.tables, args.output, backend=args.backend, fmi_version=version)
     own = table_set_x_kiss_ref(args.tables)
     kiss = (f"x_kiss_ref = {own * 1e3:.4f} mm (the table set's own kiss point, metadata.json tolerance_study)"
-            if own is not None else f"x_kiss_ref = {clutch_model.ClutchParameters().x_kiss_ref * 1e3:.4f} mm (default)")
+            if own is not None else f"x_kiss_ref = {ClutchParameters().x_kiss_ref * 1e3:.4f} mm (default)")
     return f"built {out} ({args.backend}, FMI {version}.0) from {args.tables}; {kiss}"

@@ -248,15 +248,16 @@ def test_corrupted_states_are_refused_and_change_nothing(capfd):
     s.freeInstance()
 
 
-def _stepping(version: int, name: str, logging: bool = True, start: dict | None = None):
+def _stepping(version: int, name: str, logging: bool = True, start: dict | None = None, cls=None):
     """(slave, value references) of the native FMI ``version`` CS FMU, initialised, in Step Mode at t = 0.
 
-    ``start``: parameter values (by name) set before initialisation.
+    ``start``: parameter values (by name) set before initialisation; ``cls``: the fmpy class to
+    instantiate (default: the CS slave of the version; :func:`_me_instance` passes the ME model).
     """
     fmu = native_fmus()[version]
     md = read_model_description(str(fmu))
     vr = {v.name: v.valueReference for v in md.modelVariables}
-    cls = FMU2Slave if version == 2 else FMU3Slave
+    cls = cls or (FMU2Slave if version == 2 else FMU3Slave)
     s = cls(guid=md.guid, unzipDirectory=extract(str(fmu)), modelIdentifier="CushionClutch", instanceName=name)
     s.instantiate(loggingOn=logging)
     if start:
@@ -418,19 +419,7 @@ def test_fmi3_sources_build_with_fmpy_compile(tmp_path):
 def _me_instance(version):
     from fmpy.fmi2 import FMU2Model
     from fmpy.fmi3 import FMU3Model
-    fmu = native_fmus()[version]
-    md = read_model_description(str(fmu))
-    vr = {v.name: v.valueReference for v in md.modelVariables}
-    cls = FMU2Model if version == 2 else FMU3Model
-    m = cls(guid=md.guid, unzipDirectory=extract(str(fmu)), modelIdentifier=md.modelExchange.modelIdentifier,
-            instanceName=f"me{version}")
-    m.instantiate(loggingOn=False)
-    if version == 2:
-        m.setupExperiment(startTime=0.0)
-        m.enterInitializationMode()
-    else:
-        m.enterInitializationMode(startTime=0.0)
-    m.exitInitializationMode()
+    m, vr = _stepping(version, f"me{version}", logging=False, cls=FMU2Model if version == 2 else FMU3Model)
     if version == 2:
         m.newDiscreteStates()
     else:

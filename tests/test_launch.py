@@ -165,3 +165,21 @@ def test_creep_scenario_demands_stay_under_30_Nm(fmu):
     # hot kiss point nearer than the 20 degC table says: the naive TCU over-fills, the ideal one does not
     assert all(m["creep_error_Nm"] > 1.0 for m in res["naive"].metrics)
     assert all(abs(m["creep_error_Nm"]) < 0.2 for m in res["aware"].metrics)
+
+
+def test_quiet_steps_agree_with_the_fixed_step(fmu):
+    """Quiet TCU periods (car braked at rest, clutch retracted: one FMU step per TCU period) against the all-1-ms run."""
+    sc = short(load_scenario(), launches=2)
+    fixed = simulate_launches(fmu, dataclasses.replace(sc, run=dataclasses.replace(sc.run, quiet_steps=False)),
+                              load_table(), "naive")
+    quiet = simulate_launches(fmu, sc, load_table(), "naive")
+    assert fixed.quiet_s == 0.0 and quiet.quiet_s > 0.4 * quiet.sim_time_s    # the braked rest after each launch
+    assert len(quiet.series) == len(fixed.series)
+    assert abs(quiet.energy.residual()) < 1e-9 * quiet.energy.engine_work
+    for a, b in zip(fixed.metrics, quiet.metrics):
+        assert b["theta_cs_start_degC"] == pytest.approx(a["theta_cs_start_degC"], abs=0.01)
+        assert b["characteristic_error_max_Nm"] == pytest.approx(a["characteristic_error_max_Nm"], abs=0.01)
+        assert b["slip_energy_kJ"] == pytest.approx(a["slip_energy_kJ"], rel=1e-3)
+        assert b["engagement_time_s"] == pytest.approx(a["engagement_time_s"], abs=0.005)
+    assert np.max(np.abs(quiet.series["theta_cm_K"] - fixed.series["theta_cm_K"])) < 0.01
+    assert np.max(np.abs(quiet.series["w_engine_rad_s"] - fixed.series["w_engine_rad_s"])) < 0.1

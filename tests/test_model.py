@@ -236,3 +236,18 @@ def test_argument_bounds(table):
             outputs(0.006, bad, table, P)
     assert thermal_step(300.0, 400.0, 0.0, P) == 300.0
     assert thermal_step(300.0, 400.0, 1e9, P) == pytest.approx((P.U * 400.0 + P.H * P.theta_a) / (P.U + P.H))
+
+
+def test_kiss_point_is_the_outputs_kiss_point():
+    """The frame-free kiss point equals the cover balance's, to the bit, over temperatures and wear."""
+    from cushion_clutch.model import kiss_point
+
+    table = load_table()
+    rng = np.random.default_rng(3)
+    for wear in (0.0, 0.3e-3):
+        p = ClutchParameters(facing_wear=wear)
+        for th, tm in rng.uniform([250.0, 250.0], [560.0, 700.0], size=(200, 2)):
+            assert kiss_point(th, table, p, tm) == outputs(0.004, th, table, p, tm).x_kiss
+        assert kiss_point(300.0, table, p) == outputs(0.0, 300.0, table, p).x_kiss
+    with pytest.raises(ValueError, match="theta_cs"):
+        kiss_point(-1.0, table, ClutchParameters())

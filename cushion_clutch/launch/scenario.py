@@ -224,7 +224,9 @@ class Clutch(Checked):
 
     friction_csv: str = ""
     x_kiss_offset_m: float = 0.0
-    """the plant's kiss point minus the TCU's nominal one, at the bearing (tolerances, wear), m"""
+    """the plant's kiss point minus the TCU's nominal one, at the bearing (tolerances), m"""
+    facing_wear_m: float = 0.0
+    """the plant's facing wear (the clutch FMU's ``facing_wear``), m; the TCUs believe new facings"""
     plant_tables: str = ""
     """table-set folder of the plant (relative to the scenario's folder); "" = the command's --tables"""
     tcu_tables: str = ""
@@ -233,7 +235,7 @@ class Clutch(Checked):
     _section = "clutch"
 
     def _problems(self) -> Iterable[str]:
-        yield from self._ranges({"x_kiss_offset_m": (-0.005, 0.005)})
+        yield from self._ranges({"x_kiss_offset_m": (-0.005, 0.005), "facing_wear_m": (0.0, 0.004)})
         for key in ("friction_csv", "plant_tables", "tcu_tables"):
             if not isinstance(getattr(self, key), str):
                 yield f"clutch.{key} = {getattr(self, key)!r}: must be a file or folder name or \"\""
@@ -254,6 +256,9 @@ class Run(Checked):
     cool_launches: int = 0
     cool_period_s: float = 300.0
     hot_degC: float = 100.0
+    quiet_steps: bool = True
+    """while the car stands braked, the clutch open and retracted (only the engine idles), the clutch FMU
+    and the master advance one TCU period per step; the engine keeps ``step_s``"""
 
     _section = "run"
 
@@ -262,6 +267,8 @@ class Run(Checked):
                                  "cool_launches": (0, 1000), "cool_period_s": (5.0, 3600.0),
                                  "hot_degC": (-50.0, 400.0)})
         yield from self._integers("launches", "cool_launches")
+        if not isinstance(self.quiet_steps, bool):
+            yield f"run.quiet_steps = {self.quiet_steps!r}: must be true or false"
 
     def starts(self) -> list[float]:
         """Start time of every launch, s."""

@@ -1,6 +1,11 @@
 """Repeated vehicle launches: a Python driveline and a TCU around the clutch FMU.
 
-Fixed communication step ``run.step_s``. Each launch slot starts with the
+Communication step ``run.step_s``, except in *quiet* TCU periods (``run.quiet_steps``): while the car
+stands braked with the clutch open and retracted, only the engine (idle governor, still at ``run.step_s``)
+and the temperatures move, and the clutch FMU advances one TCU period per ``doStep`` with the facing
+temperature held (its exact exponential; a held input over 10 instead of 1 ms moves theta_cs by about 1 mK,
+below what the closed loop's own sensitivity moves the metrics). Rows recorded inside a quiet period carry
+the clutch FMU's theta_cs at its end. Each launch slot starts with the
 pre-fill, then the driver presses the pedal (the slot's demand level,
 ``[driver]``) for ``tcu.drive_time_s`` (lifting off above
 ``driver.lift_off_speed_rpm`` once locked), then the clutch opens and the
@@ -32,11 +37,14 @@ from .observer import SpeedSensors
 from .scenario import Scenario
 from .engine import RPM
 from .production import ProductionTcu
-from .tcu import CLOSE, LAUNCH, PREFILL, VARIANTS, TcuController
+from .tcu import CLOSE, LAUNCH, OPEN, PREFILL, VARIANTS, TcuController
 from .thermal import FacingModel
 from .thermal_network import ThermalNetwork
 
 __all__ = ["COLUMNS", "Energy", "LaunchResult", "simulate_launches"]
+
+#: bearing positions closer to zero than this count as retracted (quiet steps), m
+X_RETRACTED_M = 1e-6
 
 #: columns of the time series (SI; recorded every ``record_every`` steps)
 COLUMNS = ("time_s", "launch", "w_engine_rad_s", "w_disc_rad_s", "v_m_s", "accel_m_s2", "x_cmd_m",
@@ -59,6 +67,8 @@ class LaunchResult:
     cpu_time_s: float
     """CPU time of this process in the loop, s (on a shared machine a steadier figure than the wall time)"""
     kiss_estimates: list[tuple[int, float]]
+    quiet_s: float = 0.0
+    """simulated time advanced in quiet steps (``run.quiet_steps``), s"""
 
 
 def _facing_profile(path: str) -> Callable[[float], float]:
@@ -112,7 +122,8 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
     prefill, drive_end = tc.prefill_s, tc.prefill_s + tc.drive_time_s
 
     clutch = ClutchFmu(fmu, {"theta_a": theta_a, "theta_cs_start": theta0,
-                             "x_kiss_ref": p.x_kiss_ref + sc.clutch.x_kiss_offset_m})
+                             "x_kiss_ref": p.x_kiss_ref + sc.clutch.x_kiss_offset_m,
+                             **({"facing_wear": sc.clutch.facing_wear_m} if sc.clutch.facing_wear_m else {})})
     theta_cm = theta0
     x_act = 0.0
     theta_cs, x_kiss = theta0, p.x_kiss_ref
@@ -132,9 +143,13 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
     rec_countdown = 0
     cool_free = profile is None and facing.g > 0.0        # no slip: exact decay towards ambient, inlined
     fac_decay = facing.decay
+    quiet = run.quiet_steps
+    n_quiet = 0
+    h_quiet = tcu_every * h
     wall0, cpu0 = time.perf_counter(), time.process_time()
     try:
-        for k in range(n_steps):
+        k = 0
+        while k < n_steps:
             t = k * h
             if t >= next_switch:
                 n += 1
@@ -155,6 +170,45 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
                 launching = phase == LAUNCH
                 sampling = (launching or phase == PREFILL) and rec.lock_time is None
                 braking = not engaged and tl >= drive_end
+            if (quiet and cycled and braking and ctl.phase == OPEN and ctl.x_cmd == 0.0 and t_cap == 0.0
+                    and -X_RETRACTED_M < x_act < X_RETRACTED_M and not stalled and not dl.locked and dl.v == 0.0
+                    and dl.w_d == 0.0 and dl.phi == 0.0 and k + tcu_every <= n_steps
+                    and (k + tcu_every - 1) * h < next_switch):
+                # -- a quiet TCU period: the car stands braked, the clutch is open and retracted, only the
+                # engine (idle governor, step h) and the temperatures move. One clutch-FMU step of h_quiet
+                # (theta_cm held: its exact exponential), the TCU's next cycle after it.
+                x_act *= act
+                t_cap, theta_cs, x_kiss = clutch_step(t, h_quiet, x_act, theta_cm, dl.w_e)
+                if t_cap != 0.0:
+                    raise RuntimeError(f"t = {t:g} s: the clutch FMU returned {t_cap:g} N.m with the bearing "
+                                       f"retracted to {x_act:g} m (kiss point {x_kiss:g} m)")
+                for j in range(tcu_every):
+                    if j:
+                        x_act *= act
+                    theta_cm_step = theta_cm
+                    t_e = engine_torque(dl.w_e, 0.0, False)
+                    dl_step(t_e, 0.0, False, True)
+                    if net is not None:
+                        net_n += 1
+                        if net_n == net_every:
+                            net.step(net_n * h, net_e / (net_n * h), dl.w_e, 0.0, False)
+                            theta_cm, net_n, net_e = net.theta_cm, 0, 0.0
+                    elif cool_free:
+                        theta_cm = theta_a + (theta_cm - theta_a) * fac_decay
+                    else:
+                        theta_cm = profile(t + (j + 1) * h) if profile is not None else facing_step(theta_cm, 0.0)
+                    if rec_countdown == 0:
+                        rec_countdown = record_every
+                        rows.append((t + j * h, n + 1, dl.w_e, 0.0, 0.0, 0.0, 0.0, x_act, 0.0, 0.0, 0.0,
+                                     theta_cm_step, theta_cs, ctl.theta_now, x_kiss, ctl.kiss_now, engine.throttle,
+                                     0.0, ctl.theta_cm_estimate(), math.nan, 0.0))
+                        if progress is not None and (k + j) % 10000 == 0:
+                            progress(t + j * h)
+                    rec_countdown -= 1
+                countdown = 0
+                k += tcu_every
+                n_quiet += 1
+                continue
             countdown -= 1
             x_cmd = ctl.x_cmd
             x_act = x_cmd + (x_act - x_cmd) * act
@@ -212,6 +266,7 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
                 if progress is not None and k % 10000 == 0:
                     progress(t)
             rec_countdown -= 1
+            k += 1
     finally:
         clutch.close()
     wall, cpu = time.perf_counter() - wall0, time.process_time() - cpu0
@@ -220,4 +275,4 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
     series = np.array(rows, dtype=[(c, float) for c in COLUMNS])
     metrics = [r.metrics(run.hot_degC) for r in recs]
     learned = ctl.learner.estimates if ctl.learner is not None else []
-    return LaunchResult(name, series, metrics, dl.en, events, wall, total, cpu, learned)
+    return LaunchResult(name, series, metrics, dl.en, events, wall, total, cpu, learned, n_quiet * h_quiet)

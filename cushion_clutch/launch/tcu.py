@@ -52,7 +52,7 @@ import copy
 import math
 from dataclasses import dataclass
 
-from ..model import KELVIN, ClutchParameters, SpringTable, outputs, thermal_step, x_to_for_torque
+from ..model import KELVIN, ClutchParameters, SpringTable, kiss_point, outputs, thermal_step, x_to_for_torque
 from .adaptation import KissLearner
 from .observer import FacingObserver
 from .scenario import Scenario
@@ -126,6 +126,8 @@ class TcuController:
         self.rate = self.t_sync = self.jerk = 0.0
         self.x_close = 0.0
         self.t_closed = math.inf
+        self._kiss_key: tuple = ()
+        self._kiss_value = math.nan
         #: the assumed theta_cs (K) and believed kiss point (m) after the last cycle
         self.theta_now, self.kiss_now = self.theta_used(), self.kiss()
 
@@ -152,8 +154,14 @@ class TcuController:
         return self.observer.theta_cm if self.observer is not None else None
 
     def model_kiss(self, theta: float) -> float:
-        """The model's kiss point at ``theta`` (K), m (the cover's balance: cushion, growth, wear)."""
-        return outputs(0.0, theta, self.table, self.p, self.theta_cm_used()).x_kiss
+        """The model's kiss point at ``theta`` (K), m (the cover's balance: cushion, growth, wear).
+
+        The last result is kept: an estimator's temperatures change less often than the TCU cycles.
+        """
+        key = (theta, self.theta_cm_used())
+        if key != self._kiss_key:
+            self._kiss_key, self._kiss_value = key, kiss_point(theta, self.table, self.p, key[1])
+        return self._kiss_value
 
     def kiss(self) -> float:
         """The kiss point the TCU believes, m."""

@@ -22,7 +22,7 @@ Examples
 """
 from .api import load_table, thermal_system, torque
 from .clutch_model import (KELVIN, OMEGA_SLIP_LIMIT, OMEGA_SLIP_START, VARIABLES, ClutchParameters, CoverParameters,
-                           Outputs, SpringTable, outputs, thermal_step, x_to_for_torque)
+                           Outputs, SpringTable, kiss_point, outputs, thermal_step, x_to_for_torque)
 
 __all__ = ["KELVIN", "VARIABLES", "ClutchParameters", "CoverParameters", "Outputs", "SpringTable", "outputs", "thermal_step",
-           "x_to_for_torque", "OMEGA_SLIP_START", "OMEGA_SLIP_LIMIT", "load_table", "torque", "thermal_system"]
+           "x_to_for_torque", "kiss_point", "OMEGA_SLIP_START", "OMEGA_SLIP_LIMIT", "load_table", "torque", "thermal_system"]

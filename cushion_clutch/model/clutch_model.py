@@ -38,7 +38,7 @@ except ImportError:
     from table_format import load_csv
 
 __all__ = ["KELVIN", "VARIABLES", "ClutchParameters", "CoverParameters", "CoverMap", "cover_frame", "Outputs", "SpringTable", "FrictionTable", "Curve",
-           "load_csv", "pchip_slopes", "thermal_step", "friction_coefficient", "outputs", "x_to_for_torque",
+           "load_csv", "pchip_slopes", "thermal_step", "friction_coefficient", "outputs", "x_to_for_torque", "kiss_point",
            "OMEGA_SLIP_START", "OMEGA_SLIP_LIMIT", "start_values"]
 
 #: The FMU interface, in value-reference order: (name, causality, unit, description).
@@ -324,6 +324,26 @@ def outputs(x_to: float, theta_cs: float, table: SpringTable, p: ClutchParameter
     mu = friction_coefficient(table, p, theta_cm, omega_slip)
     return Outputs(p.n_surfaces * mu * p.R_eq * st.clamp_force, st.cushion_force, max(st.u, 0.0), st.x_kiss, clamped,
                    st.clamp_force, st.bearing_force)
+
+
+def kiss_point(theta_cs: float, table: SpringTable, p: ClutchParameters, theta_cm: float | None = None) -> float:
+    """Kiss point at the bearing (m) at ``theta_cs`` and ``theta_cm`` (K; None: ``theta_cs``).
+
+    The same value as ``outputs(x_to, ...).x_kiss`` for any ``x_to``, without solving the
+    cover's balance: the first contact depends on the temperatures and the wear alone. It does
+    not check that the diaphragm holds the fully compressed cushion (:func:`outputs` does).
+
+    Raises
+    ------
+    ValueError
+        Naming the argument or parameter if one is not finite or outside its range.
+    """
+    if not (0.0 < theta_cs < THETA_CM_LIMIT and (theta_cm is None or 0.0 < theta_cm < THETA_CM_LIMIT)
+            and _clutch_ok(p)):
+        raise _argument_error({"theta_cs": theta_cs, **({} if theta_cm is None else {"theta_cm": theta_cm})}, p,
+                              CLUTCH_PARAMETERS)
+    return _cover_map(p.cover, p.lever_ratio).x_kiss(theta_cs, theta_cs if theta_cm is None else theta_cm,
+                                                     p.facing_wear, table, p.x_kiss_ref)
 
 
 def x_to_for_torque(torque: float, theta_cs: float, table: SpringTable, p: ClutchParameters,

@@ -267,13 +267,31 @@ class CoverMap:
     # ---- the map ----------------------------------------------------------------------------
     def prepare(self, theta_cs: float, theta_cm: float, wear: float, table, x_kiss_ref: float) -> "_Frame":
         """Everything of the balance that depends on temperature and wear, not on ``x_to``."""
-        c, kp = self.c, self.kp
         theta_c = theta_cs - 273.15
-        stack = table.delta_kiss(theta_c) + sum(self.growth(theta_cm).values())
-        s_kiss = c.installed_deflection_m + (table.full_compression(c.reference_temperature_K - 273.15)
-                                             + stack - wear) / kp
+        s_kiss = self.s_kiss(theta_cs, theta_cm, wear, table)
         return _Frame(self, table, theta_c, self.youngs_modulus(theta_cs), self.x_c(table, x_kiss_ref), s_kiss,
-                      s_kiss - table.full_compression(theta_c) / kp, theta_cs, wear)
+                      s_kiss - table.full_compression(theta_c) / self.kp, theta_cs, wear)
+
+    def s_kiss(self, theta_cs: float, theta_cm: float, wear: float, table) -> float:
+        """Diaphragm deflection (m) at the kiss point: installed deflection, cushion shift, stack growth, wear."""
+        c = self.c
+        g = theta_cm - c.reference_temperature_K
+        stack = table.delta_kiss(theta_cs - 273.15) + (
+            c.facing_thickness_m * c.facing_expansion_per_K * g
+            + c.pressure_plate_thickness_m * c.pressure_plate_expansion_per_K * g
+            + c.flywheel_length_m * c.flywheel_expansion_per_K * g)        # = sum(self.growth(theta_cm).values())
+        return c.installed_deflection_m + (table.full_compression(c.reference_temperature_K - 273.15)
+                                           + stack - wear) / self.kp
+
+    def x_kiss(self, theta_cs: float, theta_cm: float, wear: float, table, x_kiss_ref: float) -> float:
+        """Bearing position of the kiss point (m); the same number as ``prepare(...).x_kiss``, without the frame.
+
+        Unlike :meth:`prepare` it does not check that the diaphragm holds the fully compressed cushion.
+        """
+        s = self.s_kiss(theta_cs, theta_cm, wear, table)
+        f_to = (self.moment(s, self.youngs_modulus(theta_cs)) - table.force(0.0, theta_cs - 273.15) * self.L_pp) \
+            / self.L_b
+        return self.x_c(table, x_kiss_ref) - self.kb * s - self.comp * f_to
 
     def state(self, x_to: float, theta_cs: float, theta_cm: float, wear: float, table, x_kiss_ref: float,
               tol: float = 1e-15) -> CoverState:

@@ -1,7 +1,7 @@
 """Benchmark: real-time factor of a launch scenario for every TCU variant, or the README's launch tables.
 
     python -m cushion_clutch.benchmarks.launch [--scenario NAME|FILE] [--backend native|python] [--repeat N]
-    python -m cushion_clutch.benchmarks.launch --markdown [--scenarios default,creep,cooldown,fade]
+    python -m cushion_clutch.benchmarks.launch --markdown [--scenarios default,creep,cooldown,fade,wear,tolerance]
 
 The first form also times one FMU step (set inputs, doStep, get outputs)
 through the master's cffi client and through fmpy's ``FMU2Slave`` in the
@@ -98,7 +98,7 @@ def main(argv=None) -> None:
     ap.add_argument("--backend", default="native", choices=("native", "python"))
     ap.add_argument("--repeat", type=int, default=1, help="runs per variant; the median is printed")
     ap.add_argument("--markdown", action="store_true", help="print the README's launch results tables")
-    ap.add_argument("--scenarios", default="default,creep,cooldown,fade", help="with --markdown")
+    ap.add_argument("--scenarios", default="default,creep,cooldown,fade,wear,tolerance", help="with --markdown")
     args = ap.parse_args(argv)
     if args.markdown:
         for part in markdown(args.scenarios.split(","), args.backend):
@@ -118,7 +118,8 @@ def main(argv=None) -> None:
             cpu = statistics.median(r.cpu_time_s for r in runs)
             print(f"{name:>24} TCU: {sim:g} s simulated in {wall:.2f} s wall -> real-time factor "
                   f"{sim / wall:.0f}x ({wall / steps * 1e6:.2f} us per {sc.run.step_s * 1e3:g} ms step); "
-                  f"CPU time {cpu:.2f} s -> {sim / cpu:.0f}x")
+                  f"CPU time {cpu:.2f} s -> {sim / cpu:.0f}x; {runs[0].quiet_s / sim:.0%} of the time in quiet "
+                  f"steps")
 
 
 if __name__ == "__main__":

@@ -143,9 +143,11 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
     rec_countdown = 0
     cool_free = profile is None and facing.g > 0.0        # no slip: exact decay towards ambient, inlined
     fac_decay = facing.decay
-    quiet = run.quiet_steps
-    n_quiet = 0
     h_quiet = tcu_every * h
+    quiet = run.quiet_steps
+    act_quiet = act ** tcu_every
+    facing_quiet = FacingModel(fac.capacity_J_per_K, fac.loss_W_per_K, fac.heat_share, theta_a, h_quiet)
+    n_quiet = 0
     wall0, cpu0 = time.perf_counter(), time.process_time()
     try:
         k = 0
@@ -175,28 +177,29 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
                     and dl.w_d == 0.0 and dl.phi == 0.0 and k + tcu_every <= n_steps
                     and (k + tcu_every - 1) * h < next_switch):
                 # -- a quiet TCU period: the car stands braked, the clutch is open and retracted, only the
-                # engine (idle governor, step h) and the temperatures move. One clutch-FMU step of h_quiet
-                # (theta_cm held: its exact exponential), the TCU's next cycle after it.
-                x_act *= act
+                # engine's idle governor and the temperatures move: one step of h_quiet for all of them
+                # (the clutch FMU's theta_cs and the facing decay are exact exponentials for held inputs; the
+                # idle engine is the same explicit step, stable and settled long before the next launch)
+                x_act *= act_quiet
                 t_cap, theta_cs, x_kiss = clutch_step(t, h_quiet, x_act, theta_cm, dl.w_e)
                 if t_cap != 0.0:
                     raise RuntimeError(f"t = {t:g} s: the clutch FMU returned {t_cap:g} N.m with the bearing "
                                        f"retracted to {x_act:g} m (kiss point {x_kiss:g} m)")
+                theta_cm_step = theta_cm
+                engine.h = dl.h = h_quiet
+                t_e = engine_torque(dl.w_e, 0.0, False)
+                dl_step(t_e, 0.0, False, True)
+                engine.h = dl.h = h
+                if net is not None:
+                    net_n += tcu_every
+                    if net_n >= net_every:
+                        net.step(net_n * h, net_e / (net_n * h), dl.w_e, 0.0, False)
+                        theta_cm, net_n, net_e = net.theta_cm, 0, 0.0
+                elif profile is not None:
+                    theta_cm = profile(t + h_quiet)
+                else:
+                    theta_cm = facing_quiet.step(theta_cm, 0.0)
                 for j in range(tcu_every):
-                    if j:
-                        x_act *= act
-                    theta_cm_step = theta_cm
-                    t_e = engine_torque(dl.w_e, 0.0, False)
-                    dl_step(t_e, 0.0, False, True)
-                    if net is not None:
-                        net_n += 1
-                        if net_n == net_every:
-                            net.step(net_n * h, net_e / (net_n * h), dl.w_e, 0.0, False)
-                            theta_cm, net_n, net_e = net.theta_cm, 0, 0.0
-                    elif cool_free:
-                        theta_cm = theta_a + (theta_cm - theta_a) * fac_decay
-                    else:
-                        theta_cm = profile(t + (j + 1) * h) if profile is not None else facing_step(theta_cm, 0.0)
                     if rec_countdown == 0:
                         rec_countdown = record_every
                         rows.append((t + j * h, n + 1, dl.w_e, 0.0, 0.0, 0.0, 0.0, x_act, 0.0, 0.0, 0.0,

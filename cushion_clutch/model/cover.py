@@ -414,10 +414,20 @@ class _Frame:
         lo, hi = table.first_contact(th), table.full_compression(th)
         if force <= table.force(lo, th):
             return self.x_of(self.s_kiss - lo / g.kp)
-        while hi - lo > tol_m / g.i:
-            mid = 0.5 * (lo + hi)
-            if table.force(mid, th) < force:
-                lo = mid
+        # the smallest compression u with F(u) >= force, to tol: a bracket F(lo) < force <= F(hi) closed by
+        # Newton steps (bisection where a step leaves it); once a step is below tol the other side of the
+        # root is probed, so the bracket, not the step, ends the search
+        tol = tol_m / g.i
+        u = 0.5 * (lo + hi)
+        while hi - lo > tol:
+            r = self.cushion(u) - force
+            if r < 0.0:
+                lo = u
             else:
-                hi = mid
+                hi = u
+            d = self.cushion_slope(u)
+            u_new = u - r / d if d > 0.0 else 0.5 * (lo + hi)
+            if abs(u_new - u) < 0.5 * tol:
+                u_new += 0.5 * tol if r < 0.0 else -0.5 * tol
+            u = u_new if lo < u_new < hi else 0.5 * (lo + hi)
         return self.x_of(self.s_kiss - hi / g.kp)

@@ -257,8 +257,8 @@ class Run(Checked):
     cool_period_s: float = 300.0
     hot_degC: float = 100.0
     quiet_steps: bool = True
-    """while the car stands braked, the clutch open and retracted (only the engine idles), the clutch FMU
-    and the master advance one TCU period per step; the engine keeps ``step_s``"""
+    """while the car stands braked, the clutch open and retracted (only the engine idles), the master, the
+    idle engine and the clutch FMU advance one TCU period per step (false: ``step_s`` throughout)"""
 
     _section = "run"
 

@@ -1,12 +1,12 @@
 """Repeated vehicle launches: a Python driveline and a TCU around the clutch FMU.
 
 Communication step ``run.step_s``, except in *quiet* TCU periods (``run.quiet_steps``): while the car
-stands braked with the clutch open and retracted, only the engine (idle governor, still at ``run.step_s``)
-and the temperatures move, and the clutch FMU advances one TCU period per ``doStep`` with the facing
-temperature held (its exact exponential; a held input over 10 instead of 1 ms moves theta_cs by about 1 mK,
-below what the closed loop's own sensitivity moves the metrics). Rows recorded inside a quiet period carry
-the clutch FMU's theta_cs at its end. Each launch slot starts with the
-pre-fill, then the driver presses the pedal (the slot's demand level,
+stands braked with the clutch open and retracted, only the idle engine and the temperatures move, and the
+master, the engine and the clutch FMU advance one TCU period per step with the facing temperature held
+(the FMU's theta_cs step is its ODE's exact exponential; a held input over 10 instead of 1 ms moves
+theta_cs by about 1 mK). Rows recorded inside a quiet period carry the state at its end.
+
+Each launch slot starts with the pre-fill, then the driver presses the pedal (the slot's demand level,
 ``[driver]``) for ``tcu.drive_time_s`` (lifting off above
 ``driver.lift_off_speed_rpm`` once locked), then the clutch opens and the
 brake stops the car. Per step: the TCU (every ``tcu.period_s``,

@@ -246,11 +246,22 @@ class Outputs:
 
 
 @lru_cache(maxsize=32)
-def _cover_map(cover: CoverParameters, lever_ratio: float) -> CoverMap:
+def _cover_map_cached(cover: CoverParameters, lever_ratio: float) -> CoverMap:
     return CoverMap(cover, lever_ratio)
 
 
-_LAST_FRAME: list = [None, None, None]   # table, key, frame: the last temperature/wear frame
+_LAST_MAP: list = [None, None, None]     # cover, lever ratio, map: CoverParameters is frozen, so identity suffices
+
+
+def _cover_map(cover: CoverParameters, lever_ratio: float) -> CoverMap:
+    if cover is _LAST_MAP[0] and lever_ratio == _LAST_MAP[1]:
+        return _LAST_MAP[2]
+    m = _cover_map_cached(cover, lever_ratio)
+    _LAST_MAP[:] = [cover, lever_ratio, m]
+    return m
+
+
+_LAST_FRAME: list = [None, None, None, None]   # table, key, frame, cover: the last temperature/wear frame
 
 
 def cover_frame(table: SpringTable, p: ClutchParameters, theta_cs: float, theta_cm: float):
@@ -261,11 +272,11 @@ def cover_frame(table: SpringTable, p: ClutchParameters, theta_cs: float, theta_
     ValueError
         If the diaphragm cannot hold the cushion at this temperature and wear.
     """
-    key = (p.cover, p.lever_ratio, p.x_kiss_ref, p.facing_wear, theta_cs, theta_cm)
-    if _LAST_FRAME[0] is table and _LAST_FRAME[1] == key:
+    key = (p.lever_ratio, p.x_kiss_ref, p.facing_wear, theta_cs, theta_cm)
+    if _LAST_FRAME[0] is table and _LAST_FRAME[3] is p.cover and _LAST_FRAME[1] == key:
         return _LAST_FRAME[2]
     frame = _cover_map(p.cover, p.lever_ratio).prepare(theta_cs, theta_cm, p.facing_wear, table, p.x_kiss_ref)
-    _LAST_FRAME[:] = [table, key, frame]
+    _LAST_FRAME[:] = [table, key, frame, p.cover]
     return frame
 
 
@@ -281,8 +292,19 @@ def _clutch_ok(p: ClutchParameters) -> bool:
 
 
 @lru_cache(maxsize=32)
-def _cover_problems(cover: CoverParameters, lever_ratio: float) -> tuple[str, ...]:
+def _cover_problems_cached(cover: CoverParameters, lever_ratio: float) -> tuple[str, ...]:
     return tuple(cover.problems(lever_ratio))
+
+
+_LAST_PROBLEMS: list = [None, None, ()]   # cover, lever ratio, problems (CoverParameters is frozen)
+
+
+def _cover_problems(cover: CoverParameters, lever_ratio: float) -> tuple[str, ...]:
+    if cover is _LAST_PROBLEMS[0] and lever_ratio == _LAST_PROBLEMS[1]:
+        return _LAST_PROBLEMS[2]
+    out = _cover_problems_cached(cover, lever_ratio)
+    _LAST_PROBLEMS[:] = [cover, lever_ratio, out]
+    return out
 
 
 def friction_coefficient(table: SpringTable, p: ClutchParameters, theta_cm: float | None,

@@ -224,6 +224,7 @@ class CoverMap:
         #: F_AL(s) / E / (s/t) / [...]: the Almen-Laszlo factor without E, 1/Pa * N
         self._fal = 4.0 / (1.0 - nu * nu) * t ** 4 / (k1(self.a, self.b) * 4.0 * self.a * self.a)
         self._xc: tuple = (None, None, None)     # (table, x_kiss_ref, X_c) of the last call: holds one table only
+        self._u_full_ref: tuple = (None, 0.0)     # (table, full compression at the reference temperature)
 
     # ---- pieces ---------------------------------------------------------------------------
     def youngs_modulus(self, theta_K: float) -> float:
@@ -280,8 +281,9 @@ class CoverMap:
             c.facing_thickness_m * c.facing_expansion_per_K * g
             + c.pressure_plate_thickness_m * c.pressure_plate_expansion_per_K * g
             + c.flywheel_length_m * c.flywheel_expansion_per_K * g)        # = sum(self.growth(theta_cm).values())
-        return c.installed_deflection_m + (table.full_compression(c.reference_temperature_K - 273.15)
-                                           + stack - wear) / self.kp
+        if self._u_full_ref[0] is not table:        # the cushion's full compression at the reference temperature
+            self._u_full_ref = (table, table.full_compression(c.reference_temperature_K - 273.15))
+        return c.installed_deflection_m + (self._u_full_ref[1] + stack - wear) / self.kp
 
     def x_kiss(self, theta_cs: float, theta_cm: float, wear: float, table, x_kiss_ref: float) -> float:
         """Bearing position of the kiss point (m); the same number as ``prepare(...).x_kiss``, without the frame.

@@ -128,19 +128,23 @@ class ProductionTcu(TcuController):
         slip = w_e - w_d
         if len(self.hist) <= WINDOW:
             return readings
+        if self.phase == OPEN:            # clutch open: no clutch torque, no RLS update, no correction
+            e.accumulate(self.period, 0.0)
+            if e.due():
+                e.predict(w_e, w_d, False)
+            return readings
         span = WINDOW * self.period
         h0, h1 = self.hist[0], self.hist[-1]
         items = list(self.hist)[1:]
         t_est = sum(i[2] for i in items) / WINDOW
         x_mean = sum(i[3] for i in items) / WINDOW
-        t_c = t_est - self.j_e * (h1[0] - h0[0]) / span if self.phase != OPEN else 0.0
+        t_c = t_est - self.j_e * (h1[0] - h0[0]) / span
         v = h1[1] * self.r / self.i_tot               # wheel speed at the disc (ABS sensors)
         a = (h1[1] - h0[1]) / span * self.r / self.i_tot
-        if self.phase != OPEN:
-            self.rls.update(t_c, v, a)
+        self.rls.update(t_c, v, a)
         e.accumulate(self.period, max(t_c, 0.0) * abs(slip) if launching else 0.0)
         if e.due():
-            e.predict(w_e, w_d, self.phase != OPEN)
+            e.predict(w_e, w_d, True)
             if launching:
                 e.correct(t_c, x_mean, slip, True)
                 if self.rls.ready()[1] and h1[1] > 0.0 and h0[1] > 0.0:

@@ -130,7 +130,7 @@ class EkfParams(Checked):
     mu_deadband: float = 0.05
     """the engine torque estimate's stated gain accuracy: a learned mu_scale within 1 +- this is not applied"""
     temperature_update: bool = True
-    loss_scale_sd: float = 0.3
+    loss_scale_sd: float = 0.5
     """prior sd of the heat-loss scale (every node's sink conductance: convection and engine block), 1;
     0 keeps the network's losses as given"""
     loss_walk_per_s: float = 1e-7

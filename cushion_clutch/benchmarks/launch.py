@@ -54,6 +54,31 @@ def _fmu_call_us(fmu: Path, n: int = 50000) -> tuple[float, float]:
     return ours, theirs
 
 
+#: issue 17's targets for the production TCU: worst characteristic error (3 % of the engine's 240 N.m peak)
+#: and worst cushion-spring temperature error through the cool-down; naive at least this factor worse
+PRODUCTION_CHARACTERISTIC_NM, PRODUCTION_COOLDOWN_THETA_K, NAIVE_OVER_PRODUCTION = 7.2, 15.0, 2.0
+
+
+def production_line(results, group: str) -> str:
+    """One line: the production TCU in ``group`` against its targets (measured values, target in brackets)."""
+    from cushion_clutch.launch.report import summary_rows
+
+    rows = {r["tcu"]: r for r in summary_rows(results) if r["group"] == group}
+    if "production" not in rows:
+        return f"{group}: production: –"
+    p = rows["production"]
+    ch, th = p["characteristic_error_max_Nm_worst"], p["theta_cs_error_K_worst"]
+    text = (f"{group}: production worst characteristic_error_max_Nm {ch:.3f} "
+            f"(target <= {PRODUCTION_CHARACTERISTIC_NM:g})")
+    if "naive" in rows and ch > 0:
+        text += (f", naive / production {rows['naive']['characteristic_error_max_Nm_worst'] / ch:.1f}x "
+                 f"(target >= {NAIVE_OVER_PRODUCTION:g}x in default and wear)")
+    text += f", theta_cs_error_K worst {th:+.1f} K"
+    if group == "cool-down":
+        text += f" (target |.| <= {PRODUCTION_COOLDOWN_THETA_K:g} K)"
+    return text
+
+
 def markdown(scenarios: list[str], backend: str = "native") -> Iterator[str]:
     """The launch results of every scenario as Markdown (summary table, ratio, real-time factors), one
     scenario at a time."""
@@ -80,6 +105,7 @@ def markdown(scenarios: list[str], backend: str = "native") -> Iterator[str]:
             for g in groups:
                 parts.append(f"Group `{g}`:\n\n" + summary_table(results, (g,)))
                 parts.append("- " + ratio_line(results, g))
+                parts.append("- " + production_line(results, g))
             parts.append("- real-time factor (wall / CPU time): " + ", ".join(
                 f"{n} {sim / r.wall_time_s:.0f}x / {sim / r.cpu_time_s:.0f}x" for n, r in results.items()))
             yield "\n\n".join(parts)

@@ -7,7 +7,7 @@ import pytest
 from cushion_clutch.errors import ParameterError
 from cushion_clutch.model import load_table
 from cushion_clutch.model import ClutchParameters, outputs, thermal_step, x_to_for_torque
-from cushion_clutch.launch.ekf import IX_LOSS, ClutchEkf, EkfParams, TcuNetworkParams
+from cushion_clutch.launch.ekf import IX_DX, IX_LOSS, ClutchEkf, EkfParams, TcuNetworkParams
 from cushion_clutch.launch.thermal_network import NetworkParams, ThermalNetwork
 
 TA = 293.15
@@ -162,3 +162,20 @@ def test_matched_network_keeps_its_scales(table):
     ekf, err = hot_launches_then_cool_down(table, EkfParams(torque_sd_Nm=0.5), 1.0, hot=4, cool=1)
     assert ekf.loss_scale == pytest.approx(1.0, abs=0.05) and ekf.heat_scale == pytest.approx(1.0, abs=0.05)
     assert max(abs(x) for x in err) < 2.0
+
+
+def test_temperatures_are_corrected_only_above_their_torque(table):
+    """Near the kiss point a temperature error looks like a touch-point offset: only dx moves there."""
+    p = ClutchParameters()
+    for torque, thermal in ((20.0, False), (120.0, True)):
+        ekf = ClutchEkf(TcuNetworkParams(), EkfParams(), table, p, TA, TA + 100.0)
+        for _ in range(100):                        # 10 s of cooling: the losses' covariance with the temperatures
+            ekf.accumulate(0.1, 0.0)
+            ekf.predict(190.0, 190.0, True)
+        x = x_to_for_torque(torque, ekf.theta_cs, table, p, theta_cm=ekf.theta_cm)
+        assert ekf.model_torque(x) == pytest.approx(torque, abs=0.5)
+        s0 = ekf.s.copy()
+        assert ekf.correct(torque + 3.0, x, 100.0, True)
+        assert (not np.array_equal(ekf.s[:5], s0[:5])) == thermal
+        assert (ekf.s[IX_LOSS] != s0[IX_LOSS]) == thermal          # facings 100 K above ambient
+        assert ekf.s[IX_DX] != s0[IX_DX] or torque > EkfParams().touch_torque_max_Nm

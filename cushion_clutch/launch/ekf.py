@@ -55,8 +55,15 @@ State (K, K, K, K, K, m, 1, 1, 1)::
   ramp. Disjoint bands make the two parameters trade errors and converge
   slowly over many launches; the characteristic itself (what the TCU
   commands through) converges within a launch either way;
-  - temperatures and ``k_heat``: all of the above (``temperature_update = false``
-    leaves the thermal states and scales to the prediction alone);
+  - temperatures and ``k_heat``: all of the above and a model torque of at
+    least ``theta_torque_min_Nm`` (``temperature_update = false`` leaves the
+    thermal states and scales to the prediction alone). Near the kiss point a
+    temperature error moves the characteristic like a touch-point offset
+    (``dT/dtheta`` and ``dT/dx_kiss`` nearly collinear); at higher torque the
+    temperature has its own signature (the facings' growth, the spring's
+    softening changing sign along the curve). Without this condition, in the
+    ``creep`` scenario (20 N.m launches only) the two traded errors and the worst
+    characteristic error doubled;
   - ``k_loss``: in addition, the estimated facings at least
     ``loss_excitation_K`` above the ambient (the losses are proportional to
     the temperature rise: near ambient a residual says nothing about them).
@@ -140,6 +147,8 @@ class EkfParams(Checked):
     0 keeps the slip power as measured"""
     heat_walk_per_s: float = 1e-7
     """random walk of the heat-input scale, 1/s"""
+    theta_torque_min_Nm: float = 40.0
+    """the temperatures and both thermal scales are corrected only above this model torque, N.m"""
     loss_excitation_K: float = 30.0
     """the heat-loss scale is corrected only while the estimated facings are this far above the ambient, K"""
     scale_min: float = 0.25
@@ -156,7 +165,7 @@ class EkfParams(Checked):
             "slip_min_rad_s": (0.0, 1e3), "touch_torque_min_Nm": (0.0, 1e4), "touch_torque_max_Nm": (0.0, 1e4),
             "mu_torque_min_Nm": (0.0, 1e4), "gate_sd": (1.0, 100.0, True),
             "mu_deadband": (0.0, 0.5), "loss_scale_sd": (0.0, 2.0), "loss_walk_per_s": (0.0, 1.0),
-            "heat_scale_sd": (0.0, 2.0), "heat_walk_per_s": (0.0, 1.0), "loss_excitation_K": (0.0, 500.0),
+            "heat_scale_sd": (0.0, 2.0), "heat_walk_per_s": (0.0, 1.0), "loss_excitation_K": (0.0, 500.0), "theta_torque_min_Nm": (0.0, 1e4),
             "scale_min": (0.0, 1.0, True), "scale_max": (1.0, 100.0)})
         if self.touch_torque_max_Nm <= self.touch_torque_min_Nm:
             yield "ekf.touch_torque_max_Nm: must exceed ekf.touch_torque_min_Nm"
@@ -366,7 +375,7 @@ class ClutchEkf:
             mask[IX_MU] = True
         if not mask.any():
             return False
-        if e.temperature_update:
+        if e.temperature_update and h0 >= e.theta_torque_min_Nm:
             mask[:5] = True
             mask[IX_HEAT] = e.heat_scale_sd > 0.0
             mask[IX_LOSS] = e.loss_scale_sd > 0.0 and self.theta_cm - self.theta_a >= e.loss_excitation_K

@@ -25,8 +25,8 @@ State (K, K, K, K, K, m, 1, 1, 1)::
   scale and the temperatures grows while heat flows in (``k_heat``) or out
   (``k_loss``, in proportion to ``theta - theta_sink``), and a torque residual
   at the next launch corrects the scale through it. Besides learning, the
-  scales make the filter honest: a network that may lose 30 % more or less heat
-  is uncertain by tens of kelvin after a five-minute cool-down, so the torque
+  scales make the filter honest: a network that may lose half as much heat or half again
+  as much is uncertain by tens of kelvin after a five-minute cool-down, so the torque
   residuals move the temperatures, which a filter sure of its network ignores.
   Both scales are kept within ``[scale_min, scale_max]``.
 * **Measurement** (during slip): the clutch torque from the engine side,

@@ -7,7 +7,7 @@ import pytest
 from cushion_clutch.errors import ParameterError
 from cushion_clutch.model import load_table
 from cushion_clutch.model import ClutchParameters, outputs, thermal_step, x_to_for_torque
-from cushion_clutch.launch.ekf import ClutchEkf, EkfParams, TcuNetworkParams
+from cushion_clutch.launch.ekf import IX_DX, IX_LOSS, ClutchEkf, EkfParams, TcuNetworkParams
 from cushion_clutch.launch.thermal_network import NetworkParams, ThermalNetwork
 
 TA = 293.15
@@ -100,3 +100,82 @@ def test_parameters_are_checked():
     with pytest.raises(ParameterError) as err:
         TcuNetworkParams(spring_C_J_per_K=0.0)
     assert "tcu_thermal.spring_C_J_per_K" in str(err.value)
+    with pytest.raises(ParameterError) as err:
+        EkfParams(scale_min=0.0, loss_scale_sd=-0.1)
+    assert "ekf.scale_min" in str(err.value) and "ekf.loss_scale_sd" in str(err.value)
+
+
+def lumped_pair(tcu_loss_factor):
+    """A lumped plant mapped onto the network (450 J/K, 1.35 W/K, all slip heat into the facings) and the
+    TCU's copy with its heat-loss conductance times ``tcu_loss_factor`` (everything else matched)."""
+    lumped = dict(facing_capacity_J_per_K=225.0, convection_gain_at_reference=1.0,
+                  metal_effusivity_W_s05_per_m2_K=1.0, contact_W_per_K=0.0, disc_W_per_K=100.0,
+                  engine_W_per_K=0.0)
+    return (NetworkParams(facing_convection_W_per_K=0.675, **lumped),
+            TcuNetworkParams(facing_convection_W_per_K=0.675 * tcu_loss_factor, **lumped))
+
+
+def hot_launches_then_cool_down(table, e, tcu_loss_factor, hot=8, cool=3):
+    """Launches of 3 s slip at 50 rad/s (10 to 150 N.m, then 150 N.m) every 60 s, then every 300 s;
+    the measured torque is the exact model at the plant's temperatures. Returns the EKF and the
+    theta_cs error (estimate minus truth) at the start of every launch, K."""
+    plant, tcu = lumped_pair(tcu_loss_factor)
+    p = ClutchParameters()
+    net = ThermalNetwork(plant, TA, TA)
+    ekf = ClutchEkf(tcu, e, table, p, TA, TA)
+    theta_cs, errors, dt, w_slip = TA, [], 0.1, 50.0
+    ramp = np.concatenate([np.linspace(10.0, 150.0, 20), np.full(10, 150.0)])
+    for period in [60.0] * hot + [300.0] * cool:
+        errors.append(ekf.theta_cs - theta_cs)
+        for k in range(int(round(period / dt))):
+            launching = k < len(ramp)
+            pw = 0.0
+            if launching:
+                x = x_to_for_torque(ramp[k] / ekf.mu_scale, ekf.theta_cs, table, p, theta_cm=ekf.theta_cm) \
+                    + ekf.dx_kiss
+                torque = outputs(x, theta_cs, table, p, net.theta_cm).torque
+                pw = torque * w_slip
+            net.step(dt, pw, 190.0, 190.0 - w_slip if launching else 190.0, launching)
+            theta_cs = thermal_step(theta_cs, net.theta_cm, dt, p)
+            ekf.accumulate(dt, pw)
+            ekf.predict(190.0, 190.0 - w_slip if launching else 190.0, launching)
+            if launching:
+                ekf.correct(torque, x, w_slip, True)
+    return ekf, errors
+
+
+def test_augmented_ekf_learns_a_heat_loss_mismatch(table):
+    """The TCU's network loses 20 % too little heat (true loss scale 1.25): the scale is learned from the
+    torque (through the temperatures' covariance with it) and halves the cool-down error."""
+    e = EkfParams(torque_sd_Nm=0.5)                 # the synthetic torque is exact: a good torque sensor
+    ekf, err = hot_launches_then_cool_down(table, e, 0.8)
+    fixed, err_fixed = hot_launches_then_cool_down(table, dataclasses.replace(e, loss_scale_sd=0.0), 0.8)
+    assert fixed.loss_scale == 1.0
+    assert 1.1 < ekf.loss_scale < 1.35
+    assert np.sqrt(ekf.P[IX_LOSS, IX_LOSS]) < 0.6 * e.loss_scale_sd          # it was informative
+    cool = slice(-3, None)                          # the cool-down launches
+    assert max(abs(x) for x in err_fixed[cool]) > 8.0                      # K: the wrong losses, unlearned
+    assert max(abs(x) for x in err[cool]) < 0.5 * max(abs(x) for x in err_fixed[cool])
+
+
+def test_matched_network_keeps_its_scales(table):
+    ekf, err = hot_launches_then_cool_down(table, EkfParams(torque_sd_Nm=0.5), 1.0, hot=4, cool=1)
+    assert ekf.loss_scale == pytest.approx(1.0, abs=0.05) and ekf.heat_scale == pytest.approx(1.0, abs=0.05)
+    assert max(abs(x) for x in err) < 2.0
+
+
+def test_temperatures_are_corrected_only_above_their_torque(table):
+    """Near the kiss point a temperature error looks like a touch-point offset: only dx moves there."""
+    p = ClutchParameters()
+    for torque, thermal in ((20.0, False), (120.0, True)):
+        ekf = ClutchEkf(TcuNetworkParams(), EkfParams(), table, p, TA, TA + 100.0)
+        for _ in range(100):                        # 10 s of cooling: the losses' covariance with the temperatures
+            ekf.accumulate(0.1, 0.0)
+            ekf.predict(190.0, 190.0, True)
+        x = x_to_for_torque(torque, ekf.theta_cs, table, p, theta_cm=ekf.theta_cm)
+        assert ekf.model_torque(x) == pytest.approx(torque, abs=0.5)
+        s0 = ekf.s.copy()
+        assert ekf.correct(torque + 3.0, x, 100.0, True)
+        assert (not np.array_equal(ekf.s[:5], s0[:5])) == thermal
+        assert (ekf.s[IX_LOSS] != s0[IX_LOSS]) == thermal          # facings 100 K above ambient
+        assert ekf.s[IX_DX] != s0[IX_DX] or torque > EkfParams().touch_torque_max_Nm

@@ -1,22 +1,42 @@
-"""The production TCU's estimator: an extended Kalman filter on its own thermal network, with touch-point and mu adaptation.
+"""The production TCU's estimator: an extended Kalman filter on its own thermal network, with touch-point,
+mu and thermal-parameter adaptation.
 
-State (K, K, K, K, K, m, 1)::
+State (K, K, K, K, K, m, 1, 1, 1)::
 
-    s = [theta_fw, theta_f1, theta_f2, theta_pp, theta_cs, dx_kiss, mu_scale]
+    s = [theta_fw, theta_f1, theta_f2, theta_pp, theta_cs, dx_kiss, mu_scale, k_loss, k_heat]
 
 * **Prediction**: the TCU's own :class:`~.thermal_network.ThermalNetwork`
   (parameters ``[tcu_thermal]``, deliberately not the plant's) heated by
-  ``P = T_est w_slip``, the engine control unit's torque estimate times the
-  measured slip speed, plus the cushion-spring ODE with the TCU's U, H, C
-  (``C dtheta_cs/dt = U (theta_cm - theta_cs) + H (theta_a - theta_cs)``,
-  ``theta_cm`` the mean of the facings). ``dx_kiss`` (touch-point offset at the
-  bearing) and ``mu_scale`` (friction relative to the nominal mu) are random
-  walks. Process noise: ``heat_share_sd`` of each node's slip heat, plus the
-  random walks.
+  ``k_heat P``, ``P = T_est w_slip`` the engine control unit's torque estimate
+  times the measured slip speed, and losing heat to the air and the engine
+  block through ``k_loss`` times its sink conductances; plus the cushion-spring
+  ODE with the TCU's U, H, C (``C dtheta_cs/dt = U (theta_cm - theta_cs) +
+  H (theta_a - theta_cs)``, ``theta_cm`` the mean of the facings; not scaled:
+  they are the clutch model's). ``dx_kiss`` (touch-point offset at the
+  bearing), ``mu_scale`` (friction relative to the nominal mu) and the two
+  thermal scales are random walks. Process noise: ``heat_share_sd`` of each
+  node's slip heat, plus the random walks.
+* **Thermal scales** (what a production TCU adapts instead of being given the
+  plant's values): ``k_loss`` (prior sd ``loss_scale_sd``) stands for the
+  convection and conduction losses the network gets wrong, ``k_heat`` (prior
+  sd ``heat_scale_sd``) for the slip heat per J/K the network gets wrong (a
+  heat-capacity error, the torque estimate's gain and offset). Their effect on
+  the temperatures accumulates in the prediction: the covariance between a
+  scale and the temperatures grows while heat flows in (``k_heat``) or out
+  (``k_loss``, in proportion to ``theta - theta_sink``), and a torque residual
+  at the next launch corrects the scale through it. Besides learning, the
+  scales make the filter honest: a network that may lose half as much heat or half again
+  as much is uncertain by tens of kelvin after a five-minute cool-down, so the torque
+  residuals move the temperatures, which a filter sure of its network ignores.
+  Both scales are kept within ``[scale_min, scale_max]``.
 * **Measurement** (during slip): the clutch torque from the engine side,
   ``T_c = T_est - J_e dw_e/dt``, against the model
-  ``h(s) = mu_scale T_model(x_meas - dx_kiss, theta_cs)`` (the TCU's
-  characteristic, nominal mu); the Jacobian is taken numerically.
+  ``h(s) = mu_scale T_model(x_meas - dx_kiss, theta_cs, theta_cm)`` (the TCU's
+  characteristic, nominal mu; ``theta_cm`` sets the stack's thermal growth);
+  the Jacobian is taken numerically in ``theta_cs``, the facings and
+  ``dx_kiss``. The facings' column matters: on the default characteristic
+  ``dT/dtheta_cm`` is about +0.05 N.m/K at 60-150 N.m, where ``dT/dtheta_cs``
+  changes sign (+0.03 at 30 N.m, -0.03 at 150 N.m).
 * **Excitation conditions** (each parameter is corrected only while its own
   condition holds; the others' gains are set to zero and the covariance
   update uses the Joseph form, which stays valid for any gain):
@@ -35,8 +55,20 @@ State (K, K, K, K, K, m, 1)::
   ramp. Disjoint bands make the two parameters trade errors and converge
   slowly over many launches; the characteristic itself (what the TCU
   commands through) converges within a launch either way;
-  - temperatures: all of the above (``temperature_update = false`` leaves the
-    thermal states to the prediction alone).
+  - temperatures and ``k_heat``: all of the above and a model torque of at
+    least ``theta_torque_min_Nm`` (``temperature_update = false`` leaves the
+    thermal states and scales to the prediction alone). Near the kiss point a
+    temperature error moves the characteristic like a touch-point offset
+    (``dT/dtheta`` and ``dT/dx_kiss`` nearly collinear); at higher torque the
+    temperature has its own signature (the facings' growth, the spring's
+    softening changing sign along the curve). Without this condition, in the
+    ``creep`` scenario (20 N.m launches only) the two traded errors and the worst
+    characteristic error doubled;
+  - ``k_loss``: in addition, the estimated facings at least
+    ``loss_excitation_K`` above the ambient (the losses are proportional to
+    the temperature rise: near ambient a residual says nothing about them).
+    The scale is observable only across launches with a cooling in between
+    whose length the TCU knows: repeated launches and a cool-down.
 
 A torque residual larger than ``gate_sd`` standard deviations is rejected.
 """
@@ -52,7 +84,8 @@ from ..config import Checked
 from ..model import ClutchParameters, SpringTable, outputs
 from .thermal_network import NetworkParams, ThermalNetwork
 
-IX_CS, IX_DX, IX_MU = 4, 5, 6   #: state indices
+IX_CS, IX_DX, IX_MU, IX_LOSS, IX_HEAT = 4, 5, 6, 7, 8   #: state indices
+N_STATE = 9
 #: speed band of the cached discretisation (convection), rad/s
 SPEED_BAND = 10.0
 
@@ -104,6 +137,23 @@ class EkfParams(Checked):
     mu_deadband: float = 0.05
     """the engine torque estimate's stated gain accuracy: a learned mu_scale within 1 +- this is not applied"""
     temperature_update: bool = True
+    loss_scale_sd: float = 0.5
+    """prior sd of the heat-loss scale (every node's sink conductance: convection and engine block), 1;
+    0 keeps the network's losses as given"""
+    loss_walk_per_s: float = 1e-7
+    """random walk of the heat-loss scale, 1/s (its variance grows by this per second)"""
+    heat_scale_sd: float = 0.15
+    """prior sd of the heat-input scale (the slip power's share that reaches the network per J/K of it), 1;
+    0 keeps the slip power as measured"""
+    heat_walk_per_s: float = 1e-7
+    """random walk of the heat-input scale, 1/s"""
+    theta_torque_min_Nm: float = 40.0
+    """the temperatures and both thermal scales are corrected only above this model torque, N.m"""
+    loss_excitation_K: float = 30.0
+    """the heat-loss scale is corrected only while the estimated facings are this far above the ambient, K"""
+    scale_min: float = 0.25
+    scale_max: float = 4.0
+    """both scales are kept within [scale_min, scale_max] (a physical network)"""
 
     _section = "ekf"
 
@@ -114,7 +164,9 @@ class EkfParams(Checked):
             "mu_sd": (0.0, 1.0), "mu_walk_per_s": (0.0, 1.0), "torque_sd_Nm": (1e-3, 1e3),
             "slip_min_rad_s": (0.0, 1e3), "touch_torque_min_Nm": (0.0, 1e4), "touch_torque_max_Nm": (0.0, 1e4),
             "mu_torque_min_Nm": (0.0, 1e4), "gate_sd": (1.0, 100.0, True),
-            "mu_deadband": (0.0, 0.5)})
+            "mu_deadband": (0.0, 0.5), "loss_scale_sd": (0.0, 2.0), "loss_walk_per_s": (0.0, 1.0),
+            "heat_scale_sd": (0.0, 2.0), "heat_walk_per_s": (0.0, 1.0), "loss_excitation_K": (0.0, 500.0), "theta_torque_min_Nm": (0.0, 1e4),
+            "scale_min": (0.0, 1.0, True), "scale_max": (1.0, 100.0)})
         if self.touch_torque_max_Nm <= self.touch_torque_min_Nm:
             yield "ekf.touch_torque_max_Nm: must exceed ekf.touch_torque_min_Nm"
 
@@ -139,12 +191,16 @@ class ClutchEkf:
         self.net, self.e, self.table, self.p = net, e, table, p
         self.model = ThermalNetwork(net, theta_a, theta0)
         self.theta_a = theta_a
-        self.s = np.array([theta0] * 5 + [0.0, 1.0])
-        self.P = np.diag([e.theta0_sd_K ** 2] * 5 + [e.kiss_sd_m ** 2, e.mu_sd ** 2])
-        self.q_rw = np.array([e.theta_walk_K2_per_s] * 5 + [e.kiss_walk_m2_per_s, e.mu_walk_per_s])
+        self.s = np.array([theta0] * 5 + [0.0, 1.0, 1.0, 1.0])
+        self.P = np.diag([e.theta0_sd_K ** 2] * 5 + [e.kiss_sd_m ** 2, e.mu_sd ** 2, e.loss_scale_sd ** 2,
+                                                      e.heat_scale_sd ** 2])
+        self.q_rw = np.array([e.theta_walk_K2_per_s] * 5 + [e.kiss_walk_m2_per_s, e.mu_walk_per_s,
+                                                            e.loss_walk_per_s if e.loss_scale_sd > 0 else 0.0,
+                                                            e.heat_walk_per_s if e.heat_scale_sd > 0 else 0.0])
         self.energy_J = 0.0
         self.t_acc = 0.0
         self._cache: dict = {}
+        self._dcache: dict = {}
         #: count of accepted measurement updates, and of rejected ones (gate)
         self.accepted = self.rejected = 0
 
@@ -170,6 +226,16 @@ class ClutchEkf:
         return float(self.s[IX_MU])
 
     @property
+    def loss_scale(self) -> float:
+        """Learned scale of the network's heat-loss conductances (convection, engine block), 1."""
+        return float(self.s[IX_LOSS])
+
+    @property
+    def heat_scale(self) -> float:
+        """Learned scale of the slip heat that reaches the network, 1."""
+        return float(self.s[IX_HEAT])
+
+    @property
     def mu_used(self) -> float:
         """The friction scale the TCU applies: ``mu_scale`` outside a dead band of ``mu_deadband`` around 1.
 
@@ -193,17 +259,36 @@ class ClutchEkf:
                                                                  theta_cm).torque
 
     # --- prediction ----------------------------------------------------------------------------
-    def _jacobian_f(self, w_engine: float, w_disc: float, clamped: bool) -> tuple[np.ndarray, np.ndarray]:
-        a4, b4 = self.model.matrices(w_engine, w_disc, clamped)
-        n = self.net
-        a = np.zeros((7, 7))
-        b = np.zeros(7)
-        a[:4, :4], b[:4] = a4, b4
-        c = n.spring_C_J_per_K
-        a[IX_CS, 1] = a[IX_CS, 2] = 0.5 * n.spring_U_W_per_K / c
-        a[IX_CS, IX_CS] = -(n.spring_U_W_per_K + n.spring_H_W_per_K) / c
-        b[IX_CS] = n.spring_H_W_per_K * self.theta_a / c
-        return a, b
+    def _parts(self, w_engine: float, w_disc: float, clamped: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(A_link, a_sink, b_sink)`` of the five temperatures: ``dtheta/dt = A_link theta + k_loss
+        (a_sink theta + b_sink) + k_heat q``; cached per ``SPEED_BAND`` (rad/s) band of the speeds.
+
+        ``A_link`` (1/s): conduction between the nodes and the cushion-spring ODE (its ``H`` to the
+        ambient included: the spring's U, H, C are the clutch model's and are not scaled);
+        ``a_sink`` (1/s, the diagonal) and ``b_sink`` (K/s): the network's losses to the air and the
+        engine block at ``k_loss = 1``.
+        """
+        key = (clamped, round(w_engine / SPEED_BAND), round(w_disc / SPEED_BAND))
+        hit = self._cache.get(key)
+        if hit is None:
+            links, sink_g, sink_t = self.model.conductances(key[1] * SPEED_BAND, key[2] * SPEED_BAND, clamped)
+            c = np.array(self.model.caps)
+            a = np.zeros((5, 5))
+            for i, gl in enumerate(links):
+                a[i, i + 1], a[i + 1, i] = gl / c[i], gl / c[i + 1]
+                a[i, i] -= gl / c[i]
+                a[i + 1, i + 1] -= gl / c[i + 1]
+            n = self.net
+            cs = n.spring_C_J_per_K
+            a[IX_CS, 1] = a[IX_CS, 2] = 0.5 * n.spring_U_W_per_K / cs
+            a[IX_CS, IX_CS] = -(n.spring_U_W_per_K + n.spring_H_W_per_K) / cs
+            a_sink = np.zeros(5)
+            b_sink = np.zeros(5)
+            a_sink[:4] = -np.array(sink_g) / c
+            b_sink[:4] = np.array(sink_g) * np.array(sink_t) / c
+            b_sink_cs = n.spring_H_W_per_K * self.theta_a / cs
+            hit = self._cache[key] = (a, a_sink, b_sink, b_sink_cs)
+        return hit
 
     def accumulate(self, dt: float, p_slip_W: float) -> None:
         """Add one TCU period ``dt`` (s) of slip power (W) to the heat of the next prediction."""
@@ -214,37 +299,60 @@ class ClutchEkf:
         """True once a full EKF period has accumulated."""
         return self.t_acc >= self.e.period_s - 1e-12
 
-    def _discrete(self, w_engine: float, w_disc: float, clamped: bool, dt: float) -> tuple:
-        """``(F, G, b)``: ``s+ = F s + G (b + q)`` for the held inputs; cached per speed band.
-
-        The convection's speed is taken at the centre of a ``SPEED_BAND`` (rad/s) band.
+    def _discrete(self, w_engine: float, w_disc: float, clamped: bool, dt: float,
+                  k_loss: float) -> tuple[np.ndarray, np.ndarray, tuple]:
+        """``(Phi, Psi, parts)``: ``exp(A dt)`` and ``int_0^dt exp(A s) ds`` of the five temperatures with
+        the loss scale ``k_loss`` held, by their series to ``(A dt)^5`` (the EKF period is far below the
+        network's time constants; a test checks the prediction against the plant network). Cached per
+        speed band and period, recomputed when ``k_loss`` has changed (only measurement updates change it).
         """
         key = (clamped, round(w_engine / SPEED_BAND), round(w_disc / SPEED_BAND), round(dt * 1e4))
-        hit = self._cache.get(key)
-        if hit is None:
-            a, b = self._jacobian_f(key[1] * SPEED_BAND, key[2] * SPEED_BAND, clamped)
-            # exp(A dt) and int_0^dt exp(A s) ds by their series to (A dt)^5: the EKF period is far
-            # below the network's time constants (a test checks the prediction against the plant network)
-            ad, term, f, g = a * dt, np.eye(7), np.eye(7), np.eye(7) * dt
+        hit = self._dcache.get(key)
+        if hit is None or hit[0] != k_loss:
+            parts = self._parts(w_engine, w_disc, clamped)
+            a = parts[0].copy()
+            a[np.arange(5), np.arange(5)] += k_loss * parts[1]
+            ad, term, phi, psi = a * dt, np.eye(5), np.eye(5), np.eye(5) * dt
             for k in range(1, 6):
                 term = term @ ad / k
-                f = f + term
-                g = g + term * dt / (k + 1)
-            hit = self._cache[key] = (f, g, b)
-        return hit
+                phi = phi + term
+                psi = psi + term * dt / (k + 1)
+            hit = self._dcache[key] = (k_loss, phi, psi, parts)
+        return hit[1], hit[2], hit[3]
 
     def predict(self, w_engine: float, w_disc: float, clamped: bool) -> None:
-        """Advance the accumulated time with its mean slip power (the speeds and clamp state held)."""
+        """Advance the accumulated time with its mean slip power (the speeds and clamp state held).
+
+        The augmented system is bilinear (a scale times a temperature); with
+        the scales held over the period the temperatures advance exactly,
+        ``theta+ = Phi theta + Psi (k_loss b_sink + k_heat q)``, and the
+        transition of the covariance is the linearisation at the estimate:
+        the scales' rows are zero, so ``exp(J dt)`` has ``Phi`` in its
+        temperature block and ``Psi`` times the scales' Jacobian columns
+        (``a_sink theta + b_sink`` and ``q``) in their columns.
+        """
         dt = self.t_acc
         if dt <= 0.0:
             return
         p_mean = self.energy_J / dt
-        f, g, b = self._discrete(w_engine, w_disc, clamped, dt)
-        q_heat = np.zeros(7)
+        s = self.s
+        k_loss, k_heat = float(s[IX_LOSS]), float(s[IX_HEAT])
+        phi, psi, (_, a_sink, b_sink, b_cs) = self._discrete(w_engine, w_disc, clamped, dt, k_loss)
+        th = s[:5]
+        q = np.zeros(5)
         if p_mean != 0.0:
-            q_heat[:4] = np.array(self.model.heat_inputs(p_mean)) / self.model.caps
-        self.s = f @ self.s + g @ (b + q_heat)
-        qn = (self.e.heat_share_sd * q_heat * dt) ** 2 + self.q_rw * dt
+            q[:4] = np.array(self.model.heat_inputs(p_mean)) / self.model.caps
+        b = k_loss * b_sink + k_heat * q
+        b[IX_CS] += b_cs
+        s_new = s.copy()
+        s_new[:5] = phi @ th + psi @ b
+        f = np.eye(N_STATE)
+        f[:5, :5] = phi
+        f[:5, IX_LOSS] = psi @ (a_sink * th + b_sink)
+        f[:5, IX_HEAT] = psi @ q
+        self.s = s_new
+        qn = self.q_rw * dt
+        qn[:5] += (self.e.heat_share_sd * k_heat * q * dt) ** 2
         self.P = f @ self.P @ f.T + np.diag(qn)
         self.energy_J = self.t_acc = 0.0
 
@@ -260,22 +368,24 @@ class ClutchEkf:
         if not launching or abs(w_slip_rad_s) < e.slip_min_rad_s:
             return False
         h0 = self.model_torque(x_meas_m)
-        mask = np.zeros(7, dtype=bool)
+        mask = np.zeros(N_STATE, dtype=bool)
         if e.touch_torque_min_Nm <= h0 <= e.touch_torque_max_Nm:
             mask[IX_DX] = True
         if h0 >= e.mu_torque_min_Nm:
             mask[IX_MU] = True
         if not mask.any():
             return False
-        if e.temperature_update:
+        if e.temperature_update and h0 >= e.theta_torque_min_Nm:
             mask[:5] = True
-        hrow = np.zeros(7)
-        for i, d in ((IX_CS, 1.0), (IX_DX, 1e-6)):
+            mask[IX_HEAT] = e.heat_scale_sd > 0.0
+            mask[IX_LOSS] = e.loss_scale_sd > 0.0 and self.theta_cm - self.theta_a >= e.loss_excitation_K
+        hrow = np.zeros(N_STATE)
+        for i, d in ((IX_CS, 1.0), (1, 1.0), (IX_DX, 1e-6)):
             sp = self.s.copy()
             sp[i] += d
             hrow[i] = (self.model_torque(x_meas_m, sp) - h0) / d
+        hrow[2] = hrow[1]                    # the stack grows with the facings' mean: both enter alike
         hrow[IX_MU] = h0 / max(self.mu_scale, 1e-6)
-        # h has no direct facing term: the facings are corrected through their covariance with theta_cs
         r = (e.torque_sd_Nm if torque_sd_Nm is None else torque_sd_Nm) ** 2
         s_inn = float(hrow @ self.P @ hrow) + r
         nu = torque_meas_Nm - h0
@@ -285,7 +395,8 @@ class ClutchEkf:
         k = self.P @ hrow / s_inn
         k[~mask] = 0.0
         self.s = self.s + k * nu
-        ikh = np.eye(7) - np.outer(k, hrow)
+        self.s[IX_LOSS:] = np.clip(self.s[IX_LOSS:], e.scale_min, e.scale_max)
+        ikh = np.eye(N_STATE) - np.outer(k, hrow)
         self.P = ikh @ self.P @ ikh.T + r * np.outer(k, k)
         self.accepted += 1
         return True

@@ -8,7 +8,8 @@ import numpy as np
 from ..model import KELVIN
 from .simulate import LaunchResult
 
-STYLE = {"naive": "-", "aware": "--", "aware_estimated": "-.", "adaptive": ":", "adaptive_aware_estimated": (0, (5, 1, 1, 1, 1, 1))}
+STYLE = {"naive": "-", "aware": "--", "aware_estimated": "-.", "adaptive": ":", "adaptive_aware_estimated": (0, (5, 1, 1, 1, 1, 1)),
+         "production": (0, (3, 1, 1, 1))}
 
 
 def plot_launches(results: dict[str, LaunchResult], out: Path) -> list[Path]:
@@ -33,7 +34,7 @@ def plot_launches(results: dict[str, LaunchResult], out: Path) -> list[Path]:
             axes[0].plot(t, s["w_engine_rad_s"][sel] * 30 / np.pi, color="grey", label="engine (naive)")
             axes[1].plot(t, s["x_kiss_m"][sel] * 1e3, color="k", lw=1.5, label="true kiss point")
             axes[2].plot(t, s["torque_demand_Nm"][sel], color="k", lw=1.5, label="demanded (naive)")
-    axes[0].set(ylabel="speed [rpm]", title=f"Launch {hottest} (hottest start): the five TCUs")
+    axes[0].set(ylabel="speed [rpm]", title=f"Launch {hottest} (hottest start): the {len(results)} TCUs")
     axes[1].set(ylabel="bearing [mm] (thin: kiss point believed)")
     lock = max((m["engagement_time_s"] for r in results.values() for m in r.metrics
                 if m["launch"] == hottest and m["engagement_time_s"] == m["engagement_time_s"]), default=3.0)
@@ -45,13 +46,16 @@ def plot_launches(results: dict[str, LaunchResult], out: Path) -> list[Path]:
     s = any_res.series
     ax.plot(s["time_s"], s["theta_cm_K"] - KELVIN, color="C3", label="facing θ_cm (plant)")
     ax.plot(s["time_s"], s["theta_cs_K"] - KELVIN, color="C0", label="cushion spring θ_cs (FMU)")
-    est = results.get("aware_estimated")
-    if est is not None:
+    # the estimates of the TCUs with their own thermal model: the lumped observer and the production EKF
+    for name, ls, what in (("aware_estimated", "--", "observer"), ("production", ":", "production EKF")):
+        est = results.get(name)
+        if est is None:
+            continue
         e = est.series
-        ax.plot(e["time_s"], e["theta_cm_tcu_K"] - KELVIN, "--", color="C3", label="θ_cm estimated (observer)")
-        ax.plot(e["time_s"], e["theta_cs_tcu_K"] - KELVIN, "--", color="C0", label="θ_cs estimated (observer)")
+        ax.plot(e["time_s"], e["theta_cm_tcu_K"] - KELVIN, linestyle=ls, color="C3", label=f"θ_cm estimated ({what})")
+        ax.plot(e["time_s"], e["theta_cs_tcu_K"] - KELVIN, linestyle=ls, color="C0", label=f"θ_cs estimated ({what})")
     ax.set(xlabel="time [s]", ylabel="temperature [°C]",
-           title="Temperatures over the launches: plant and the TCU's mismatched observer")
+           title="Temperatures over the launches: plant and the TCUs' mismatched models")
     p2 = finish_figure(fig, ax, out / "launch_temperatures.png")
 
     fig, axes = plt.subplots(3, 1, figsize=(9, 9), sharex=True)

@@ -14,7 +14,9 @@ and differs in what it knows:
   mean torque estimate and bearing position over the same window);
 * **slip power** for the thermal model: ``T_c`` times the measured slip speed;
 * **temperatures, touch point and friction** from the EKF (:mod:`.ekf`) on
-  the TCU's own thermal network;
+  the TCU's own thermal network, whose heat-loss and heat-input scales the
+  EKF learns from the torque across launches (the network stays mismatched
+  with the plant as shipped);
 * **mass and grade** from the RLS (:mod:`.mass_grade`); once the load is
   estimated, the vehicle-side clutch torque ``(m_eq a + F_load) r / (eta i)``
   while the car moves in slip is a second EKF measurement (its noise

@@ -127,11 +127,13 @@ def test_mesh_refinement_2mm_vs_1_5mm(two_temps, case_cache, tmp_path):
     s = c1.pair_travel_m
     mid = (c1.force_N > 0.1 * c1.force_N.max()) & (s < 0.9 * s.max())
     rel = np.abs(np.interp(s[mid], c2.pair_travel_m, c2.force_N) / c1.force_N[mid] - 1)
-    assert rel.max() < 0.15, f"2 mm vs 1 mm differ by {rel.max():.1%}"
+    assert rel.max() < 0.075, f"2 mm vs 1.5 mm differ by {rel.max():.1%}"
 
 
 def test_without_thermal_distortion_force_scales_with_youngs_modulus(coarse, tmp_path):
-    p = coarse.replace(sweep={"thermal_distortion": False})
+    """On a 4 mm mesh: the scaling with E holds on any mesh; measured worst deviation 0.62 % on 4 mm
+    (limit 1 %)."""
+    p = coarse.replace(sweep={"thermal_distortion": False}, mesh={"element_size_m": 4e-3})
     cold = solve_case(p, 20.0, tmp_path / "c").result
     hot = solve_case(p, 300.0, tmp_path / "h").result
     assert abs(hot.crest_rise_m) < 1e-7

@@ -44,7 +44,8 @@ def test_remote_solve_uses_the_shipped_surface_not_the_path(coarse, tmp_path):
     d.mkdir()
     write_csv(d / "paddle.csv", synthetic_scan(coarse.geometry))
     scan = import_scan(d / "paddle.csv", DEFAULT_SPRING, d / "spring" / "scanned.toml")
-    params = load_params(scan.toml).replace(mesh={"element_size_m": coarse.mesh.element_size_m})
+    # 4 mm: the remote solve must equal the local one bit for bit on any mesh
+    params = load_params(scan.toml).replace(mesh={"element_size_m": 4e-3})
     surface = params.geometry.surface_file
     blob = open(surface, "rb").read()
     local = cases.solve_case(params, 20.0, tmp_path / "local")
@@ -69,7 +70,8 @@ def test_dask_run_closes_the_client_it_made_and_caches_with_the_workers_version(
             yield client, info
 
     monkeypatch.setattr(cases, "open_cluster", spy)
-    p = coarse.replace(sweep={"temperatures_degC": (20.0,)})
+    # 4 mm: the cluster's life cycle and the cache are under test, not the mesh
+    p = coarse.replace(mesh={"element_size_m": 4e-3}, sweep={"temperatures_degC": (20.0,)})
     outcomes, failures = run_cases([Case(p, 20.0, 1, "t")], cache_dir=tmp_path, jobs=1, local_cluster=True)
     assert failures == {} and outcomes[0] is not None and not outcomes[0].from_cache
     client, cluster = made[0]

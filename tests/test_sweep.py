@@ -72,6 +72,9 @@ def test_rerun_is_served_from_cache(two_temps, case_cache, coarse_tables):
 
 
 def test_non_convergence_names_case_keeps_finished_and_resumes(two_temps, tmp_path):
+    """A 4 mm mesh (same 60 increments, 20 and 195 degC both converge on it): the failure handling,
+    the cache and the resume are under test here, not the mesh."""
+    two_temps = two_temps.replace(mesh={"element_size_m": 4e-3})
     cache, out = tmp_path / "cache", tmp_path / "tables"
     run_sweep(two_temps.replace(sweep={"temperatures_degC": (20.0,)}), cache_dir=cache)
     # 60 compression increments cannot fit under a cap of 30
@@ -90,29 +93,47 @@ def test_non_convergence_names_case_keeps_finished_and_resumes(two_temps, tmp_pa
     assert (out / "force_deflection.csv").exists()
 
 
-def test_half_pair_in_series_matches_full_pair(coarse, tmp_path):
-    """The series composition of one paddle equals the back-to-back pair within 2 %."""
-    for theta in (20.0, 195.0):
-        half = solve_case(coarse, theta, tmp_path / f"h{theta}", paddles=1).result
-        pair = solve_case(coarse, theta, tmp_path / f"p{theta}", paddles=2).result
-        s = pair.pair_travel_m
-        f_half = np.interp(s, half.pair_travel_m, half.force_N)
-        loaded = pair.force_N > 0.05 * pair.force_N.max()
-        assert np.abs(f_half[loaded] / pair.force_N[loaded] - 1).max() < 0.02
+def test_half_pair_in_series_matches_full_pair(two_temps, case_cache, tmp_path):
+    """The series composition of one paddle equals the back-to-back pair within 2 %.
+
+    At 195 degC only: the composition is a kinematic principle, independent of the temperature, and
+    the hot case (thermally distorted paddle, softer steel) is the harder one. The half pair is the
+    sweep's own 195 degC case (shared through the session cache with ``coarse_tables``); only the full
+    pair is solved here. Measured on the 2 mm mesh: 0.04 % at 195 degC and at 20 degC (limit 2 %).
+    """
+    theta = 195.0
+    half = run_sweep(two_temps, cache_dir=case_cache)[theta].result
+    assert half.paddles == 1
+    pair = solve_case(two_temps, theta, tmp_path / "pair", paddles=2).result
+    s = pair.pair_travel_m
+    f_half = np.interp(s, half.pair_travel_m, half.force_N)
+    loaded = pair.force_N > 0.05 * pair.force_N.max()
+    assert np.abs(f_half[loaded] / pair.force_N[loaded] - 1).max() < 0.02
 
 
-def test_mesh_refinement_2mm_vs_1mm(coarse, tmp_path):
-    fine = coarse.replace(mesh={"element_size_m": 1e-3}, sweep={"temperatures_degC": (20.0,)})
-    c2 = solve_case(coarse, 20.0, tmp_path / "m2").result
-    c1 = solve_case(fine, 20.0, tmp_path / "m1").result
+def test_mesh_refinement_2mm_vs_1_5mm(two_temps, case_cache, tmp_path):
+    """The 2 mm test mesh is close to converged: refined to 1.5 mm, the curve moves by less than 7.5 %.
+
+    1.5 mm instead of 1 mm keeps this affordable (the 1 mm case alone took about a minute). The limit is
+    the former one (15 % between 2 mm and 1 mm) scaled to the smaller refinement step: for a
+    first-order error e(h) ~ h, e(2) - e(1.5) = e(2)/4 while e(2) - e(1) = e(2)/2, so a 7.5 % change
+    bounds the 2 mm error as the 15 % did. Measured at 20 degC: 4 mm vs 2 mm 8.3 %, 3 mm vs 2 mm 5.3 %,
+    2 mm vs 1.5 mm 2.9 % (each step smaller: converging). The 2 mm case is the sweep's own, shared
+    through the session cache with ``coarse_tables``.
+    """
+    c2 = run_sweep(two_temps, cache_dir=case_cache)[20.0].result
+    fine = two_temps.replace(mesh={"element_size_m": 1.5e-3}, sweep={"temperatures_degC": (20.0,)})
+    c1 = solve_case(fine, 20.0, tmp_path / "m1.5").result
     s = c1.pair_travel_m
     mid = (c1.force_N > 0.1 * c1.force_N.max()) & (s < 0.9 * s.max())
     rel = np.abs(np.interp(s[mid], c2.pair_travel_m, c2.force_N) / c1.force_N[mid] - 1)
-    assert rel.max() < 0.15, f"2 mm vs 1 mm differ by {rel.max():.1%}"
+    assert rel.max() < 0.075, f"2 mm vs 1.5 mm differ by {rel.max():.1%}"
 
 
 def test_without_thermal_distortion_force_scales_with_youngs_modulus(coarse, tmp_path):
-    p = coarse.replace(sweep={"thermal_distortion": False})
+    """On a 4 mm mesh: the scaling with E holds on any mesh; measured worst deviation 0.62 % on 4 mm
+    (limit 1 %)."""
+    p = coarse.replace(sweep={"thermal_distortion": False}, mesh={"element_size_m": 4e-3})
     cold = solve_case(p, 20.0, tmp_path / "c").result
     hot = solve_case(p, 300.0, tmp_path / "h").result
     assert abs(hot.crest_rise_m) < 1e-7

@@ -184,3 +184,14 @@ def test_quiet_steps_agree_with_the_fixed_step(fmu):
     assert np.max(np.abs(quiet.series["theta_cm_K"] - fixed.series["theta_cm_K"])) < 0.01
     # the idle governor at 10 ms: the same settled idle, a slightly different settling after the car stops
     assert np.max(np.abs(quiet.series["w_engine_rad_s"] - fixed.series["w_engine_rad_s"])) < 1.0
+
+
+def test_a_folder_named_like_a_shipped_scenario_does_not_hide_it(tmp_path, monkeypatch):
+    """`launch --scenario wear --out wear` twice: the output folder ``wear`` is not the scenario ``wear``."""
+    from cushion_clutch.launch.scenario import scenario_path
+
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "wear").mkdir()
+    assert load_scenario(scenario_path("wear")).name == "wear"
+    (tmp_path / "mine").write_text(DEFAULT_SCENARIO.read_text().replace('name = "default"', 'name = "mine"'))
+    assert load_scenario(scenario_path("mine")).name == "mine"          # a file of that name is used

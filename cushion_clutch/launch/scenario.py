@@ -332,7 +332,8 @@ def scenario_path(name: str | Path) -> Path:
     """A scenario file: ``name`` itself, or the shipped ``<name>.toml`` (default, creep, cooldown, fade, wear, tolerance)."""
     path = Path(name)
     shipped = DEFAULT_SCENARIO.parent / f"{name}.toml"
-    return shipped if not path.exists() and path.suffix == "" and shipped.is_file() else path
+    # a folder of that name (e.g. the output of an earlier `launch --scenario wear --out wear`) is no scenario
+    return shipped if not path.is_file() and path.suffix == "" and shipped.is_file() else path
 
 
 def load_scenario(path: str | Path = DEFAULT_SCENARIO) -> Scenario:

@@ -27,12 +27,15 @@ def test_constant_mu_table_gives_todays_results(tmp_path):
     flat_fmu = build_plant_fmu(DEFAULT_TABLES, with_table, tmp_path / "b" / "flat.fmu")
     a = simulate_launches(plain_fmu, sc, load_table(), "aware_estimated")
     b = simulate_launches(flat_fmu, with_table, load_table(), "aware_estimated")
-    # equal to round-off: the bilinear weights make mu = 0.28 within one ulp, not bit for bit
+    # equal to round-off: the bilinear weights make mu = 0.28 within one ulp, not bit for bit, and the
+    # driveline carries that ulp on through 40 s of lock-ups (measured: 4e-12 N.m in the locked torque);
+    # a friction table applied wrongly moves these columns by newton-metres
     for f in a.series.dtype.names:
-        # accel_m_s2 is a finite difference (v_next - v) / h: one ulp of v becomes eps |v| / h there
-        atol = 1e-12 if f != "accel_m_s2" else max(1e-12, 8 * np.finfo(float).eps * np.abs(a.series["v_m_s"]).max()
-                                                   / np.diff(a.series["time_s"]).min())
-        np.testing.assert_allclose(b.series[f], a.series[f], rtol=1e-12, atol=atol, equal_nan=True)
+        # accel_m_s2 is a finite difference (v_next - v) / h over the step h (not the rows' spacing): one ulp
+        # of v becomes eps |v| / h there
+        atol = 1e-9 if f != "accel_m_s2" else max(1e-9, 64 * np.finfo(float).eps * np.abs(a.series["v_m_s"]).max()
+                                                  / sc.run.step_s)
+        np.testing.assert_allclose(b.series[f], a.series[f], rtol=1e-9, atol=atol, equal_nan=True)
     assert len(a.metrics) == len(b.metrics) > 0
     for ma, mb in zip(a.metrics, b.metrics):
         assert mb.keys() == ma.keys()

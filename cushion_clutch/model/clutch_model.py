@@ -250,15 +250,21 @@ def _cover_map_cached(cover: CoverParameters, lever_ratio: float) -> CoverMap:
     return CoverMap(cover, lever_ratio)
 
 
-_LAST_MAP: list = [None, None, None]     # cover, lever ratio, map: CoverParameters is frozen, so identity suffices
+def _last_cover(slot: list, compute, cover: CoverParameters, lever_ratio: float):
+    """``compute(cover, lever_ratio)``, kept in ``slot`` for the last cover object (CoverParameters is frozen,
+    so its identity suffices and the dataclass hash behind ``compute``'s lru_cache is skipped)."""
+    if cover is slot[0] and lever_ratio == slot[1]:
+        return slot[2]
+    out = compute(cover, lever_ratio)
+    slot[:] = [cover, lever_ratio, out]
+    return out
+
+
+_LAST_MAP: list = [None, None, None]        # cover, lever ratio, map
 
 
 def _cover_map(cover: CoverParameters, lever_ratio: float) -> CoverMap:
-    if cover is _LAST_MAP[0] and lever_ratio == _LAST_MAP[1]:
-        return _LAST_MAP[2]
-    m = _cover_map_cached(cover, lever_ratio)
-    _LAST_MAP[:] = [cover, lever_ratio, m]
-    return m
+    return _last_cover(_LAST_MAP, _cover_map_cached, cover, lever_ratio)
 
 
 _LAST_FRAME: list = [None, None, None, None]   # table, key, frame, cover: the last temperature/wear frame
@@ -296,15 +302,11 @@ def _cover_problems_cached(cover: CoverParameters, lever_ratio: float) -> tuple[
     return tuple(cover.problems(lever_ratio))
 
 
-_LAST_PROBLEMS: list = [None, None, ()]   # cover, lever ratio, problems (CoverParameters is frozen)
+_LAST_PROBLEMS: list = [None, None, ()]     # cover, lever ratio, problems
 
 
 def _cover_problems(cover: CoverParameters, lever_ratio: float) -> tuple[str, ...]:
-    if cover is _LAST_PROBLEMS[0] and lever_ratio == _LAST_PROBLEMS[1]:
-        return _LAST_PROBLEMS[2]
-    out = _cover_problems_cached(cover, lever_ratio)
-    _LAST_PROBLEMS[:] = [cover, lever_ratio, out]
-    return out
+    return _last_cover(_LAST_PROBLEMS, _cover_problems_cached, cover, lever_ratio)
 
 
 def friction_coefficient(table: SpringTable, p: ClutchParameters, theta_cm: float | None,

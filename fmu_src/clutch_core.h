@@ -41,7 +41,16 @@ enum {
 typedef struct {
     int n;
     double *x, *y, *d;
+    double x_first; /* first contact: the last row still at the first force, m (spring_table.Curve.x_first) */
 } Curve;
+
+/* F(u) at one temperature: curves c0 and c1 (weight w of c1; c1 = c0 where w = 0) blended on a common
+   normalised compression between the first contact and the full compression, both linear in theta
+   (spring_table.Bracket); r0, r1 = d(u_k)/du */
+typedef struct {
+    const Curve *c0, *c1;
+    double w, first, full, r0, r1;
+} TBracket;
 
 typedef struct {
     int nt;
@@ -67,8 +76,8 @@ typedef struct {
     double xc;                        /* bearing-system constant X_c, m */
     int hint[2], hint_k[2];           /* last table intervals (Newton; kiss and solid points) */
     /* the frame of the last (theta_cs K, theta_cm K, wear m): bracket, E, positions and forces */
-    double f_theta_cs, f_theta_cm, f_wear, f_e, f_w;
-    const Curve *f_c0, *f_c1;
+    double f_theta_cs, f_theta_cm, f_wear, f_e;
+    TBracket f_br;
     double s_kiss, s_solid, fc_solid, m_solid, fto_solid, fto_kiss, x_solid, x_kiss;
 } CcCover;
 
@@ -118,7 +127,7 @@ double cc_table_delta(const Table *tb, double theta_degC);
 double cc_table_mu(const Table *tb, double theta_degC, double omega);
 double cc_table_full(const Table *tb, double theta_degC);
 /* table temperatures i and i+1 around theta with weight w of i+1 (clamped: w = 0 or 1) */
-void cc_table_bracket(const Table *tb, double theta_degC, int *i, double *w);
+void cc_table_bracket(const Table *tb, double theta_degC, TBracket *br);
 
 /* ---- cover (clutch_cover.c) */
 void cc_cover_prepare(CcCover *cv, const double *par, double lever_ratio, double x_kiss_ref, const Table *tb);

@@ -89,14 +89,14 @@ static double curve_vd(const Curve *c, double u, double *dfdu, int *hint) {
            c->y[i + 1] + (t2 * t - t2) * h * c->d[i + 1];
 }
 
-/* the cushion force at one temperature bracket: curves i and i+1 with weight w (as cc_table_force) */
-typedef struct { const Curve *c0, *c1; double w; } Bracket;
-
-static double cushion(const Bracket *b, double u, double *dfdu, int *hint) {
-    double d0, d1, f0 = curve_vd(b->c0, u, &d0, &hint[0]), f1;
-    if (b->w == 0.0) { *dfdu = d0; return f0; }
-    f1 = curve_vd(b->c1, u, &d1, &hint[1]);
-    *dfdu = (1.0 - b->w) * d0 + b->w * d1;
+/* the cushion force and its slope at one temperature (as spring_table.Bracket.force and .slope) */
+static double cushion(const TBracket *b, double u, double *dfdu, int *hint) {
+    double d0, d1, f0, f1, v;
+    if (b->w == 0.0) return curve_vd(b->c0, u, dfdu, &hint[0]);
+    v = u - b->first;
+    f0 = curve_vd(b->c0, b->c0->x_first + v * b->r0, &d0, &hint[0]);
+    f1 = curve_vd(b->c1, b->c1->x_first + v * b->r1, &d1, &hint[1]);
+    *dfdu = (1.0 - b->w) * d0 * b->r0 + b->w * d1 * b->r1;
     return (1.0 - b->w) * f0 + b->w * f1;
 }
 
@@ -108,22 +108,16 @@ int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
     int k;
     if (!(theta_cs == cv->f_theta_cs && theta_cm == cv->f_theta_cm && wear == cv->f_wear)) {
         /* the frame: everything that depends on temperature and wear, not on x_to */
-        int i;
-        double w, stack, m_solid, dummy;
-        Bracket b;
+        double stack, m_solid, dummy;
+        TBracket b;
         e_mod = youngs(cv, theta_cs);
-        cc_table_bracket(tb, th, &i, &w);
-        b.c0 = &tb->curves[i];
-        b.c1 = w == 0.0 ? b.c0 : &tb->curves[i + 1];
-        b.w = w;
-        stack = (w == 0.0 ? tb->delta[i] : (1.0 - w) * tb->delta[i] + w * tb->delta[i + 1]) +
+        cc_table_bracket(tb, th, &b);
+        stack = cc_table_delta(tb, th) +
                 (p[CV_TF] * p[CV_AF] + p[CV_TPP] * p[CV_APP] + p[CV_LFW] * p[CV_AFW]) * (theta_cm - p[CV_TREF]);
         cv->f_e = e_mod;
-        cv->f_c0 = b.c0;
-        cv->f_c1 = b.c1;
-        cv->f_w = w;
+        cv->f_br = b;
         cv->s_kiss = p[CV_SINST] + (cv->u_full_ref + stack - wear) / kp;
-        cv->s_solid = cv->s_kiss - cc_table_full(tb, th) / kp;
+        cv->s_solid = cv->s_kiss - b.full / kp;
         cv->fc_solid = cushion(&b, (cv->s_kiss - cv->s_solid) * kp, &dummy, cv->hint_k);
         m_solid = moment(cv, cv->s_solid, e_mod);
         cv->m_solid = m_solid;
@@ -152,11 +146,8 @@ int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
         return 0;
     }
     {
-        Bracket b;
+        const TBracket b = cv->f_br;
         double s_kiss = cv->s_kiss;
-        b.c0 = cv->f_c0;
-        b.c1 = cv->f_c1;
-        b.w = cv->f_w;
         lo = cv->s_solid;
         hi = (cv->xc - x_to) / kb;
         /* start (from the inputs only, so the result never depends on the call history): the chord of

@@ -71,29 +71,55 @@ static void grid_bracket(const double *g, int n, double v, int *i, double *w) {
     *w = (v - g[lo]) / (g[lo + 1] - g[lo]);
 }
 
-void cc_table_bracket(const Table *tb, double theta, int *i, double *w) { grid_bracket(tb->theta, tb->nt, theta, i, w); }
-
-/* compression from which F no longer grows at theta (the longest active curve) */
-double cc_table_full(const Table *tb, double theta) {
-    int i; double w, a, b;
-    grid_bracket(tb->theta, tb->nt, theta, &i, &w);
-    a = tb->curves[i].x[tb->curves[i].n - 1];
-    if (w == 0.0) return a;
-    b = tb->curves[i + 1].x[tb->curves[i + 1].n - 1];
-    return w == 1.0 ? b : (a > b ? a : b);
+/* the table index and weight of theta: w = 0 at a table temperature and beyond either end (as
+   SpringTable._bracket) */
+static void table_index(const Table *tb, double theta, int *i, double *w) {
+    grid_bracket(tb->theta, tb->nt, theta, i, w);
+    if (*w == 1.0) { *i += 1; *w = 0.0; }
 }
 
+void cc_table_bracket(const Table *tb, double theta, TBracket *br) {
+    int i;
+    double w, span;
+    table_index(tb, theta, &i, &w);
+    br->c0 = &tb->curves[i];
+    br->w = w;
+    if (w == 0.0) {
+        br->c1 = br->c0;
+        br->first = br->c0->x_first;
+        br->full = br->c0->x[br->c0->n - 1];
+        br->r0 = 1.0;
+        br->r1 = 0.0;
+        return;
+    }
+    br->c1 = &tb->curves[i + 1];
+    br->first = (1.0 - w) * br->c0->x_first + w * br->c1->x_first;
+    br->full = (1.0 - w) * br->c0->x[br->c0->n - 1] + w * br->c1->x[br->c1->n - 1];
+    span = br->full - br->first;
+    br->r0 = span > 0.0 ? (br->c0->x[br->c0->n - 1] - br->c0->x_first) / span : 0.0;
+    br->r1 = span > 0.0 ? (br->c1->x[br->c1->n - 1] - br->c1->x_first) / span : 0.0;
+}
+
+/* compression from which F no longer grows at theta (linear in theta between the tables) */
+double cc_table_full(const Table *tb, double theta) {
+    TBracket br;
+    cc_table_bracket(tb, theta, &br);
+    return br.full;
+}
 
 double cc_table_force(const Table *tb, double u, double theta) {
-    int i; double w, f0;
-    grid_bracket(tb->theta, tb->nt, theta, &i, &w);
-    f0 = curve_eval(&tb->curves[i], u);
-    return w == 0.0 ? f0 : (1.0 - w) * f0 + w * curve_eval(&tb->curves[i + 1], u);
+    TBracket br;
+    double v;
+    cc_table_bracket(tb, theta, &br);
+    if (br.w == 0.0) return curve_eval(br.c0, u);
+    v = u - br.first;
+    return (1.0 - br.w) * curve_eval(br.c0, br.c0->x_first + v * br.r0) +
+           br.w * curve_eval(br.c1, br.c1->x_first + v * br.r1);
 }
 
 double cc_table_delta(const Table *tb, double theta) {
     int i; double w;
-    grid_bracket(tb->theta, tb->nt, theta, &i, &w);
+    table_index(tb, theta, &i, &w);
     return w == 0.0 ? tb->delta[i] : (1.0 - w) * tb->delta[i] + w * tb->delta[i + 1];
 }
 
@@ -301,6 +327,8 @@ int cc_table_load(Table *tb, const char *dir, char *err, size_t errlen) {
             goto fail;
         }
         pchip_slopes(c->x, c->y, c->d, n);
+        for (j = 0, c->x_first = c->x[0]; j < n; ++j)
+            if (c->y[j] == c->y[0]) c->x_first = c->x[j];
     }
     free(fd); free(kp); free(fdl); free(kpl);
     fd = kp = NULL;

@@ -40,11 +40,48 @@ def test_force_is_monotone_in_u_at_and_between_table_temperatures(table):
         assert f[0] == pytest.approx(0.0, abs=1e-9)
 
 
-def test_linear_in_theta_between_tables(table, raw):
-    u = 0.7e-3
-    f80, f195 = table.force(u, 80.0), table.force(u, 195.0)
-    assert table.force(u, 80.0 + 0.3 * 115.0) == pytest.approx(0.7 * f80 + 0.3 * f195, rel=1e-12)
+def _first_contact(u, f):
+    """Last row still at the curve's first force (independent of spring_table)."""
+    return u[np.flatnonzero(f == f[0])[-1]]
+
+
+def test_between_tables_the_curves_blend_on_a_normalised_compression(table, raw):
+    """F(u, theta) between 80 and 195 degC: each neighbour read at the same fraction of its own first-contact ->
+    full-compression span (spans linear in theta), the forces weighted linearly in theta (scipy's PCHIP)."""
+    k80, k195 = list(raw.theta_degC).index(80.0), list(raw.theta_degC).index(195.0)
+    w = 0.3
+    curves = [(raw.u_m[k], raw.force_N[k]) for k in (k80, k195)]
+    a = [_first_contact(u, f) for u, f in curves]
+    b = [u[-1] for u, _ in curves]
+    a_t, b_t = (1 - w) * a[0] + w * a[1], (1 - w) * b[0] + w * b[1]
+    assert table.first_contact(80.0 + w * 115.0) == pytest.approx(a_t, rel=1e-14)
+    assert table.full_compression(80.0 + w * 115.0) == pytest.approx(b_t, rel=1e-14)
+    for u in np.linspace(a_t - 1e-4, b_t + 1e-4, 301):
+        xi = (u - a_t) / (b_t - a_t)
+        ref = [float(PchipInterpolator(cu, cf, extrapolate=False)(np.clip(a[j] + xi * (b[j] - a[j]), a[j], b[j])))
+               for j, (cu, cf) in enumerate(curves)]
+        assert table.force(u, 80.0 + w * 115.0) == pytest.approx((1 - w) * ref[0] + w * ref[1], rel=1e-11, abs=1e-9)
     assert table.delta_kiss(137.5) == pytest.approx(np.interp(137.5, raw.theta_degC, raw.delta_kiss_m))
+
+
+def test_first_contact_and_full_compression_are_continuous_in_theta(table):
+    """No step where theta crosses a table temperature (issue 30: the max/min over the active curves jumped)."""
+    for t in table.theta_degC[1:-1]:
+        for q in (table.first_contact, table.full_compression):
+            assert abs(q(t + 1e-7) - q(t - 1e-7)) < 1e-12
+        u = np.linspace(-3e-4, 2e-3, 801)
+        jump = max(abs(table.force(x, t + 1e-7) - table.force(x, t - 1e-7)) for x in u)
+        assert jump < 1e-3       # N; the force's theta slope is < 10 N/K
+
+
+def test_first_contact_is_where_the_force_starts(table):
+    """The 300 degC curve begins with two 0 N rows: its first contact is the second (issue 31)."""
+    c = table.curves[-1]
+    assert c.y[0] == c.y[1] == 0.0 < c.y[2]
+    assert table.first_contact(300.0) == c.x[1]
+    for t in (20.0, 137.5, 260.0, 300.0):
+        a = table.first_contact(t)
+        assert table.force(a, t) == 0.0 < table.force(a + 1e-7, t)
 
 
 def test_clamped_outside_table_temperatures(table):
@@ -251,3 +288,17 @@ def test_kiss_point_is_the_outputs_kiss_point():
         assert kiss_point(300.0, table, p) == outputs(0.0, 300.0, table, p).x_kiss
     with pytest.raises(ValueError, match="theta_cs"):
         kiss_point(-1.0, table, ClutchParameters())
+
+
+def test_inverse_at_zero_torque_is_where_the_torque_starts(table):
+    """x_to_for_torque(0) is the first position with torque, at every temperature (issue 31: at 300 degC it
+    answered 0.1 mm early, at the first of the 300 degC curve's two 0 N rows)."""
+    for t in np.linspace(10.0, 320.0, 32):
+        th = t + KELVIN
+        x0 = x_to_for_torque(0.0, th, table, P)
+        lo, hi = x0 - 2e-4, x0 + 2e-4               # bisection on the forward model for the first torque > 0
+        assert outputs(lo, th, table, P).torque == 0.0 < outputs(hi, th, table, P).torque
+        while hi - lo > 1e-10:
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if outputs(mid, th, table, P).torque == 0.0 else (lo, mid)
+        assert abs(x0 - hi) < 1.5e-6, t

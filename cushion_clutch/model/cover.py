@@ -339,9 +339,7 @@ class _Frame:
     def __init__(self, g: CoverMap, table, theta_c: float, e_mod: float, xc: float, s_kiss: float, s_solid: float,
                  theta_cs: float, wear: float):
         self.g, self.table, self.theta_c, self.e_mod, self.xc = g, table, theta_c, e_mod, xc
-        i, self._w = table._bracket(theta_c)        # the curves of this temperature, as table.force uses them
-        self._c0 = table.curves[i]
-        self._c1 = table.curves[i + 1] if self._w != 0.0 else None
+        self._b = table.bracket(theta_c)            # F(u) at this temperature, as table.force uses it
         self.s_kiss, self.s_solid, self.theta_cs, self.wear = s_kiss, s_solid, theta_cs, wear
         self.fto_solid, self.fc_solid = self.f_to(s_solid)
         self.x_solid = xc - g.kb * s_solid - g.comp * self.fto_solid
@@ -356,13 +354,11 @@ class _Frame:
 
     def cushion(self, u: float) -> float:
         """F(u, theta_cs), N (= ``table.force``, with the temperature bracket found once)."""
-        f0 = self._c0(u)
-        return f0 if self._w == 0.0 else (1.0 - self._w) * f0 + self._w * self._c1(u)
+        return self._b.force(u)
 
     def cushion_slope(self, u: float) -> float:
         """dF/du at theta_cs, N/m (= ``table.force_slope``)."""
-        d0 = self._c0.slope(u)
-        return d0 if self._w == 0.0 else (1.0 - self._w) * d0 + self._w * self._c1.slope(u)
+        return self._b.slope(u)
 
     def f_to(self, s: float) -> tuple[float, float]:
         """(bearing force, cushion force) at deflection ``s`` while the bearing is on the fingers, N."""
@@ -407,14 +403,14 @@ class _Frame:
         return CoverState(fc, fto, fc, (s_kiss - s) * kp, s, self.x_kiss, self.x_solid, self.x_lift)
 
     def x_for_clamp(self, force: float, tol_m: float = 1e-12) -> float:
-        g, table, th = self.g, self.table, self.theta_c
+        g = self.g
         if force >= self.clamp_installed():
             return self.x_lift
         if force > self.fc_solid:       # solid phase: F_to = (M(s_solid) - F L_pp) / L_b
             fto = (g.moment(self.s_solid, self.e_mod) - force * g.L_pp) / g.L_b
             return self.x_solid + g.comp * (self.fto_solid - fto)
-        lo, hi = table.first_contact(th), table.full_compression(th)
-        if force <= table.force(lo, th):
+        lo, hi = self._b.first, self._b.full
+        if force <= self._b.force(lo):
             return self.x_of(self.s_kiss - lo / g.kp)
         # the smallest compression u with F(u) >= force, to tol: a bracket F(lo) < force <= F(hi) closed by
         # Newton steps (bisection where a step leaves it); once a step is below tol the other side of the

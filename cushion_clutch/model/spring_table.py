@@ -2,9 +2,20 @@
 
 Shared by the pythonfmu slave and the Python API (through ``clutch_model``).
 Force: shape-preserving (PCHIP, Fritsch-Carlson) cubic in u per table
-temperature, linear between temperatures; u below the table's first contact
-gives its first force (zero), beyond full compression the full-compression
-force; temperatures outside the table are clamped.
+temperature; u below a curve's first contact gives its first force (zero),
+beyond its full compression the full-compression force.
+
+Between two table temperatures the curves are blended on a common normalised
+compression: first contact ``a(theta)`` and full compression ``b(theta)`` are
+linear in theta between their table values, and at ``u`` each neighbouring curve
+``k`` is read at ``a_k + (u - a(theta)) (b_k - a_k) / (b(theta) - a(theta))``, then
+the two forces are weighted linearly in theta. So the blended curve starts
+rising exactly at ``a(theta)``, is solid exactly at ``b(theta)``, equals the table
+curve at a table temperature, and every quantity (force, first contact, full
+compression, hence kiss point, clamp load and torque) is continuous in theta.
+(Blending the curves at the same ``u`` instead gives a curve whose first contact
+and full compression are the extreme ones of the two neighbours: a step at
+every table temperature.) Temperatures outside the table are clamped.
 """
 from __future__ import annotations
 
@@ -65,13 +76,15 @@ def _end_slope(h0: float, h1: float, m0: float, m1: float) -> float:
 class Curve:
     """One F(u) curve with its PCHIP slopes, evaluated in plain Python (fast for scalars)."""
 
-    __slots__ = ("x", "y", "d", "x_min", "x_max")
+    __slots__ = ("x", "y", "d", "x_min", "x_max", "x_first")
 
     def __init__(self, u: np.ndarray, force: np.ndarray):
         self.x = [float(v) for v in u]
         self.y = [float(v) for v in force]
         self.d = [float(v) for v in pchip_slopes(u, force)]
         self.x_min, self.x_max = self.x[0], self.x[-1]
+        #: first contact: the last row still at the first force (a curve may begin with several 0 N rows), m
+        self.x_first = self.x[max(k for k, f in enumerate(self.y) if f == self.y[0])]
 
     def __call__(self, u: float) -> float:
         x, y, d = self.x, self.y, self.d
@@ -135,6 +148,7 @@ class SpringTable:
         self.friction = None
         self.theta_min_K = self.theta_degC[0] + KELVIN
         self.theta_max_K = self.theta_degC[-1] + KELVIN
+        self._last: Bracket | None = None
 
     @classmethod
     def from_dir(cls, folder: str | Path) -> "SpringTable":
@@ -167,26 +181,35 @@ class SpringTable:
         return table
 
     def _bracket(self, theta_degC: float) -> tuple[int, float]:
-        """Index i and weight w so that theta lies between table i and i+1 (clamped)."""
+        """Index i and weight w of table i + 1 so that theta lies between tables i and i + 1.
+
+        At a table temperature and beyond either end w is 0 (table i alone counts; clamped).
+        """
         ts = self.theta_degC
         if theta_degC <= ts[0] or len(ts) == 1:
             return 0, 0.0
         if theta_degC >= ts[-1]:
-            return len(ts) - 2, 1.0
+            return len(ts) - 1, 0.0
         i = bisect_right(ts, theta_degC) - 1
         return i, (theta_degC - ts[i]) / (ts[i + 1] - ts[i])
 
+    def bracket(self, theta_degC: float) -> "Bracket":
+        """The blended curve at ``theta_degC`` (kept for the last temperature asked)."""
+        last = self._last
+        if last is not None and last.theta_degC == theta_degC:
+            return last
+        i, w = self._bracket(theta_degC)
+        b = Bracket(theta_degC, self.curves[i], self.curves[i + 1] if w != 0.0 else None, w)
+        self._last = b
+        return b
+
     def force(self, u_m: float, theta_degC: float) -> float:
         """Whole-spring force at compression ``u_m`` from the kiss point, N."""
-        i, w = self._bracket(theta_degC)
-        f0 = self.curves[i](u_m)
-        return f0 if w == 0.0 else (1.0 - w) * f0 + w * self.curves[i + 1](u_m)
+        return self.bracket(theta_degC).force(u_m)
 
     def force_slope(self, u_m: float, theta_degC: float) -> float:
         """dF/du at compression ``u_m`` and ``theta_degC``, N/m."""
-        i, w = self._bracket(theta_degC)
-        d0 = self.curves[i].slope(u_m)
-        return d0 if w == 0.0 else (1.0 - w) * d0 + w * self.curves[i + 1].slope(u_m)
+        return self.bracket(theta_degC).slope(u_m)
 
     def delta_kiss(self, theta_degC: float) -> float:
         """Kiss-point shift of the spring, m (linear in theta, clamped)."""
@@ -194,16 +217,60 @@ class SpringTable:
         d = self.delta_kiss_m
         return d[i] if w == 0.0 else (1.0 - w) * d[i] + w * d[i + 1]
 
-    def _active(self, theta_degC: float) -> list[Curve]:
-        """Curves that carry weight at this temperature."""
-        i, w = self._bracket(theta_degC)
-        return [c for c, wc in ((self.curves[i], 1.0 - w), (self.curves[min(i + 1, len(self.curves) - 1)], w))
-                if wc > 0.0]
-
     def full_compression(self, theta_degC: float) -> float:
-        """Compression from which F no longer grows at this temperature, m."""
-        return max(c.x_max for c in self._active(theta_degC))
+        """Compression from which F no longer grows at this temperature, m (linear in theta between the tables)."""
+        return self.bracket(theta_degC).full
 
     def first_contact(self, theta_degC: float) -> float:
-        """Compression below which F is its first (zero) value at this temperature, m (<= 0)."""
-        return min(c.x_min for c in self._active(theta_degC))
+        """Compression below which F is its first (zero) value at this temperature, m (linear in theta)."""
+        return self.bracket(theta_degC).first
+
+
+class Bracket:
+    """F(u) at one temperature: the two neighbouring table curves blended on a common normalised compression.
+
+    Parameters
+    ----------
+    theta_degC : float
+        The temperature, degC.
+    c0, c1 : Curve, Curve or None
+        The table curves below and above it (``c1`` None where the weight ``w`` is 0).
+    w : float
+        Weight of ``c1``, 1 (linear in theta).
+
+    Attributes
+    ----------
+    first, full : float
+        First contact and full compression at this temperature, m: ``(1 - w) a_0 + w a_1`` and
+        ``(1 - w) b_0 + w b_1`` of the curves' own (``Curve.x_first``, ``Curve.x_max``).
+    """
+
+    __slots__ = ("theta_degC", "c0", "c1", "w", "first", "full", "r0", "r1")
+
+    def __init__(self, theta_degC: float, c0: Curve, c1: Curve | None, w: float):
+        self.theta_degC, self.c0, self.c1, self.w = theta_degC, c0, c1, w
+        if w == 0.0:
+            self.first, self.full, self.r0, self.r1 = c0.x_first, c0.x_max, 1.0, 0.0
+            return
+        self.first = (1.0 - w) * c0.x_first + w * c1.x_first
+        self.full = (1.0 - w) * c0.x_max + w * c1.x_max
+        span = self.full - self.first
+        #: d(u_k)/du: each curve's span over the blended span (0 for a degenerate span)
+        self.r0 = (c0.x_max - c0.x_first) / span if span > 0.0 else 0.0
+        self.r1 = (c1.x_max - c1.x_first) / span if span > 0.0 else 0.0
+
+    def force(self, u: float) -> float:
+        """F(u) at this temperature, N."""
+        if self.w == 0.0:
+            return self.c0(u)
+        v = u - self.first
+        return ((1.0 - self.w) * self.c0(self.c0.x_first + v * self.r0)
+                + self.w * self.c1(self.c1.x_first + v * self.r1))
+
+    def slope(self, u: float) -> float:
+        """dF/du at this temperature, N/m (0 outside the curves)."""
+        if self.w == 0.0:
+            return self.c0.slope(u)
+        v = u - self.first
+        return ((1.0 - self.w) * self.c0.slope(self.c0.x_first + v * self.r0) * self.r0
+                + self.w * self.c1.slope(self.c1.x_first + v * self.r1) * self.r1)

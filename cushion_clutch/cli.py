@@ -197,16 +197,17 @@ def _launch(args: argparse.Namespace) -> int:
 
 
 def _export(args: argparse.Namespace) -> int:
-    from .fe.exports import export_mat, export_modelica
+    from .fe.exports import build, export_mat, export_modelica
 
     from .fe.tables import read_tables
     from .outputs import OutputSet
 
     out = _guard_out(Path(args.out), args.force)
     read_tables(Path(args.tables))                          # a clear TableError first
+    data = build(Path(args.tables))                         # the model on every grid, once for both files
     with OutputSet(out, "export") as stage:
-        mat = export_mat(Path(args.tables), stage / "cushion_spring_tables.mat")
-        mo = export_modelica(Path(args.tables), stage / "cushion_spring_tables.txt")
+        mat = export_mat(data, stage / "cushion_spring_tables.mat")
+        mo = export_modelica(data, stage / "cushion_spring_tables.txt")
     mat, mo = out / mat.name, out / mo.name
     print(f"wrote {mat} (Simulink 2-D Lookup Table) and {mo} (Modelica CombiTable2Ds, #1 format)")
     return 0

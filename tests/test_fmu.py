@@ -11,9 +11,7 @@ from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import FMU2Slave
 from fmpy.validation import validate_fmu
 from scipy.interpolate import PchipInterpolator
-from scipy.io import loadmat
 
-from cushion_clutch.fe.exports import export_mat, export_modelica, read_modelica
 from cushion_clutch.fmu.build import build_fmu
 from cushion_clutch.data import DEFAULT_TABLES
 from cushion_clutch.model import load_table
@@ -275,39 +273,3 @@ def test_many_steps_do_not_grow_memory(fmu):
     finally:
         client.close()
     assert rss1 - rss0 < 3 * 1024, f"{rss1 - rss0} kB more after 300 000 steps"
-
-
-def test_exports_read_back_equal_to_tables(tables, tmp_path):
-    mat = loadmat(export_mat(DEFAULT_TABLES, tmp_path / "t.mat"))
-    mo = read_modelica(export_modelica(DEFAULT_TABLES, tmp_path / "t.txt"))
-    assert np.array_equal(mat["theta_degC"].ravel(), tables.theta_degC)
-    assert np.array_equal(mo["force_N"][0, 1:], tables.theta_degC)
-    u_mat, u_mo = mat["u_m"].ravel(), mo["force_N"][1:, 0]
-    for j, (u, f) in enumerate(zip(tables.u_m, tables.force_N)):
-        i = np.searchsorted(u_mat, u)
-        assert np.array_equal(u_mat[i], u)
-        assert mat["force_N"][i, j] == pytest.approx(f, rel=1e-12, abs=1e-12)
-        k = np.searchsorted(u_mo, u)
-        assert u_mo[k] == pytest.approx(u, rel=1e-11) and mo["force_N"][1 + k, 1 + j] == pytest.approx(f, rel=1e-11)
-    assert mat["delta_kiss_m"].ravel() == pytest.approx(tables.delta_kiss_m)
-    assert mo["delta_kiss_m"][:, 1] == pytest.approx(tables.delta_kiss_m, rel=1e-11)
-    assert "force_N [N]" in str(mat["units"])
-
-
-def test_exports_carry_the_cover_map_at_full_precision(tmp_path):
-    """clamp/bearing force tables equal the model at every node; x_to values are distinct after reading back."""
-    from cushion_clutch.model import ClutchParameters, outputs
-    mat = loadmat(export_mat(DEFAULT_TABLES, tmp_path / "t.mat"))
-    mo = read_modelica(export_modelica(DEFAULT_TABLES, tmp_path / "t.txt"))
-    table, p = load_table(), ClutchParameters()
-    x_mo, th = mo["clamp_force_N"][1:, 0], mo["clamp_force_N"][0, 1:]
-    assert np.all(np.diff(x_mo) > 0)                               # CombiTable2Ds needs strictly increasing u
-    assert np.array_equal(x_mo, mat["x_to_m"].ravel())             # %.17g round-trips exactly
-    assert np.array_equal(mo["force_N"][1:, 0], mat["u_m"].ravel())
-    for k in range(0, len(x_mo), 37):
-        for j, t in enumerate(th):
-            o = outputs(float(x_mo[k]), t + 273.15, table, p, t + 273.15)
-            assert mo["clamp_force_N"][1 + k, 1 + j] == o.clamp_force
-            assert mo["bearing_force_N"][1 + k, 1 + j] == o.bearing_force
-    assert np.all(np.diff(mat["clamp_force_N"], axis=0) >= 0)      # monotone in x_to at every temperature
-    assert "HoldLastPoint" in (tmp_path / "t.txt").read_text()

@@ -42,3 +42,4 @@ autodoc_typehints = "description"
 html_theme = "furo"
 html_title = f"cushion-clutch {__version__}"
 html_static_path = []
+smartquotes = False                          # keep -- in option names as typed

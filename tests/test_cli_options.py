@@ -123,3 +123,18 @@ def test_launch_terminal_table_fits_100_columns():
     text = launch_terminal_table([row, row])
     assert max(len(line) for line in text.splitlines()) <= 100
     assert "adaptive_aware_estimated" in text and "-146.0" in text
+
+
+def test_a_slow_fmu_build_says_why(capsys):
+    """The zig notice appears once a build outlasts its delay, and never for a quick one."""
+    import time
+
+    from cushion_clutch.cli import ZIG_NOTICE, _slow_notice
+
+    with _slow_notice(ZIG_NOTICE, after_s=0.05):
+        time.sleep(0.3)
+    with _slow_notice("quick", after_s=0.5):
+        pass
+    time.sleep(0.6)
+    err = capsys.readouterr().err
+    assert err.count("zig") >= 1 and "first build" in err and "quick" not in err

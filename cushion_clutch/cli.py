@@ -78,13 +78,13 @@ def _sweep(args: argparse.Namespace) -> int:
         plot_kiss_shift(tables, stage / "kiss_point.png")
     print(f"tables written to {out} in {wall:.1f} s (mesh {params.mesh.element_size_m * 1e3:g} mm)")
     prog, crest = tables.metadata["progressivity"], tables.metadata["kiss_point"]
-    print(f"{'theta [degC]':>12} {'delta_kiss [mm]':>16} {'crest growth [mm]':>18} {'F full [N]':>11} "
-          f"{'k20/k50/k90 [kN/mm]':>20} {'k90/k20':>8} {'increments':>10}")
+    print(f"{'theta [degC]':>12} {'delta_kiss [mm]':>15} {'crest growth [mm]':>18} {'F full [N]':>10} "
+          f"{'k20/k50/k90 [kN/mm]':>20} {'k90/k20':>8} {'increments':>10}")      # 99 columns
     for c in curves:
         o, k = outcomes[c.theta_degC], prog[f"{c.theta_degC:g}"]
         ks = "/".join(f"{k[n] / 1e6:.2f}" for n in ("k20_N_per_m", "k50_N_per_m", "k90_N_per_m"))
-        print(f"{c.theta_degC:>12g} {shifts[c.theta_degC] * 1e3:>16.4f} "
-              f"{crest[f'{c.theta_degC:g}']['crest_growth_m'] * 1e3:>18.4f} {c.force_N[-1]:>11.0f} "
+        print(f"{c.theta_degC:>12g} {shifts[c.theta_degC] * 1e3:>15.4f} "
+              f"{crest[f'{c.theta_degC:g}']['crest_growth_m'] * 1e3:>18.4f} {c.force_N[-1]:>10.0f} "
               f"{ks:>20} {k['k90_over_k20']:>8.2f} {o.stats.increments:>10d}")
     return 0
 

@@ -198,38 +198,42 @@ def _launch(args: argparse.Namespace) -> int:
     print(ratio_line(results, "hot"))
     for name, res in results.items():
         e = res.energy
-        print(f"{name}: energy balance residual {e.residual():.3g} J of {e.engine_work / 1e3:.1f} kJ; "
-              f"real-time factor {total / res.wall_time_s:.0f}x (CPU {total / res.cpu_time_s:.0f}x)")
+        print(f"{name}: energy residual {e.residual():.3g} J of {e.engine_work / 1e3:.1f} kJ; "
+              f"{total / res.wall_time_s:.0f}x real time (CPU {total / res.cpu_time_s:.0f}x)")
     print(f"scenario '{sc.name}': {len(results[next(iter(results))].metrics)} launches with {len(results)} TCUs "
-          f"in {wall:.1f} s; every metric per launch in {out / 'launch_metrics.csv'}, mean and worst per group "
-          f"in {out / 'launch_summary.csv'}; wrote {len(paths)} files to {out}")
+          f"in {wall:.1f} s; {len(paths)} files written to {out}")
+    print(f"every metric per launch: {out / 'launch_metrics.csv'}")
+    print(f"mean and worst per group: {out / 'launch_summary.csv'}")
     return 0
 
 
 #: the launch summary's terminal columns: (summary key, header, format); the rest is in launch_summary.csv
-TERMINAL_COLUMNS = (("characteristic_error_max_Nm_worst", "char.err max", ".2f"),
-                    ("characteristic_error_rms_Nm_mean", "char.err rms", ".2f"),
+TERMINAL_COLUMNS = (("characteristic_error_max_Nm_worst", "err max", ".2f"),
+                    ("characteristic_error_rms_Nm_mean", "err rms", ".2f"),
                     ("tracking_error_rms_Nm_worst", "track rms", ".2f"),
                     ("creep_error_Nm_worst", "creep err", ".2f"),
-                    ("theta_cs_error_K_worst", "θ_cs err K", ".1f"),
-                    ("engagement_time_s_mean", "engage s", ".2f"))
+                    ("theta_cs_error_K_worst", "θ_cs err", ".1f"),
+                    ("engagement_time_s_mean", "engage", ".2f"))
+TERMINAL_LEGEND = ("err max / err rms: characteristic error (believed - true torque) [N.m], worst max / mean RMS;\n"
+                   "track rms: tracking error, worst RMS [N.m]; creep err: worst [N.m]; θ_cs err: worst [K];\n"
+                   "engage: mean [s]")
 
 
 def launch_terminal_table(rows: list[dict], width: int = 100) -> str:
     """The launch summary for a terminal, at most ``width`` columns: per group and TCU the worst (or mean)
-    of a few metrics in N.m unless the header says otherwise. Every column is in ``launch_summary.csv``."""
+    of a few metrics (:data:`TERMINAL_LEGEND`). Every column is in ``launch_summary.csv``."""
     import math
 
     def cell(v, fmt):
         return "-" if isinstance(v, float) and math.isnan(v) else format(v, fmt)
 
-    head = f"{'launches':<10}{'TCU':<25}{'n':>3}" + "".join(f"{h:>11}" for _, h, _ in TERMINAL_COLUMNS)
+    head = f"{'launches':<10}{'TCU':<25}{'n':>3}" + "".join(f"{h:>10}" for _, h, _ in TERMINAL_COLUMNS)
     lines = [head[:width], "-" * min(len(head), width)]
     for r in rows:
         line = f"{r['group']:<10}{r['tcu']:<25}{r['n']:>3}" + "".join(
-            f"{cell(r.get(k, float('nan')), f):>11}" for k, _, f in TERMINAL_COLUMNS)
+            f"{cell(r.get(k, float('nan')), f):>10}" for k, _, f in TERMINAL_COLUMNS)
         lines.append(line[:width])
-    lines.append("(worst: char.err max, track rms, creep err, θ_cs err; mean: char.err rms, engage)")
+    lines.append(TERMINAL_LEGEND)
     return "\n".join(lines)
 
 

@@ -121,7 +121,7 @@ def test_launch_terminal_table_fits_100_columns():
            "tracking_error_rms_Nm_worst": 1234.5, "creep_error_Nm_worst": -12.34,
            "theta_cs_error_K_worst": -146.0, "engagement_time_s_mean": math.nan}
     text = launch_terminal_table([row, row])
-    assert max(len(line) for line in text.splitlines()) <= 100
+    assert max(len(line) for line in text.splitlines()) <= 100, text
     assert "adaptive_aware_estimated" in text and "-146.0" in text
 
 

@@ -1,9 +1,11 @@
-"""Command line: ``cushion-clutch <job>``. Only this module prints."""
+"""Command line: ``cushion-clutch <command>``. Only this module prints."""
 from __future__ import annotations
 
 import argparse
+import contextlib
 import logging
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -26,7 +28,9 @@ def _fmu_arg(args: argparse.Namespace, stage: Path) -> Path:
     from .fmu.check import check_fmu
     if args.fmu:
         return check_fmu(args.fmu)
-    return build_fmu(Path(args.tables), stage / "CushionClutch.fmu", backend=args.backend)
+    _check_tables(args.tables)
+    with _slow_notice(ZIG_NOTICE):
+        return build_fmu(Path(args.tables), stage / "CushionClutch.fmu", backend=args.backend)
 
 
 def _sweep(args: argparse.Namespace) -> int:
@@ -74,13 +78,13 @@ def _sweep(args: argparse.Namespace) -> int:
         plot_kiss_shift(tables, stage / "kiss_point.png")
     print(f"tables written to {out} in {wall:.1f} s (mesh {params.mesh.element_size_m * 1e3:g} mm)")
     prog, crest = tables.metadata["progressivity"], tables.metadata["kiss_point"]
-    print(f"{'theta [degC]':>12} {'delta_kiss [mm]':>16} {'crest growth [mm]':>18} {'F full [N]':>11} "
-          f"{'k20/k50/k90 [kN/mm]':>20} {'k90/k20':>8} {'increments':>10}")
+    print(f"{'theta [degC]':>12} {'delta_kiss [mm]':>15} {'crest growth [mm]':>18} {'F full [N]':>10} "
+          f"{'k20/k50/k90 [kN/mm]':>20} {'k90/k20':>8} {'increments':>10}")      # 99 columns
     for c in curves:
         o, k = outcomes[c.theta_degC], prog[f"{c.theta_degC:g}"]
         ks = "/".join(f"{k[n] / 1e6:.2f}" for n in ("k20_N_per_m", "k50_N_per_m", "k90_N_per_m"))
-        print(f"{c.theta_degC:>12g} {shifts[c.theta_degC] * 1e3:>16.4f} "
-              f"{crest[f'{c.theta_degC:g}']['crest_growth_m'] * 1e3:>18.4f} {c.force_N[-1]:>11.0f} "
+        print(f"{c.theta_degC:>12g} {shifts[c.theta_degC] * 1e3:>15.4f} "
+              f"{crest[f'{c.theta_degC:g}']['crest_growth_m'] * 1e3:>18.4f} {c.force_N[-1]:>10.0f} "
               f"{ks:>20} {k['k90_over_k20']:>8.2f} {o.stats.increments:>10d}")
     return 0
 
@@ -124,10 +128,12 @@ def _simulate(args: argparse.Namespace) -> int:
     from .outputs import OutputSet
 
     out = _guard_out(Path(args.out), args.force)
+    _check_tables(args.tables)
     table = load_table(args.tables)
     with OutputSet(out, "simulate") as stage:              # checks --out before the simulation
         fmu = _fmu_arg(args, stage)
-        print(f"simulating {args.engagements} engagements with {fmu} (fmpy, step {args.step:g} s) ...")
+        which = args.fmu or f"the {args.backend} FMU built from {args.tables}"
+        print(f"simulating {args.engagements} engagements with {which} (fmpy, step {args.step:g} s) ...")
         start = time.perf_counter()
         res = simulate(fmu, EngagementCycle(), n_engagements=args.engagements, step_s=args.step)
         wall = time.perf_counter() - start
@@ -161,17 +167,22 @@ def _launch(args: argparse.Namespace) -> int:
     from .fmu.check import check_fmu
     from .model import load_table
     from .launch.plant import build_plant_fmu
-    from .launch.report import metrics_table, ratio_line, run_all, summary_table, write_outputs
+    from .launch.report import ratio_line, run_all, summary_rows, write_outputs
     from .launch.scenario import load_scenario, scenario_path
     from .launch.tcu import VARIANTS
     from .outputs import OutputSet
 
     sc = load_scenario(scenario_path(args.scenario))
     out = _guard_out(Path(args.out), args.force)
+    _check_tables(sc.tables_path("tcu") or args.tables)
     table = load_table(sc.tables_path("tcu") or args.tables)     # a scenario may name the TCUs' table set
     with OutputSet(out, "launch") as stage:                # checks --out before the simulation
-        fmu = (check_fmu(args.fmu) if args.fmu else
-               build_plant_fmu(Path(args.tables), sc, stage / "CushionClutch.fmu", backend=args.backend))
+        if args.fmu:
+            fmu = check_fmu(args.fmu)
+        else:
+            _check_tables(args.tables)
+            with _slow_notice(ZIG_NOTICE):
+                fmu = build_plant_fmu(Path(args.tables), sc, stage / "CushionClutch.fmu", backend=args.backend)
         total = sc.run.duration()
         start = time.perf_counter()
         with Progress(refresh_per_second=2) as bar:        # the bar's thread competes for the GIL
@@ -182,18 +193,48 @@ def _launch(args: argparse.Namespace) -> int:
         wall = time.perf_counter() - start
         paths = write_outputs(results, stage)
     paths = [out / p.relative_to(stage) for p in paths]
-    print(metrics_table(results))
-    print()
-    print(summary_table(results))
+    print(launch_terminal_table(summary_rows(results)))
     print()
     print(ratio_line(results, "hot"))
     for name, res in results.items():
         e = res.energy
-        print(f"{name}: energy balance residual {e.residual():.3g} J of {e.engine_work / 1e3:.1f} kJ engine "
-              f"work; real-time factor {total / res.wall_time_s:.0f}x (CPU time {total / res.cpu_time_s:.0f}x)")
+        print(f"{name}: energy residual {e.residual():.3g} J of {e.engine_work / 1e3:.1f} kJ; "
+              f"{total / res.wall_time_s:.0f}x real time (CPU {total / res.cpu_time_s:.0f}x)")
     print(f"scenario '{sc.name}': {len(results[next(iter(results))].metrics)} launches with {len(results)} TCUs "
-          f"in {wall:.1f} s; wrote " + ", ".join(str(p) for p in paths))
+          f"in {wall:.1f} s; {len(paths)} files written to {out}")
+    print(f"every metric per launch: {out / 'launch_metrics.csv'}")
+    print(f"mean and worst per group: {out / 'launch_summary.csv'}")
     return 0
+
+
+#: the launch summary's terminal columns: (summary key, header, format); the rest is in launch_summary.csv
+TERMINAL_COLUMNS = (("characteristic_error_max_Nm_worst", "err max", ".2f"),
+                    ("characteristic_error_rms_Nm_mean", "err rms", ".2f"),
+                    ("tracking_error_rms_Nm_worst", "track rms", ".2f"),
+                    ("creep_error_Nm_worst", "creep err", ".2f"),
+                    ("theta_cs_error_K_worst", "θ_cs err", ".1f"),
+                    ("engagement_time_s_mean", "engage", ".2f"))
+TERMINAL_LEGEND = ("err max / err rms: characteristic error (believed - true torque) [N.m], worst max / mean RMS;\n"
+                   "track rms: tracking error, worst RMS [N.m]; creep err: worst [N.m]; θ_cs err: worst [K];\n"
+                   "engage: mean [s]")
+
+
+def launch_terminal_table(rows: list[dict], width: int = 100) -> str:
+    """The launch summary for a terminal, at most ``width`` columns: per group and TCU the worst (or mean)
+    of a few metrics (:data:`TERMINAL_LEGEND`). Every column is in ``launch_summary.csv``."""
+    import math
+
+    def cell(v, fmt):
+        return "-" if isinstance(v, float) and math.isnan(v) else format(v, fmt)
+
+    head = f"{'launches':<10}{'TCU':<25}{'n':>3}" + "".join(f"{h:>10}" for _, h, _ in TERMINAL_COLUMNS)
+    lines = [head[:width], "-" * min(len(head), width)]
+    for r in rows:
+        line = f"{r['group']:<10}{r['tcu']:<25}{r['n']:>3}" + "".join(
+            f"{cell(r.get(k, float('nan')), f):>10}" for k, _, f in TERMINAL_COLUMNS)
+        lines.append(line[:width])
+    lines.append(TERMINAL_LEGEND)
+    return "\n".join(lines)
 
 
 def _export(args: argparse.Namespace) -> int:
@@ -203,6 +244,7 @@ def _export(args: argparse.Namespace) -> int:
     from .outputs import OutputSet
 
     out = _guard_out(Path(args.out), args.force)
+    _check_tables(args.tables)
     read_tables(Path(args.tables))                          # a clear TableError first
     data = build(Path(args.tables))                         # the model on every grid, once for both files
     with OutputSet(out, "export") as stage:
@@ -214,16 +256,53 @@ def _export(args: argparse.Namespace) -> int:
 
 
 def _check(args: argparse.Namespace) -> int:
-    from .fe.params import load_params
-    p = load_params(args.spring)
-    print(f"{args.spring}: spring '{p.name}' is valid ({p.n_pairs} pairs, "
+    from .fe.params import DEFAULT_SPRING, load_params
+    if args.spring_file and args.spring and Path(args.spring_file) != Path(args.spring):
+        raise ParameterError([f"two springs given ({args.spring_file} and --spring {args.spring}); give one"])
+    spring = args.spring_file or args.spring or DEFAULT_SPRING
+    p = load_params(spring)
+    print(f"{spring}: spring '{p.name}' is valid ({p.n_pairs} pairs, "
           f"{len(p.sweep.temperatures_degC)} temperatures)")
     return 0
 
 
+@contextlib.contextmanager
+def _slow_notice(message: str, after_s: float = 5.0):
+    """Print ``message`` on stderr once if the block is still running after ``after_s`` (zig's first build
+    compiles its C libraries for every target: minutes without a word otherwise)."""
+    timer = threading.Timer(after_s, lambda: print(message, file=sys.stderr, flush=True))
+    timer.daemon = True
+    timer.start()
+    try:
+        yield
+    finally:
+        timer.cancel()
+
+
+#: said while an FMU build takes longer than a warm zig cache needs
+ZIG_NOTICE = ("building the FMU's binaries with zig ... (the first build on a machine compiles zig's C "
+              "libraries for every target: a few minutes; later builds take seconds)")
+
+
+def _check_tables(folder) -> None:
+    """A clear error for a ``--tables`` folder that is missing or holds no table set (before any work)."""
+    from .model.table_format import REQUIRED_FILES
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise TableError(f"--tables {folder}: table folder does not exist (it must hold "
+                         f"{' and '.join(REQUIRED_FILES)}, as written by cushion-clutch sweep)")
+    missing = [n for n in REQUIRED_FILES if not (folder / n).is_file()]
+    if missing:
+        raise TableError(f"--tables {folder}: no table set there ({', '.join(missing)} missing; a table set is "
+                         "the folder cushion-clutch sweep writes, e.g. lookup_tables/<spring>)")
+
+
 def _build_fmu(args: argparse.Namespace) -> int:
     from .fmu.build import build_from_args
-    print(build_from_args(args))
+    _check_tables(args.tables)
+    with _slow_notice(ZIG_NOTICE):
+        report = build_from_args(args)
+    print(report)
     return 0
 
 
@@ -300,28 +379,130 @@ def _tolerance(args: argparse.Namespace) -> int:
     return 0
 
 
+#: the top-level description of ``cushion-clutch --help``
+DESCRIPTION = ("Temperature-aware dry-clutch torque characteristics: CalculiX sweeps of a cushion spring -> "
+               "lookup tables -> a clutch FMU (FMI 2.0/3.0, Co-Simulation and Model Exchange) -> launch "
+               "simulations with six TCU variants.")
+EPILOG = ("examples:\n"
+          "  cushion-clutch launch --out out              # the main job: build the FMU, run the launches\n"
+          "  cushion-clutch build-fmu --out CushionClutch.fmu\n"
+          "  cushion-clutch <command> --help              # options and an example of each command\n"
+          "documentation: docs/ (sphinx-build docs docs/_build/html)")
+
+
+def _command(sub, name: str, func, summary: str, description: str, example: str) -> argparse.ArgumentParser:
+    """A subcommand with its one-line summary, a description, one example, and the global options
+    (``-v``, ``--debug``) accepted after the subcommand too."""
+    p = sub.add_parser(name, help=summary, description=description, epilog=f"example:\n  {example}",
+                       formatter_class=argparse.RawDescriptionHelpFormatter)
+    _global_options(p, argparse.SUPPRESS)
+    p.set_defaults(func=func)
+    return p
+
+
+def _global_options(p: argparse.ArgumentParser, default) -> None:
+    """``-v/--verbose`` and ``--debug``; on a subcommand their default is SUPPRESS, so that the value given
+    before the subcommand survives."""
+    p.add_argument("-v", "--verbose", action="store_true", default=default, help="log progress details")
+    p.add_argument("--debug", action="store_true", default=default, help="show the traceback of an error")
+
+
+def _out(p: argparse.ArgumentParser, help: str, **kw) -> None:
+    """``-o/--out``: the one name of every command's output (a folder, or the file a command writes)."""
+    p.add_argument("-o", "--out", help=help, **kw)
+
+
+def _jobs(p: argparse.ArgumentParser, help: str, dest: str = "jobs", **kw) -> None:
+    """``-j/--jobs`` (``--workers`` accepted as an alias): parallel FE jobs or worker processes."""
+    p.add_argument("-j", "--jobs", "--workers", dest=dest, type=int, help=help, **kw)
+
+
+def _force(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--force", action="store_true", help="allow writing into a table set shipped with the package")
+
+
 def build_parser() -> argparse.ArgumentParser:
+    """The ``cushion-clutch`` argument parser (also what the documentation's CLI reference is generated from)."""
+    from . import __version__
     from .fmu.build import add_backend, add_build_arguments
     from .fe.params import DEFAULT_SPRING
     from .launch.scenario import DEFAULT_SCENARIO
+    from .launch.tcu import VARIANTS
     from .fe.cases import DEFAULT_CACHE
 
-    parser = argparse.ArgumentParser(prog="cushion-clutch", description=__doc__)
-    parser.add_argument("-v", "--verbose", action="store_true", help="log progress details")
-    parser.add_argument("--debug", action="store_true", help="show the traceback of an error")
-    sub = parser.add_subparsers(dest="job", required=True)
+    parser = argparse.ArgumentParser(prog="cushion-clutch", description=DESCRIPTION, epilog=EPILOG,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--version", action="version", version=f"cushion-clutch {__version__}")
+    _global_options(parser, False)
+    sub = parser.add_subparsers(dest="job", required=True, metavar="<command>")
 
-    sw = sub.add_parser("sweep", help="run the CalculiX temperature sweep and write lookup tables")
+    la = _command(sub, "launch", _launch, f"repeated launches with the {len(VARIANTS)} TCU variants (main job)",
+                  f"Build the clutch FMU from --tables (or take --fmu), run a launch scenario with each of the "
+                  f"{len(VARIANTS)} TCU variants ({', '.join(VARIANTS)}) and write time series, metrics, a "
+                  "summary and plots to --out. The terminal shows a short summary; the full tables are the "
+                  "CSV files.",
+                  "cushion-clutch launch --scenario creep --out out_creep")
+    la.add_argument("--scenario", default=DEFAULT_SCENARIO,
+                    help="scenario TOML, or a shipped one: default, creep, cooldown, fade, wear, tolerance")
+    la.add_argument("--fmu", help="clutch FMU (default: build one from --tables into --out)")
+    la.add_argument("--tables", default=DEFAULT_TABLES, help="table folder")
+    add_backend(la)
+    _out(la, "output folder (default: out)", default="out")
+    _force(la)
+
+    sm = _command(sub, "simulate", _simulate, "repeated engagements through the FMU with fmpy, with plots",
+                  "Drive the clutch FMU through fmpy over repeated engagements 60 s apart (bearing ramp, "
+                  "hold, open; a prescribed facing temperature) and write engagements.csv and three plots.",
+                  "cushion-clutch simulate --engagements 4 --out out_sim")
+    sm.add_argument("--fmu", help="FMU to simulate (default: build one from --tables into --out)")
+    sm.add_argument("--tables", default=DEFAULT_TABLES, help="table folder")
+    add_backend(sm)
+    _out(sm, "output folder (default: out)", default="out")
+    _force(sm)
+    sm.add_argument("--engagements", type=int, default=12, help="number of engagements (60 s apart)")
+    sm.add_argument("--step", type=float, default=0.1, help="communication step [s]")
+
+    bf = _command(sub, "build-fmu", _build_fmu, "build the clutch FMU from a table set (native C by default)",
+                  "Build CushionClutch.fmu with the table set in its resources: the native C FMU (FMI 2.0 "
+                  "or 3.0, Co-Simulation and Model Exchange, binaries for Linux, Windows and macOS) or the "
+                  "pythonfmu FMU. The output must be a new or existing file ending in .fmu, not a folder.",
+                  "cushion-clutch build-fmu --fmi-version 3 --out CushionClutch3.fmu")
+    add_build_arguments(bf)
+
+    ex = _command(sub, "export", _export, "write the tables for Simulink (.mat) and Modelica (CombiTable)",
+                  "Write cushion_spring_tables.mat (Simulink 2-D Lookup Table) and cushion_spring_tables.txt "
+                  "(Modelica CombiTable2Ds/1Ds, #1 format) with the cushion force, the kiss-point shift and "
+                  "the cover's clamp and bearing force maps.",
+                  "cushion-clutch export --tables lookup_tables/default --out out_tables")
+    ex.add_argument("--tables", default=DEFAULT_TABLES, help="table folder")
+    _out(ex, "output folder (default: out)", default="out")
+    _force(ex)
+
+    sw = _command(sub, "sweep", _sweep, "run the CalculiX temperature sweep and write lookup tables",
+                  "Solve the spring's paddle pair with CalculiX at every sweep temperature (one ccx job per "
+                  "core, cached per case) and write the table set F(u, theta), kiss-point shift, crest growth "
+                  "and metadata, with plots. Needs ccx on the PATH.",
+                  "cushion-clutch sweep --spring my_spring.toml --out lookup_tables/my_spring")
     sw.add_argument("--spring", default=DEFAULT_SPRING, help="spring parameter TOML")
-    sw.add_argument("--out", help="table folder (default ./lookup_tables/<spring name>)")
-    sw.add_argument("--force", action="store_true", help="allow overwriting a table set shipped with the package")
+    _out(sw, "table folder (default ./lookup_tables/<spring name>)")
+    _force(sw)
     sw.add_argument("--mesh-size", type=float, help="override mesh.element_size_m [m]")
-    sw.add_argument("--jobs", type=int, help="parallel ccx jobs (default: cores)")
+    _jobs(sw, "parallel ccx jobs (default: cores)")
     sw.add_argument("--scheduler", help="Dask scheduler address, e.g. tcp://host:8786")
     sw.add_argument("--cache", default=DEFAULT_CACHE, help="case cache folder")
-    sw.set_defaults(func=_sweep)
 
-    ca = sub.add_parser("calibrate", help="fit spring parameters to a measured load-deflection curve")
+    ck = _command(sub, "check-spring", _check, "validate a spring parameter TOML",
+                  "Load a spring TOML and name every bad key with its allowed range (exit 2), or say it is "
+                  "valid.", "cushion-clutch check-spring --spring my_spring.toml")
+    ck.add_argument("spring_file", nargs="?", metavar="SPRING", help="spring TOML (or --spring)")
+    ck.add_argument("--spring", help="spring TOML (default: the shipped default spring)")
+
+    ca = _command(sub, "calibrate", _calibrate, "fit spring parameters to a measured load-deflection curve",
+                  "Fit chosen spring keys to bench curves (cold, and hot for the thermal keys) by bounded "
+                  "least squares on FE runs; write the calibrated spring TOML with a report (.txt) and a "
+                  "plot (.png) beside it.",
+                  "cushion-clutch calibrate --measured bench.csv --fit wave_height_m,thickness_m "
+                  "--out calibrated.toml")
     ca.add_argument("--measured", required=True, action="append",
                     help="CSV u_m,force_N, u from the reference temperature's kiss point, as measured (noise "
                          "kept): FILE (reference temperature) or THETA_DEGC=FILE; repeat for hot curves, "
@@ -331,48 +512,22 @@ def build_parser() -> argparse.ArgumentParser:
     ca.add_argument("--spring", default=DEFAULT_SPRING, help="start parameter TOML")
     ca.add_argument("--fit", required=True, help="comma-separated keys, e.g. wave_height_m,thickness_m")
     ca.add_argument("--bounds", help="NAME=LOWER:UPPER,... (default: start value +-30 %%)")
-    ca.add_argument("--out", required=True, help="calibrated TOML (report .txt and .png beside it)")
+    _out(ca, "calibrated spring TOML to write (report .txt and .png beside it)", required=True)
     ca.add_argument("--name", help="name of the calibrated spring (default: <spring name>_calibrated)")
     ca.add_argument("--mesh-size", type=float, help="override mesh.element_size_m [m]")
-    ca.add_argument("--jobs", type=int, default=2, help="parallel ccx jobs")
+    _jobs(ca, "parallel ccx jobs (default 2)", default=2)
     ca.add_argument("--scheduler", help="Dask scheduler address, e.g. tcp://host:8786")
     ca.add_argument("--cache", default=DEFAULT_CACHE, help="case cache folder")
-    ca.set_defaults(func=_calibrate)
 
-    sm = sub.add_parser("simulate", help="repeated engagements through the FMU with fmpy, with plots")
-    sm.add_argument("--fmu", help="FMU to simulate (default: build one from --tables into --out)")
-    sm.add_argument("--tables", default=DEFAULT_TABLES, help="table folder")
-    add_backend(sm)
-    sm.add_argument("--out", default="out", help="output folder")
-    sm.add_argument("--force", action="store_true", help="allow writing into a shipped table set")
-    sm.add_argument("--engagements", type=int, default=12, help="number of engagements (60 s apart)")
-    sm.add_argument("--step", type=float, default=0.1, help="communication step [s]")
-    sm.set_defaults(func=_simulate)
-
-    la = sub.add_parser("launch", help="repeated launches with the five TCU variants (main job)")
-    la.add_argument("--scenario", default=DEFAULT_SCENARIO,
-                    help="scenario TOML, or a shipped one: default, creep, cooldown, fade, wear, tolerance")
-    la.add_argument("--fmu", help="clutch FMU (default: build one from --tables into --out)")
-    la.add_argument("--tables", default=DEFAULT_TABLES, help="table folder")
-    add_backend(la)
-    la.add_argument("--out", default="out", help="output folder")
-    la.add_argument("--force", action="store_true", help="allow writing into a shipped table set")
-    la.set_defaults(func=_launch)
-
-    ex = sub.add_parser("export", help="write the tables for Simulink (.mat) and Modelica (CombiTable)")
-    ex.add_argument("--tables", default=DEFAULT_TABLES, help="table folder")
-    ex.add_argument("--out", default="out", help="output folder")
-    ex.add_argument("--force", action="store_true", help="allow writing into a shipped table set")
-    ex.set_defaults(func=_export)
-
-    bf = sub.add_parser("build-fmu", help="build the clutch FMU from a table set (native C by default)")
-    add_build_arguments(bf)
-    bf.set_defaults(func=_build_fmu)
-
-    im = sub.add_parser("import-scan", help="fit a scanned paddle's mid-surface and write a spring TOML using it")
+    im = _command(sub, "import-scan", _import_scan,
+                  "fit a scanned paddle's mid-surface and write a spring TOML using it",
+                  "Read a scanned paddle (point cloud or triangulated surface) in disc coordinates, check "
+                  "units, frame and coverage, fit its mid-surface with a bicubic spline and write a spring "
+                  "TOML whose geometry.surface_file is that surface (the .npz and plots beside it).",
+                  "cushion-clutch import-scan paddle.csv --out scanned.toml")
     im.add_argument("scan", help="point cloud CSV (x,y,z header) or STL/PLY/OBJ surface")
     im.add_argument("--spring", default=DEFAULT_SPRING, help="base spring TOML (plan shape, rivet zone, material)")
-    im.add_argument("--out", required=True, help="spring TOML to write (the surface .npz and PNG go next to it)")
+    _out(im, "spring TOML to write (the surface .npz and PNGs go next to it)", required=True)
     im.add_argument("--unit", choices=("um", "mm", "cm", "in", "m"), default="mm",
                     help="length unit of the scan (default mm)")
     im.add_argument("--face", choices=("top", "bottom", "mid"), default="top",
@@ -380,9 +535,12 @@ def build_parser() -> argparse.ArgumentParser:
     im.add_argument("--datum", choices=("rigid", "offset"), default="rigid",
                     help="fit tilt and offset on the rivet zone (default) or the offset only")
     im.add_argument("--crop", action="store_true", help="drop points off the paddle sector instead of refusing")
-    im.set_defaults(func=_import_scan)
 
-    to = sub.add_parser("tolerance", help="tolerance study: sampled springs swept on Dask, P5/P50/P95 bands")
+    to = _command(sub, "tolerance", _tolerance, "tolerance study: sampled springs swept on Dask, P5/P50/P95 bands",
+                  "Draw springs from the [tolerances] of a spring TOML (Latin hypercube or Monte Carlo), sweep "
+                  "each on Dask (a LocalCluster, or --scheduler), write P5/P50/P95 bands of force, kiss-point "
+                  "shift and torque, and the P5 and P95 table sets.",
+                  "cushion-clutch tolerance --samples 16 --jobs 2 --out lookup_tables")
     to.add_argument("--spring", default=DEFAULT_SPRING, help="spring TOML with a [tolerances] table")
     to.add_argument("--samples", type=int, default=16, help="number of drawn springs (default 16)")
     to.add_argument("--method", choices=("lhs", "mc"), default="lhs", help="Latin hypercube or Monte Carlo")
@@ -391,19 +549,13 @@ def build_parser() -> argparse.ArgumentParser:
                     help="temperatures [degC] (default 20 195 300; must include the reference)")
     to.add_argument("--mesh-size", type=float, help="override mesh.element_size_m [m]")
     to.add_argument("--scheduler", help="Dask scheduler address, e.g. tcp://host:8786 (default: a LocalCluster)")
-    to.add_argument("--workers", type=int, help="LocalCluster worker processes, one thread each (default: cores)")
+    _jobs(to, "LocalCluster worker processes, one thread each (default: cores)", dest="workers")
     to.add_argument("--rank-by", choices=("torque", "force", "kiss"), default="torque",
                     help="figure that picks the P5/P95 samples (default: torque at the nominal half-engaged "
                          "bearing position, 20 degC)")
-    to.add_argument("--out", default="lookup_tables",
-                    help="folder for <name>_tolerance/ and the <name>_p05/, <name>_p95/ table sets "
-                         "(default ./lookup_tables)")
+    _out(to, "folder for <name>_tolerance/ and the <name>_p05/, <name>_p95/ table sets (default ./lookup_tables)",
+         default="lookup_tables")
     to.add_argument("--cache", default=DEFAULT_CACHE, help="case cache folder (shared with sweep)")
-    to.set_defaults(func=_tolerance)
-
-    ck = sub.add_parser("check-spring", help="validate a spring parameter TOML")
-    ck.add_argument("spring")
-    ck.set_defaults(func=_check)
     return parser
 
 

@@ -20,6 +20,9 @@ def test_check_spring_names_the_bad_key(tmp_path, capsys):
 @pytest.mark.fmu
 def test_simulate_and_export_write_their_files(tmp_path, capsys):
     assert main(["simulate", "--out", str(tmp_path), "--engagements", "2", "--step", "0.5"]) == 0
+    printed = capsys.readouterr().out
+    assert ".staging" not in printed and "missing input" not in printed       # issue 27
+    assert "the native FMU built from" in printed
     for name in ("CushionClutch.fmu", "engagements.csv", "engagements.png",
                  "torque_characteristic.png", "thermal_step_response.png"):
         assert (tmp_path / name).stat().st_size > 0

@@ -1,26 +1,61 @@
-"""The README's Python examples run as written (from an empty folder)."""
+"""The README's Python examples run as written (from a folder holding the FMU the README builds first), its
+figure is that example's output, and the default-table figures in the documentation are the committed CSVs'."""
+import os
 import re
+import shutil
 from pathlib import Path
 
 import pytest
 
-README = Path(__file__).resolve().parents[1] / "README.md"
-BLOCKS = re.findall(r"```python\n(.*?)```", README.read_text(encoding="utf-8"), flags=re.S)
+ROOT = Path(__file__).resolve().parents[1]
+README = ROOT / "README.md"
+BLOCKS = re.findall(r"^```python\n(.*?)^```", README.read_text(encoding="utf-8"), flags=re.S | re.M)
+FE_PAGE = ROOT / "docs" / "explanation" / "fe_model.md"
+#: the quick start's figure, committed; CUSHION_UPDATE_FIGURES=1 replaces it with the example's new output
+FIGURE = ROOT / "docs" / "images" / "quickstart_torque.png"
 
 
 def test_readme_has_python_examples():
     assert BLOCKS
 
 
+def test_readme_fits_a_screenful_or_so():
+    assert len(README.read_text(encoding="utf-8").splitlines()) <= 250
+
+
+def test_readme_keeps_the_two_commands_and_ci_runs_the_same_tests():
+    text = README.read_text(encoding="utf-8")
+    assert "bash .ci/install && cushion-clutch launch --out out" in text
+    assert "bash .ci/install && python3 -m pytest -q" in text
+    assert "bash .ci/install && python3 -m pytest -q" in (ROOT / ".ci" / "run").read_text()
+    assert "sphinx-build -W --keep-going -b html docs docs/_build/html" in text
+
+
+@pytest.mark.fmu
 @pytest.mark.parametrize("code", BLOCKS, ids=[f"block{i}" for i in range(len(BLOCKS))])
 def test_readme_python_block_runs(code, tmp_path, monkeypatch):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from cushion_clutch.data import DEFAULT_TABLES
+    from cushion_clutch.fmu.build import build_fmu
+
+    if "CushionClutch.fmu" in code:                          # what `cushion-clutch build-fmu` wrote before
+        build_fmu(DEFAULT_TABLES, tmp_path / "CushionClutch.fmu")
     monkeypatch.chdir(tmp_path)
     exec(compile(code, str(README), "exec"), {"__name__": "readme_example"})
+    plt.close("all")
+    png = tmp_path / FIGURE.name
+    if png.exists():
+        assert png.stat().st_size > 10_000 and FIGURE.exists()
+        if os.environ.get("CUSHION_UPDATE_FIGURES") == "1":
+            shutil.copy(png, FIGURE)
 
 
-def _readme_table(header_start: str) -> list[list[str]]:
-    """Rows (cells as text) of the README's markdown table whose header starts with ``header_start``."""
-    lines = README.read_text(encoding="utf-8").splitlines()
+def _page_table(path: Path, header_start: str) -> list[list[str]]:
+    """Rows (cells as text) of the Markdown table in ``path`` whose header starts with ``header_start``."""
+    lines = path.read_text(encoding="utf-8").splitlines()
     i = next(k for k, line in enumerate(lines) if line.startswith(header_start))
     rows = []
     for line in lines[i + 2:]:
@@ -31,8 +66,9 @@ def _readme_table(header_start: str) -> list[list[str]]:
 
 
 def test_committed_table_figures_are_the_readme_s():
-    """README "Results" table: delta_kiss, crest growth, full force, k20/k50/k90 and k90/k20 per temperature,
-    recomputed from the committed CSVs of lookup_tables/default (each at the README's rounding)."""
+    """The committed default tables' figures (docs/explanation/fe_model.md, once the README's): delta_kiss,
+    crest growth, full force, k20/k50/k90 and k90/k20 per temperature, recomputed from the CSVs of
+    lookup_tables/default (each at the page's rounding)."""
     import numpy as np
 
     from cushion_clutch.data import DEFAULT_TABLES
@@ -40,7 +76,7 @@ def test_committed_table_figures_are_the_readme_s():
 
     t = read_tables(DEFAULT_TABLES)
     crest = dict(np.loadtxt(DEFAULT_TABLES / "crest_growth.csv", delimiter=",", skiprows=1))
-    rows = _readme_table("| θ [°C] | δ_kiss [mm]")
+    rows = _page_table(FE_PAGE, "| θ [°C] | δ_kiss [mm]")
     assert [float(r[0]) for r in rows] == list(t.theta_degC)
     for r, theta, u, f, d in zip(rows, t.theta_degC, t.u_m, t.force_N, t.delta_kiss_m):
         assert float(r[1]) == pytest.approx(d * 1e3, abs=0.5e-4), r

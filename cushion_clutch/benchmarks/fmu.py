@@ -111,15 +111,31 @@ def time_builds(tmp: Path, cold: bool) -> None:
                     os.environ["ZIG_GLOBAL_CACHE_DIR"] = env_before
 
 
+#: the results page's intro
+PAGE_INTRO = ("Cost of one FMU step (set inputs, doStep, get outputs; 1 ms communication step) for the native and "
+              "the pythonfmu FMU, through fmpy and in our C host (`fmu_src/hosts/fmi2_host.c`), the Python model "
+              "alone, and the time to build the native FMU for every platform. Per-step times on a shared, loaded "
+              "machine are noisy: compare figures from one run.")
+
+
 def main(argv=None) -> None:
     from cushion_clutch.fmu.build import build_fmu
     from cushion_clutch.data import DEFAULT_TABLES
     from cushion_clutch.model import ClutchParameters, load_table, outputs, thermal_step
 
+    from .page import results_page
+
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--steps", type=int, default=200_000)
     ap.add_argument("--cold", action="store_true", help="also time builds from an empty zig cache (minutes)")
+    ap.add_argument("--markdown", action="store_true", help="with --out: the results page")
+    ap.add_argument("--out", type=Path, help="write the results page (e.g. docs/results/benchmarks.md)")
     args = ap.parse_args(argv)
+    with results_page(args.out, "Benchmarks: the FMU", "cushion_clutch.benchmarks.fmu", argv, PAGE_INTRO):
+        _run(args, build_fmu, DEFAULT_TABLES, ClutchParameters, load_table, outputs, thermal_step)
+
+
+def _run(args, build_fmu, DEFAULT_TABLES, ClutchParameters, load_table, outputs, thermal_step) -> None:
     n = args.steps
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)

@@ -12,6 +12,7 @@ Part 2 (``--sensitivity``) prints delta_kiss(195 degC) with kappa
 of the default, at the mesh of ``--sens-model``.
 
     python -m cushion_clutch.benchmarks.sweep --models 0.5e-3:S4 1e-3:S4 --temps 20 --sensitivity
+    python -m cushion_clutch.benchmarks.sweep --markdown --out docs/results/fe_cost.md   # the results page
 """
 from __future__ import annotations
 
@@ -57,8 +58,19 @@ def _sweep(params, cache, jobs):
     return read_tables(out / "t"), outcomes, wall
 
 
+#: the results page's intro
+PAGE_INTRO = ("The FE cost of the sweep with several models (element size, type, increments) on the default "
+              "spring, and each one's largest force difference to the first (the reference) over the whole curve "
+              "from the kiss point to full compression, in % of the reference's full-compression force, and "
+              "pointwise (in % of the local force, above 10 % of the full force). Calibration and tolerance "
+              "studies multiply FE cases, so the committed model is the cheapest one within 1 % of the finest. "
+              "Wall times depend on the machine and its load.")
+
+
 def main(argv=None) -> None:
     from cushion_clutch.fe.params import load_params
+
+    from .page import results_page
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--models", nargs="*", default=["0.5e-3:S4", "1e-3:S4", "2e-3:S8R", "2e-3:S4"],
@@ -69,32 +81,46 @@ def main(argv=None) -> None:
                     help="case cache (default: a temporary one, so every case is solved)")
     ap.add_argument("--sensitivity", action="store_true", help="kappa and tab stiffness +-50 %%")
     ap.add_argument("--sens-model", default="2e-3:S4")
+    ap.add_argument("--markdown", action="store_true", help="also give the models as a Markdown table")
+    ap.add_argument("--out", type=Path, help="write the results page (e.g. docs/results/fe_cost.md)")
     args = ap.parse_args(argv)
     base = load_params()
     if args.temps:
         base = base.replace(sweep={"temperatures_degC": tuple(float(t) for t in args.temps.split(","))})
     cache = args.cache or Path(tempfile.mkdtemp(prefix="bench_cache_"))
-    tables = {}
-    for text in args.models:
-        size, kind, inc = _model(text)
-        p = base.replace(mesh={"element_size_m": size, "element_type": kind},
-                         solver={"compression_increments": inc or base.solver.compression_increments})
-        t, outcomes, wall = _sweep(p, cache, args.jobs)
-        tables[text] = t
-        o = next(iter(outcomes.values()))
-        cpu = sum(v.stats.wall_time_s for v in outcomes.values())
-        prog = t.metadata["progressivity"]
-        k = prog[f"{t.theta_degC[0]:g}"]["k90_over_k20"]
-        print(f"{size * 1e3:4.2f} mm {kind:4s} {p.solver.compression_increments:3d} inc: {o.n_elements:5d} elements, {len(outcomes)} temperatures, "
-              f"sweep wall {wall:7.1f} s (sum of ccx case times {cpu:7.1f} s), "
-              f"F_full({t.theta_degC[0]:g} C) = {t.force_N[0][-1]:.0f} N, k90/k20 = {k:.2f}", flush=True)
-    ref = args.models[0]
-    for text in args.models[1:]:
-        full, point = compare(tables[text], tables[ref])
-        print(f"{text} vs {ref}: largest force difference {full:.2%} of the full force, "
-              f"{point:.2%} pointwise above 10 % of it")
-    if args.sensitivity:
-        sensitivity(base, _model(args.sens_model), cache, args.jobs)
+    tables, rows = {}, {}
+    with results_page(args.out, "FE cost", "cushion_clutch.benchmarks.sweep", argv, PAGE_INTRO) as page:
+        for text in args.models:
+            size, kind, inc = _model(text)
+            p = base.replace(mesh={"element_size_m": size, "element_type": kind},
+                             solver={"compression_increments": inc or base.solver.compression_increments})
+            t, outcomes, wall = _sweep(p, cache, args.jobs)
+            tables[text] = t
+            o = next(iter(outcomes.values()))
+            cpu = sum(v.stats.wall_time_s for v in outcomes.values())
+            prog = t.metadata["progressivity"]
+            k = prog[f"{t.theta_degC[0]:g}"]["k90_over_k20"]
+            rows[text] = [f"{size * 1e3:g} mm {kind}, {p.solver.compression_increments} increments",
+                          str(o.n_elements), str(len(outcomes)), f"{wall:.1f}", f"{cpu:.1f}",
+                          f"{t.force_N[0][-1]:.0f}", f"{k:.2f}"]
+            print(f"{size * 1e3:4.2f} mm {kind:4s} {p.solver.compression_increments:3d} inc: {o.n_elements:5d} elements, {len(outcomes)} temperatures, "
+                  f"sweep wall {wall:7.1f} s (sum of ccx case times {cpu:7.1f} s), "
+                  f"F_full({t.theta_degC[0]:g} C) = {t.force_N[0][-1]:.0f} N, k90/k20 = {k:.2f}", flush=True)
+        ref = args.models[0]
+        rows[ref] += ["reference", "reference"]
+        for text in args.models[1:]:
+            full, point = compare(tables[text], tables[ref])
+            rows[text] += [f"{full:.2%}", f"{point:.2%}"]
+            print(f"{text} vs {ref}: largest force difference {full:.2%} of the full force, "
+                  f"{point:.2%} pointwise above 10 % of it")
+        if args.markdown or args.out:
+            theta = tables[ref].theta_degC[0]
+            page.markdown("| model | elements | temperatures | sweep wall [s] | sum of ccx case times [s] | "
+                          f"F full at {theta:g} °C [N] | k90/k20 | difference to {ref} | pointwise |\n"
+                          "|---|---|---|---|---|---|---|---|---|\n" +
+                          "\n".join("| " + " | ".join(r) + " |" for r in rows.values()))
+        if args.sensitivity:
+            sensitivity(base, _model(args.sens_model), cache, args.jobs)
 
 
 def sensitivity(base, model, cache, jobs) -> None:

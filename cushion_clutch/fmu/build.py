@@ -5,10 +5,11 @@
 """
 from __future__ import annotations
 
+import argparse
 import logging
 from pathlib import Path
 
-from ..errors import ParameterError, TableError
+from ..errors import FmuError, ParameterError, TableError
 from ..fe.tables import read_tables
 from ..model.table_format import REQUIRED_FILES
 
@@ -29,6 +30,7 @@ def build_fmu(tables: Path, output: Path, backend: str = "native", fmi_version: 
         If the table set is missing or malformed (checked before building).
     """
     tables, output = Path(tables), Path(output)
+    check_output(output)
     read_tables(tables)                                 # fail early, with the file's name
     for name in REQUIRED_FILES:
         if not (tables / name).exists():
@@ -49,6 +51,22 @@ def build_fmu(tables: Path, output: Path, backend: str = "native", fmi_version: 
     return output
 
 
+def check_output(output: Path) -> None:
+    """Refuse an FMU path that is a folder or does not end in ``.fmu`` (before anything is built).
+
+    Raises
+    ------
+    FmuError
+        Naming the path and what to give instead.
+    """
+    output = Path(output)
+    if output.is_dir():
+        raise FmuError(f"{output} is a folder; give the FMU's file name, e.g. {output / 'CushionClutch.fmu'}")
+    if output.suffix.lower() != ".fmu":
+        raise FmuError(f"{output}: an FMU's file name must end in .fmu (FMI hosts look for it); "
+                       f"give {output.name}.fmu")
+
+
 def add_backend(parser) -> None:
     """The ``--backend`` option shared by every command that builds an FMU."""
     parser.add_argument("--backend", choices=("native", "python"), default="native",
@@ -61,7 +79,9 @@ def add_build_arguments(parser) -> None:
     from ..data import DEFAULT_TABLES
     parser.add_argument("--tables", type=Path, default=DEFAULT_TABLES,
                         help="table folder (force_deflection.csv, kiss_point.csv, metadata.json)")
-    parser.add_argument("-o", "--output", type=Path, default=Path("CushionClutch.fmu"), help="FMU file")
+    parser.add_argument("-o", "--out", dest="output", type=Path, default=Path("CushionClutch.fmu"),
+                        help="FMU file to write, ending in .fmu (default CushionClutch.fmu)")
+    parser.add_argument("--output", dest="output", type=Path, help=argparse.SUPPRESS)   # the old name
     add_backend(parser)
     parser.add_argument("--fmi-version", type=int, choices=(2, 3), default=2,
                         help="FMI 2.0 (default) or 3.0 (native backend only); both carry Co-Simulation "

@@ -75,19 +75,23 @@ def build_native_fmu(tables: Path, output: Path, fmi_version: int = 2,
         staged = stage_sources(src, guid, fmi_version, x_kiss_ref)
         libs = build_binaries(src, sources(fmi_version), fmi_version, Path(tmp) / "binaries", platforms)
         tmp_out = output.with_suffix(".fmu.tmp")
-        with zipfile.ZipFile(tmp_out, "w", zipfile.ZIP_DEFLATED) as z:
-            z.writestr("modelDescription.xml", fmi2_description(guid, has_friction, x_kiss_ref)
-                       if fmi_version == 2 else fmi3_description(guid, has_friction, x_kiss_ref))
-            for platform, lib in sorted(libs.items()):
-                z.write(lib, f"binaries/{platform}/{lib.name}")
-            for name in staged:
-                z.write(src / name, f"sources/{name}")
-            if fmi_version == 3:
-                z.writestr("sources/buildDescription.xml", fmi3_build_description())
-            for name in FMU_FILES:
-                if (tables / name).exists():
-                    z.write(tables / name, f"resources/tables/{name}")
-        tmp_out.replace(output)
+        try:                                            # no half-written .fmu.tmp left behind
+            with zipfile.ZipFile(tmp_out, "w", zipfile.ZIP_DEFLATED) as z:
+                z.writestr("modelDescription.xml", fmi2_description(guid, has_friction, x_kiss_ref)
+                           if fmi_version == 2 else fmi3_description(guid, has_friction, x_kiss_ref))
+                for platform, lib in sorted(libs.items()):
+                    z.write(lib, f"binaries/{platform}/{lib.name}")
+                for name in staged:
+                    z.write(src / name, f"sources/{name}")
+                if fmi_version == 3:
+                    z.writestr("sources/buildDescription.xml", fmi3_build_description())
+                for name in FMU_FILES:
+                    if (tables / name).exists():
+                        z.write(tables / name, f"resources/tables/{name}")
+            tmp_out.replace(output)
+        except BaseException:
+            tmp_out.unlink(missing_ok=True)
+            raise
     log.info("built native FMI %d.0 %s (%s) from tables %s", fmi_version, output, ", ".join(sorted(libs)), tables)
     return output
 

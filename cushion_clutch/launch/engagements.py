@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from ..model import KELVIN, ClutchParameters, SpringTable, outputs
+from ..model.clutch_model import OMEGA_SLIP_START
 
 
 @dataclass(frozen=True)
@@ -97,8 +98,10 @@ def simulate(fmu: Path, cycle: EngagementCycle = EngagementCycle(), n_engagement
 
     stop = n_engagements * cycle.period_s
     t = np.arange(0.0, stop + step_s / 2, step_s)
-    inputs = np.zeros(len(t), dtype=[("time", float), ("x_to", float), ("theta_cm", float)])
+    # every input given (omega_slip at its start value), so fmpy does not warn about a missing one
+    inputs = np.zeros(len(t), dtype=[("time", float), ("x_to", float), ("theta_cm", float), ("omega_slip", float)])
     inputs["time"], inputs["x_to"], inputs["theta_cm"] = t, cycle.bearing_position(t), cycle.facing_temperature(t)
+    inputs["omega_slip"] = OMEGA_SLIP_START
     res = simulate_fmu(str(fmu), start_time=0.0, stop_time=stop, output_interval=step_s,
                        input=inputs, start_values=start_values or {},
                        output=["x_to", "theta_cm", "torque", "force", "theta_cs", "u_f", "x_kiss"])

@@ -48,7 +48,7 @@ VARIABLES = (
     ("x_to", "input", "m", "throwout-bearing position, 0 = open"),
     ("theta_cm", "input", "K", "clutch facing temperature"),
     ("torque", "output", "N.m", "transmissible clutch torque n*mu*R_eq*F"),
-    ("force", "output", "N", "cushion-spring clamp force F(u, theta_cs)"),
+    ("force", "output", "N", "cushion-spring force F(u, theta_cs); the clamp force is clamp_force"),
     ("theta_cs", "output", "K", "cushion-spring temperature"),
     ("u_f", "output", "m", "cushion compression from the kiss point, clipped at 0"),
     ("x_kiss", "output", "m", "kiss point at the bearing at theta_cs"),

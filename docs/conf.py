@@ -1,0 +1,45 @@
+"""Sphinx configuration of the cushion-clutch documentation.
+
+Build: ``sphinx-build -W --keep-going -b html docs docs/_build/html`` (warnings are errors; MyST reports
+broken internal links as warnings). Sphinx because the command-line reference is generated from the
+argparse parser itself (sphinx-argparse), the Python reference from the numpydoc docstrings (autodoc +
+napoleon), and the pages stay Markdown (MyST), like the README.
+"""
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))                 # the checkout's package, also without pip install -e
+sys.path.insert(0, str(Path(__file__).parent / "_ext"))
+
+from cushion_clutch import __version__  # noqa: E402
+
+project = "cushion-clutch"
+author = "cushion-clutch contributors"
+copyright = "cushion-clutch contributors, MIT licence"
+release = version = __version__
+
+extensions = [
+    "myst_parser",
+    "sphinx.ext.autodoc",
+    "sphinx.ext.napoleon",
+    "sphinxarg.ext",
+    "fmu_variables",
+]
+source_suffix = {".md": "markdown", ".rst": "restructuredtext"}
+exclude_patterns = ["_build", "Thumbs.db", ".DS_Store"]
+myst_enable_extensions = ["colon_fence", "dollarmath", "deflist"]
+myst_heading_anchors = 3
+suppress_warnings = ["myst.header"]           # results pages start at ### (they are generated tables)
+
+napoleon_numpy_docstring = True
+napoleon_google_docstring = False
+autodoc_member_order = "bysource"
+autodoc_typehints = "description"
+
+html_theme = "furo"
+html_title = f"cushion-clutch {__version__}"
+html_static_path = []
+smartquotes = False                          # keep -- in option names as typed

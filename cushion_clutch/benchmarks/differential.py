@@ -362,7 +362,8 @@ def compare(reference: Fmi2CS, other: Fmi2CS, seed: int, calls: int) -> Outcome:
             if op[0] == "restore" and saved_clock is None:
                 continue
             t = clock[0]
-            reference.log.worst = other.log.worst = 0
+            for log in (reference.log, other.log):            # the messages of this call only
+                log.worst, log.lines = 0, []
             s_ref, v_ref = _drive(reference, op, clock)
             clock[0] = t
             s_oth, v_oth = _drive(other, op, clock)
@@ -421,13 +422,20 @@ def main(argv=None) -> int:
     ap.add_argument("--first-seed", type=int, default=0)
     ap.add_argument("--fmi3", action="store_true", help="also compare the native FMI 3.0 CS FMU")
     ap.add_argument("--show", type=int, default=3, help="differences printed in full")
+    ap.add_argument("--raw-status", action="store_true",
+                    help="compare pythonfmu's returned statuses as they are (a refusal is fmi2OK + an error message)")
+    ap.add_argument("--fmus", type=Path, help="use native2.fmu, python2.fmu (and native3.fmu) from this folder "
+                                              "instead of building them (e.g. FMUs of an older commit)")
     args = ap.parse_args(argv)
     with tempfile.TemporaryDirectory(prefix="cushion_differential_") as tmp:
         t0 = time.perf_counter()
-        fmus = build_fmus(Path(tmp), args.fmi3)
-        print(f"built {', '.join(fmus)} in {time.perf_counter() - t0:.1f} s")
+        if args.fmus:
+            fmus = {k: args.fmus / f"{k}.fmu" for k in ("native2", "python2", "native3")}
+        else:
+            fmus = build_fmus(Path(tmp), args.fmi3)
+            print(f"built {', '.join(fmus)} in {time.perf_counter() - t0:.1f} s")
         reference = Fmi2CS(fmus["native2"], "native2")
-        others = [Fmi2CS(fmus["python2"], "python2", refusal_is_error=True)] + ([Fmi3CS(fmus["native3"], "native3")] if args.fmi3 else [])
+        others = [Fmi2CS(fmus["python2"], "python2", refusal_is_error=not args.raw_status)] + ([Fmi3CS(fmus["native3"], "native3")] if args.fmi3 else [])
         seeds = range(args.first_seed, args.first_seed + args.sequences)
         failed = 0
         for other in others:

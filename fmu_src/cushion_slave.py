@@ -7,17 +7,22 @@ as the wrapper allows:
 
 - Any Python exception in a slave hook becomes fmi2Fatal *and* leaves the
   wrapper holding freed objects (the next call crashes the host). So no hook
-  ever raises. A call that FMI 2.0 answers with fmi2Error (wrong state,
-  unknown value reference, write to an output or to a fixed parameter after
-  initialisation, a bad state) is refused: nothing changes, an error is
-  logged, and the wrapper returns fmi2OK, the only other status it has.
-  The instance is then *faulty*: every later ``fmi2DoStep`` returns
-  fmi2Discard with the reasons logged again, so the host learns about it at
-  the next step at the latest. ``fmi2Reset`` clears it.
+  ever raises.
+- The wrapper returns only fmi2OK (or fmi2Discard from a doStep that returns
+  False). A call that the native FMU answers with fmi2Warning or fmi2Error
+  (wrong state, unknown value reference, write to an output or to a fixed
+  parameter after initialisation, bad parameters at
+  fmi2ExitInitializationMode, a bad state, a step that does not start where
+  the last one ended) sends that status as a message of category
+  ``STATUS_CATEGORY``; the guard library in front of the wrapper
+  (``pythonfmu_guard.c``) keeps it from the host and returns it. A refused
+  call changes nothing and is logged, as in the native FMU. Without the guard
+  (a platform it was not built for) the host sees fmi2OK and that message.
 - The wrapper passes log messages to the host logger as printf format
   strings, so every ``%`` is doubled here.
-- The wrapper drops every message when ``loggingOn`` is false; errors are
-  therefore also written to the process's standard error.
+- The wrapper drops every message when ``loggingOn`` is false (the guard runs
+  it with true and filters as the native FMU does); errors are also written to
+  the process's standard error, for hosts without the guard.
 - Serialized states carry a format tag and a CRC-32 checksum; a state is
   checked (tag, checksum, every variable finite, phase, parameter ranges)
   before it is applied, and never raises.
@@ -60,8 +65,10 @@ PARAMETERS = [name for name, causality, _, _ in VARIABLES if causality == "param
 #: the outputs that clutch_model.outputs() returns (fields of Outputs): every output but the state theta_cs
 OUTPUTS = [name for name, causality, _, _ in VARIABLES if causality == "output" and name != "theta_cs"]
 #: tag of a serialized state; bump when the state's content changes
-STATE_FORMAT = "cushion_clutch.pythonfmu.state/3"
+STATE_FORMAT = "cushion_clutch.pythonfmu.state/4"
 #: "error": fmi2ExitInitializationMode refused the parameters or tables (the native FMU's Error state)
+#: log category of the status message the guard library returns as the call's status (pythonfmu_guard.c)
+STATUS_CATEGORY = "cushionReturnStatus"
 PHASES = ("instantiated", "initialization", "stepping", "terminated", "error")
 #: the phases in which outputs are computed from the state (in Initialization Mode from theta_cs_start)
 COMPUTED_PHASES = ("initialization", "stepping", "terminated")
@@ -112,9 +119,8 @@ class CushionClutch(Fmi2Slave):
         self._range_warned = False
         self._params = defaults
         self._dirty = True                  # outputs are stale: recomputed at the next get
-        self._faults: list[str] = []
         self._phase = "instantiated"
-        self._time: float | None = None
+        self._time = 0.0                  # as the native FMU: 0 until fmi2SetupExperiment
         self._table = None
         self._table_error = table_error
         for name, causality, unit, desc in VARIABLES:
@@ -141,19 +147,23 @@ class CushionClutch(Fmi2Slave):
                 pass
         super().log(_escape(msg), status, category)
 
+    def _answer(self, status: Fmi2Status) -> None:
+        """Make the current call return ``status`` (through the guard library; the wrapper cannot)."""
+        Fmi2Slave.log(self, f"the call returns fmi2{status.name.capitalize()}", status, STATUS_CATEGORY)
+
     def _refuse(self, call: str, problems: list[str]) -> None:
-        """Refuse a call the wrapper can only answer with OK: log, and mark the instance faulty."""
+        """Refuse a call with fmi2Error: nothing changes, every problem is logged."""
         for p in problems:
-            text = f"{call} refused: {p}"
-            self.log(text, Fmi2Status.error)
-            self._faults.append(text)
+            self.log(f"{call} refused: {p}", Fmi2Status.error)
+        self._answer(Fmi2Status.error)
 
     # -- life cycle ---------------------------------------------------------
     def setup_experiment(self, start_time, stop_time=None, tolerance=None):
         if self._phase != "instantiated":
             return self._refuse("fmi2SetupExperiment", [f"not allowed in phase {self._phase}"])
-        if isinstance(start_time, float) and math.isfinite(start_time):
-            self._time = start_time
+        if not (isinstance(start_time, float) and math.isfinite(start_time)):
+            return self._refuse("fmi2SetupExperiment", [f"startTime = {start_time!r} is not finite"])
+        self._time = start_time
 
     def enter_initialization_mode(self):
         if self._phase != "instantiated":
@@ -166,8 +176,7 @@ class CushionClutch(Fmi2Slave):
             return self._refuse("fmi2ExitInitializationMode", [f"not allowed in phase {self._phase} "
                                                                 "(only after fmi2EnterInitializationMode)"])
         self._phase = "stepping"
-        # bad parameters or tables (fmi2Error in the native FMU) are refused: the instance is faulty,
-        # every doStep is refused with fmi2Discard (and the message again) until the instance is reset.
+        # bad parameters or tables: fmi2Error, and the instance is in the error phase until fmi2Reset
         problems = []
         if self._table is None:
             problems.append(self._table_error or "tables missing")
@@ -190,12 +199,9 @@ class CushionClutch(Fmi2Slave):
         self._phase = "terminated"
 
     def do_step(self, current_time: float, step_size: float) -> bool:
-        if self._phase != "stepping" or self._faults:
-            if self._phase != "stepping":
-                self.log(f"fmi2DoStep refused: not allowed in phase {self._phase} (only between "
-                         "fmi2ExitInitializationMode and fmi2Terminate)", Fmi2Status.error)
-            for p in self._faults:         # a refused call (fmi2Error in the native FMU) is reported again
-                self.log(f"t = {current_time:g} s: {p}; step refused", Fmi2Status.error)
+        if self._phase != "stepping":
+            self._refuse("fmi2DoStep", [f"not allowed in phase {self._phase} (only between "
+                                        "fmi2ExitInitializationMode and fmi2Terminate)"])
             return False
         problems = self._input_problems()
         if not (math.isfinite(step_size) and step_size >= 0.0 and math.isfinite(current_time)):
@@ -207,6 +213,7 @@ class CushionClutch(Fmi2Slave):
         if self._time is not None and abs(current_time - self._time) > 1e-9 * (1.0 + abs(current_time)):
             self.log(f"currentCommunicationPoint {current_time:.17g} s does not follow the previous "
                      f"step's end {self._time:.17g} s; accepted (the master decides)", Fmi2Status.warning)
+            self._answer(Fmi2Status.warning)
         try:
             theta_cs = thermal_step(self.theta_cs, self.theta_cm, step_size, self._params)
         except ValueError as exc:           # dt > 1e9 s: the model's own limit
@@ -259,6 +266,8 @@ class CushionClutch(Fmi2Slave):
         return [float(getattr(self, self._names[vr])) for vr in vrs]
 
     def _no_such_type(self, call: str, vrs) -> None:
+        if len(vrs) == 0:
+            return
         self._refuse(call, [f"value reference {vr}: this FMU has Real variables only" for vr in vrs]
                      or ["this FMU has Real variables only"])
 
@@ -339,8 +348,7 @@ class CushionClutch(Fmi2Slave):
     # -- state -------------------------------------------------------------------
     def _get_fmu_state(self):
         state = {name: float(getattr(self, name)) for name, _, _, _ in VARIABLES}
-        state.update(_phase=self._phase, _time=self._time, _range_warned=self._range_warned,
-                     _faults=list(self._faults))
+        state.update(_phase=self._phase, _time=self._time, _range_warned=self._range_warned)
         return state
 
     def _state_problems(self, state) -> list[str]:
@@ -363,8 +371,6 @@ class CushionClutch(Fmi2Slave):
             out += [f"parameter {p}" for p in params.problems()]
             if not 0.0 < state["theta_cs"] < THETA_CM_LIMIT:
                 out.append(f"theta_cs = {state['theta_cs']!r} K is outside (0, {THETA_CM_LIMIT:g}) K")
-        if not (isinstance(state.get("_faults"), list) and all(isinstance(s, str) for s in state["_faults"])):
-            out.append("_faults is not a list of messages")
         return out
 
     def _set_fmu_state(self, state):
@@ -375,7 +381,6 @@ class CushionClutch(Fmi2Slave):
             setattr(self, name, float(state[name]))
         self._phase, self._time = state["_phase"], state["_time"]
         self._range_warned = bool(state.get("_range_warned"))
-        self._faults = list(state["_faults"])
         self._dirty = True                 # outputs of the restored inputs and state, at the next get
         if self._phase in ("stepping", "terminated"):
             self._params = ClutchParameters.from_flat({p: float(state[p]) for p in PARAMETERS})

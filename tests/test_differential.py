@@ -52,6 +52,7 @@ def test_pythonfmu_fmu_answers_every_call_as_the_native_one(fmus):
     assert sum(o.calls for o in outcomes) == sum(len(D.sequence(s, 60, ["x"])) for s in range(SEQUENCES))
     assert sum(o.discards for o in outcomes) >= 40                   # refused steps and reads were compared
     assert sum(o.errors for o in outcomes) >= 3                      # e.g. a saved state with x_to = NaN
+    assert sum(o.warnings for o in outcomes) >= 3                    # a step not where the last one ended
     assert sum(o.gets_after_set for o in outcomes) >= 100
 
 

@@ -311,7 +311,7 @@ int cc_exit_init(CcModel *m, const char *fn) {
 }
 
 int cc_do_step(CcModel *m, double t, double h, const char *fn) {
-    double g, theta_inf, *r = m->r;
+    double g, theta_inf, theta_old, *r = m->r;
     int status = CC_OK;
     if (!cc_allowed(m, PH_STEP, fn)) return CC_ERROR;
     if (!(isfinite(h) && h >= 0.0 && isfinite(t))) {
@@ -331,12 +331,15 @@ int cc_do_step(CcModel *m, double t, double h, const char *fn) {
     }
     g = r[VR_U] + r[VR_H];
     theta_inf = (r[VR_U] * r[VR_THETA_CM] + r[VR_H] * r[VR_THETA_A]) / g;
+    theta_old = r[VR_THETA_CS];
     r[VR_THETA_CS] = theta_inf + (r[VR_THETA_CS] - theta_inf) * exp(-h * g / r[VR_C]);
-    m->time = t + h;
-    if (update_outputs(m) != CC_OK) {
+    if (update_outputs(m) != CC_OK) { /* a discarded step leaves state and time where they were */
+        r[VR_THETA_CS] = theta_old;
+        r[CC_VR_DER_THETA_CS] = (r[VR_U] * r[VR_THETA_CM] + r[VR_H] * r[VR_THETA_A] - g * theta_old) / r[VR_C];
         m->terminated = 1;
         return CC_DISCARD;
     }
+    m->time = t + h;
     m->terminated = 0;
     return status;
 }

@@ -7,20 +7,41 @@ as the wrapper allows:
 
 - Any Python exception in a slave hook becomes fmi2Fatal *and* leaves the
   wrapper holding freed objects (the next call crashes the host). So no hook
-  ever raises. A call that FMI 2.0 answers with fmi2Error (wrong state,
-  unknown value reference, write to an output or to a fixed parameter after
-  initialisation, a bad state) is refused: nothing changes, an error is
-  logged, and the wrapper returns fmi2OK, the only other status it has.
-  The instance is then *faulty*: every later ``fmi2DoStep`` returns
-  fmi2Discard with the reasons logged again, so the host learns about it at
-  the next step at the latest. ``fmi2Reset`` clears it.
+  ever raises.
+- The wrapper returns only fmi2OK (or fmi2Discard from a doStep that returns
+  False). A call that the native FMU answers with fmi2Warning or fmi2Error
+  (wrong state, unknown value reference, write to an output or to a fixed
+  parameter after initialisation, bad parameters at
+  fmi2ExitInitializationMode, a bad state, a step that does not start where
+  the last one ended) sends that status as a message of category
+  ``STATUS_CATEGORY``; the guard library in front of the wrapper
+  (``pythonfmu_guard.c``) keeps it from the host and returns it. A refused
+  call changes nothing and is logged, as in the native FMU. Without the guard
+  (a platform it was not built for) the host sees fmi2OK and that message.
 - The wrapper passes log messages to the host logger as printf format
   strings, so every ``%`` is doubled here.
-- The wrapper drops every message when ``loggingOn`` is false; errors are
-  therefore also written to the process's standard error.
+- The wrapper drops every message when ``loggingOn`` is false (the guard runs
+  it with true and filters as the native FMU does); errors are also written to
+  the process's standard error, for hosts without the guard.
 - Serialized states carry a format tag and a CRC-32 checksum; a state is
   checked (tag, checksum, every variable finite, phase, parameter ranges)
   before it is applied, and never raises.
+
+Everything else follows the native FMU's contract (``clutch_core.c``; tested call
+by call against it by ``tests/test_differential.py``):
+
+- Outputs are computed on read: ``fmi2SetReal`` marks them stale, and
+  ``fmi2GetReal`` recomputes them from the current inputs and state first
+  (in Initialization Mode with ``theta_cs = theta_cs_start``). Inputs that are
+  not finite or out of range, or a cover that cannot hold the cushion, leave
+  the outputs at their last values (a Discard message is logged; the get
+  itself is fmi2OK, as in the native CS FMU) and they stay stale, so the next
+  valid input recovers them.
+- ``fmi2DoStep`` refuses (fmi2Discard) bad step sizes, bad inputs and a step
+  after which the cover cannot hold the cushion, with the state, the time and
+  the outputs unchanged (as the native FMU; fmi2LastSuccessfulTime is the
+  step's start in both). A later step with valid inputs goes on: nothing of a
+  Discard is remembered.
 """
 from __future__ import annotations
 
@@ -44,8 +65,13 @@ PARAMETERS = [name for name, causality, _, _ in VARIABLES if causality == "param
 #: the outputs that clutch_model.outputs() returns (fields of Outputs): every output but the state theta_cs
 OUTPUTS = [name for name, causality, _, _ in VARIABLES if causality == "output" and name != "theta_cs"]
 #: tag of a serialized state; bump when the state's content changes
-STATE_FORMAT = "cushion_clutch.pythonfmu.state/2"
-PHASES = ("instantiated", "initialization", "stepping", "terminated")
+STATE_FORMAT = "cushion_clutch.pythonfmu.state/4"
+#: "error": fmi2ExitInitializationMode refused the parameters or tables (the native FMU's Error state)
+#: log category of the status message the guard library returns as the call's status (pythonfmu_guard.c)
+STATUS_CATEGORY = "cushionReturnStatus"
+PHASES = ("instantiated", "initialization", "stepping", "terminated", "error")
+#: the phases in which outputs are computed from the state (in Initialization Mode from theta_cs_start)
+COMPUTED_PHASES = ("initialization", "stepping", "terminated")
 
 
 def _escape(msg: str) -> str:
@@ -92,10 +118,9 @@ class CushionClutch(Fmi2Slave):
             setattr(self, name, value)
         self._range_warned = False
         self._params = defaults
-        self._problems: list[str] = []
-        self._faults: list[str] = []
+        self._dirty = True                  # outputs are stale: recomputed at the next get
         self._phase = "instantiated"
-        self._time: float | None = None
+        self._time = 0.0                  # as the native FMU: 0 until fmi2SetupExperiment
         self._table = None
         self._table_error = table_error
         for name, causality, unit, desc in VARIABLES:
@@ -122,19 +147,23 @@ class CushionClutch(Fmi2Slave):
                 pass
         super().log(_escape(msg), status, category)
 
+    def _answer(self, status: Fmi2Status) -> None:
+        """Make the current call return ``status`` (through the guard library; the wrapper cannot)."""
+        Fmi2Slave.log(self, f"the call returns fmi2{status.name.capitalize()}", status, STATUS_CATEGORY)
+
     def _refuse(self, call: str, problems: list[str]) -> None:
-        """Refuse a call the wrapper can only answer with OK: log, and mark the instance faulty."""
+        """Refuse a call with fmi2Error: nothing changes, every problem is logged."""
         for p in problems:
-            text = f"{call} refused: {p}"
-            self.log(text, Fmi2Status.error)
-            self._faults.append(text)
+            self.log(f"{call} refused: {p}", Fmi2Status.error)
+        self._answer(Fmi2Status.error)
 
     # -- life cycle ---------------------------------------------------------
     def setup_experiment(self, start_time, stop_time=None, tolerance=None):
         if self._phase != "instantiated":
             return self._refuse("fmi2SetupExperiment", [f"not allowed in phase {self._phase}"])
-        if isinstance(start_time, float) and math.isfinite(start_time):
-            self._time = start_time
+        if not (isinstance(start_time, float) and math.isfinite(start_time)):
+            return self._refuse("fmi2SetupExperiment", [f"startTime = {start_time!r} is not finite"])
+        self._time = start_time
 
     def enter_initialization_mode(self):
         if self._phase != "instantiated":
@@ -147,23 +176,22 @@ class CushionClutch(Fmi2Slave):
             return self._refuse("fmi2ExitInitializationMode", [f"not allowed in phase {self._phase} "
                                                                 "(only after fmi2EnterInitializationMode)"])
         self._phase = "stepping"
-        # bad parameters or tables are logged now and every doStep is refused with
-        # fmi2Discard (and the message again) until the instance is reset.
+        # bad parameters or tables: fmi2Error, and the instance is in the error phase until fmi2Reset
         problems = []
         if self._table is None:
             problems.append(self._table_error or "tables missing")
-        params = ClutchParameters.from_flat({name: getattr(self, name) for name in PARAMETERS})
+        params = self._current_parameters()
         problems += [f"parameter {p}" for p in params.problems()]
-        self._problems = problems
-        for p in problems:
-            self.log(p, Fmi2Status.error)
         self.theta_cs = params.theta_cs_start
+        self._dirty = True
         if problems:
+            self._refuse("fmi2ExitInitializationMode", problems)
             self.torque = self.force = self.u_f = self.clamp_force = self.bearing_force = 0.0
+            self._phase = "error"
             return
         self._params = params
         if not self._input_problems():
-            self._update_outputs()
+            self._update_outputs("fmi2ExitInitializationMode")
 
     def terminate(self):
         if self._phase != "stepping":
@@ -172,30 +200,30 @@ class CushionClutch(Fmi2Slave):
 
     def do_step(self, current_time: float, step_size: float) -> bool:
         if self._phase != "stepping":
-            msg = (f"fmi2DoStep refused: not allowed in phase {self._phase} (only between "
-                   "fmi2ExitInitializationMode and fmi2Terminate)")
-            self.log(msg, Fmi2Status.error)
+            self._refuse("fmi2DoStep", [f"not allowed in phase {self._phase} (only between "
+                                        "fmi2ExitInitializationMode and fmi2Terminate)"])
             return False
-        problems = self._faults + self._problems + self._input_problems()
-        if not (math.isfinite(step_size) and step_size >= 0.0):
-            problems.append(f"step size {step_size!r} must be finite and >= 0")
-        if not math.isfinite(current_time):
-            problems.append(f"currentCommunicationPoint {current_time!r} is not finite")
-        if problems:
+        problems = self._input_problems()
+        if not (math.isfinite(step_size) and step_size >= 0.0 and math.isfinite(current_time)):
+            problems = [f"step size {step_size!r} s must be finite and >= 0"]
+        if problems:                       # refused: nothing changes (fmi2Discard, as the native FMU)
             for p in problems:
-                self.log(f"t = {current_time:g} s: {p}; step refused", Fmi2Status.error)
+                self.log(f"t = {current_time:g} s: {p}; step refused", Fmi2Status.discard)
             return False
-        if self._time is not None and abs(current_time - self._time) > 1e-9 * max(1.0, abs(self._time)):
+        if self._time is not None and abs(current_time - self._time) > 1e-9 * (1.0 + abs(current_time)):
             self.log(f"currentCommunicationPoint {current_time:.17g} s does not follow the previous "
                      f"step's end {self._time:.17g} s; accepted (the master decides)", Fmi2Status.warning)
+            self._answer(Fmi2Status.warning)
         try:
             theta_cs = thermal_step(self.theta_cs, self.theta_cm, step_size, self._params)
-            out = outputs(self.x_to, theta_cs, self._table, self._params, self.theta_cm, self.omega_slip)
-        except Exception as exc:  # noqa: BLE001 - an exception here would be fmi2Fatal and crash the host
-            self.log(f"t = {current_time:g} s: {exc}; step refused", Fmi2Status.error)
+        except ValueError as exc:           # dt > 1e9 s: the model's own limit
+            self.log(f"t = {current_time:g} s: {exc}; step refused", Fmi2Status.discard)
             return False
-        self.theta_cs = theta_cs
-        self._set_outputs(out)
+        # a step the cover cannot take (fmi2Discard) leaves state, time and outputs where they were
+        theta_old, self.theta_cs = self.theta_cs, theta_cs
+        if not self._update_outputs(f"t = {current_time:g} s"):
+            self.theta_cs = theta_old
+            return False
         self._time = current_time + step_size
         return True
 
@@ -208,8 +236,8 @@ class CushionClutch(Fmi2Slave):
                 out.append(f"value reference {vr} does not exist (0..{len(self.vars) - 1})")
             elif not isinstance(var, Real):
                 out.append(f"value reference {vr} ({var.name}) is not a Real")
-            elif write and self._phase == "terminated":
-                out.append(f"{var.name}: the instance is terminated")
+            elif write and self._phase in ("terminated", "error"):
+                out.append(f"{var.name}: not allowed in phase {self._phase}")
             elif write and self._kinds[vr] == "output":
                 out.append(f"{var.name} is an output and cannot be set")
             elif write and self._kinds[vr] == "parameter" and self._phase not in ("instantiated", "initialization"):
@@ -225,15 +253,21 @@ class CushionClutch(Fmi2Slave):
             return self._refuse("fmi2SetReal", problems)
         for vr, value in zip(vrs, values):
             setattr(self, self._names[vr], float(value))
+        if len(vrs):
+            self._dirty = True
 
     def get_real(self, vrs):
         problems = self._access_problems(vrs, write=False)
         if problems:
             self._refuse("fmi2GetReal", problems)
             return [math.nan] * len(vrs)
+        if self._dirty and self._phase in COMPUTED_PHASES:
+            self._refresh()
         return [float(getattr(self, self._names[vr])) for vr in vrs]
 
     def _no_such_type(self, call: str, vrs) -> None:
+        if len(vrs) == 0:
+            return
         self._refuse(call, [f"value reference {vr}: this FMU has Real variables only" for vr in vrs]
                      or ["this FMU has Real variables only"])
 
@@ -272,14 +306,34 @@ class CushionClutch(Fmi2Slave):
                        f"{OMEGA_SLIP_LIMIT:g} rad/s")
         return out
 
-    def _update_outputs(self) -> None:
+    def _current_parameters(self) -> ClutchParameters:
+        return ClutchParameters.from_flat({name: getattr(self, name) for name in PARAMETERS})
+
+    def _refresh(self) -> None:
+        """Outputs of the current inputs and state, computed on read (stale outputs only)."""
+        problems = self._input_problems()
+        if problems:                       # the outputs keep their last values and stay stale
+            for p in problems:
+                self.log(f"fmi2GetReal: {p}; outputs not updated", Fmi2Status.discard)
+            return
+        if self._phase == "initialization":
+            params = self._current_parameters()
+            if self._table is None or params.problems():
+                return                     # reported at fmi2ExitInitializationMode
+            self._params = params
+            self.theta_cs = params.theta_cs_start
+        self._update_outputs("fmi2GetReal")
+
+    def _update_outputs(self, where: str = "") -> bool:
+        """Outputs from the current inputs and state; False (logged, outputs kept) if the cover cannot hold."""
         try:
             out = outputs(self.x_to, self.theta_cs, self._table, self._params, self.theta_cm, self.omega_slip)
-        except Exception as exc:  # noqa: BLE001 - logged; refused again at the first step
-            self._problems.append(str(exc))
-            self.log(str(exc), Fmi2Status.error)
-            return
+        except Exception as exc:  # noqa: BLE001 - never raise into the wrapper (fmi2Fatal)
+            self.log(f"{where}: {exc}; outputs not updated", Fmi2Status.discard)
+            return False
         self._set_outputs(out)
+        self._dirty = False
+        return True
 
     def _set_outputs(self, out) -> None:
         for name in OUTPUTS:
@@ -294,8 +348,7 @@ class CushionClutch(Fmi2Slave):
     # -- state -------------------------------------------------------------------
     def _get_fmu_state(self):
         state = {name: float(getattr(self, name)) for name, _, _, _ in VARIABLES}
-        state.update(_phase=self._phase, _time=self._time, _range_warned=self._range_warned,
-                     _problems=list(self._problems), _faults=list(self._faults))
+        state.update(_phase=self._phase, _time=self._time, _range_warned=self._range_warned)
         return state
 
     def _state_problems(self, state) -> list[str]:
@@ -318,9 +371,6 @@ class CushionClutch(Fmi2Slave):
             out += [f"parameter {p}" for p in params.problems()]
             if not 0.0 < state["theta_cs"] < THETA_CM_LIMIT:
                 out.append(f"theta_cs = {state['theta_cs']!r} K is outside (0, {THETA_CM_LIMIT:g}) K")
-        for key in ("_problems", "_faults"):
-            if not (isinstance(state.get(key), list) and all(isinstance(s, str) for s in state[key])):
-                out.append(f"{key} is not a list of messages")
         return out
 
     def _set_fmu_state(self, state):
@@ -331,7 +381,7 @@ class CushionClutch(Fmi2Slave):
             setattr(self, name, float(state[name]))
         self._phase, self._time = state["_phase"], state["_time"]
         self._range_warned = bool(state.get("_range_warned"))
-        self._problems, self._faults = list(state["_problems"]), list(state["_faults"])
+        self._dirty = True                 # outputs of the restored inputs and state, at the next get
         if self._phase in ("stepping", "terminated"):
             self._params = ClutchParameters.from_flat({p: float(state[p]) for p in PARAMETERS})
 

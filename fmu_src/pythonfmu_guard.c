@@ -14,6 +14,15 @@
  *   - every refusal is logged through the host's logger (as a "%s" argument, never as the format)
  *     and fmi2Instantiate returns NULL, as FMI 2.0 asks.
  * The wrapper library is never unloaded (pythonfmu's interpreter must outlive its last instance).
+ *
+ * It also gives the slave the statuses the wrapper cannot return (fmi2Warning, fmi2Error: the wrapper
+ * answers every call fmi2OK, or fmi2Discard from a doStep that returned False). Each instance is a
+ * Guard holding the wrapper's instance; the wrapper gets the guard's logger, through which the slave
+ * sends a message of category CC_STATUS_CATEGORY with the status the call returns (cushion_slave.py,
+ * STATUS_CATEGORY). Such a message is not passed on; the call returns the worst of the wrapper's
+ * status and the slave's. The wrapper runs with loggingOn = true (it would drop every message,
+ * these too, otherwise); the guard passes on what the native FMU would: Discard and worse always,
+ * OK and Warning messages only with loggingOn.
  */
 #ifndef _WIN32
 #define _GNU_SOURCE /* dladdr */
@@ -23,6 +32,7 @@
 #include "resource_uri.h"
 
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #ifdef _WIN32
 #include <windows.h>
@@ -35,8 +45,31 @@
 #endif
 
 #define PATH_MAX_LEN 4096
+/* category of the slave's status messages: cushion_slave.STATUS_CATEGORY */
+#define CC_STATUS_CATEGORY "cushionReturnStatus"
 
 static void *wrapper = NULL;
+
+/* one instance: the wrapper's instance, the host's callbacks and the ones given to the wrapper */
+typedef struct {
+    fmi2Component inner;
+    fmi2CallbackFunctions host, mine;
+    int logging_on;
+    int status; /* the slave's status for the call under way */
+} Guard;
+
+/* the wrapper's logger: status messages are kept, the others passed on as the wrapper sends them
+   (the message is the format, '%' doubled by the slave) */
+static void guard_logger(fmi2ComponentEnvironment env, fmi2String name, fmi2Status status, fmi2String category,
+                         fmi2String message, ...) {
+    Guard *g = (Guard *)env;
+    if (category && strcmp(category, CC_STATUS_CATEGORY) == 0) {
+        if ((int)status > g->status) g->status = (int)status;
+        return;
+    }
+    if (!g->logging_on && status < fmi2Discard) return;
+    g->host.logger(g->host.componentEnvironment, name, status, category, message ? message : "");
+}
 
 static void refuse(const fmi2CallbackFunctions *functions, fmi2String name, const char *fmt, const char *arg) {
     char msg[PATH_MAX_LEN + 512];
@@ -179,15 +212,37 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
         refuse(functions, instanceName, "fmi2Instantiate: %s", "the pythonfmu wrapper exports no fmi2Instantiate");
         return NULL;
     }
-    return real(instanceName, fmuType, fmuGUID, uri, functions, visible, loggingOn);
+    {
+        Guard *g = (Guard *)calloc(1, sizeof(Guard));
+        if (!g) {
+            refuse(functions, instanceName, "fmi2Instantiate: %s", "out of memory");
+            return NULL;
+        }
+        g->host = g->mine = *functions;
+        g->mine.logger = guard_logger;
+        g->mine.componentEnvironment = g;
+        g->logging_on = loggingOn != fmi2False;
+        g->inner = real(instanceName, fmuType, fmuGUID, uri, &g->mine, visible, fmi2True);
+        if (!g->inner) {
+            free(g);
+            return NULL;
+        }
+        return g;
+    }
 }
 
-/* ---- every other call: forwarded; before the wrapper is loaded there is no instance to call */
-#define FORWARD_C(name, params, args)                 \
-    fmi2Status name params {                          \
-        name##TYPE *f = (name##TYPE *)sym(#name);     \
-        if (!c) return fmi2Error;                     \
-        return f ? f args : fmi2Error;                \
+/* ---- every other call: forwarded to the wrapper's instance (in); the worse of its status and the slave's */
+#define FORWARD_C(name, params, args)                                      \
+    fmi2Status name params {                                               \
+        name##TYPE *f = (name##TYPE *)sym(#name);                          \
+        Guard *g = (Guard *)c;                                             \
+        fmi2Component in;                                                  \
+        fmi2Status r;                                                      \
+        if (!g || !f) return fmi2Error;                                    \
+        in = g->inner;                                                     \
+        g->status = fmi2OK;                                                \
+        r = f args;                                                        \
+        return (int)r >= g->status ? r : (fmi2Status)g->status;            \
     }
 
 const char *fmi2GetTypesPlatform(void) { return fmi2TypesPlatform; }
@@ -195,45 +250,56 @@ const char *fmi2GetVersion(void) { return fmi2Version; }
 
 void fmi2FreeInstance(fmi2Component c) {
     fmi2FreeInstanceTYPE *f = (fmi2FreeInstanceTYPE *)sym("fmi2FreeInstance");
-    if (c && f) f(c);
+    Guard *g = (Guard *)c;
+    if (!g) return;
+    if (f) f(g->inner);
+    free(g);
 }
 
-FORWARD_C(fmi2SetDebugLogging, (fmi2Component c, fmi2Boolean on, size_t n, const fmi2String cat[]), (c, on, n, cat))
+/* the wrapper keeps loggingOn = true; the guard filters (categories are not used, as in the native FMU) */
+fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean on, size_t n, const fmi2String cat[]) {
+    Guard *g = (Guard *)c;
+    (void)n;
+    (void)cat;
+    if (!g) return fmi2Error;
+    g->logging_on = on != fmi2False;
+    return fmi2OK;
+}
 FORWARD_C(fmi2SetupExperiment, (fmi2Component c, fmi2Boolean tolDef, fmi2Real tol, fmi2Real t0, fmi2Boolean stopDef,
-                                fmi2Real t1), (c, tolDef, tol, t0, stopDef, t1))
-FORWARD_C(fmi2EnterInitializationMode, (fmi2Component c), (c))
-FORWARD_C(fmi2ExitInitializationMode, (fmi2Component c), (c))
-FORWARD_C(fmi2Terminate, (fmi2Component c), (c))
-FORWARD_C(fmi2Reset, (fmi2Component c), (c))
-FORWARD_C(fmi2GetReal, (fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2Real v[]), (c, vr, n, v))
-FORWARD_C(fmi2GetInteger, (fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2Integer v[]), (c, vr, n, v))
-FORWARD_C(fmi2GetBoolean, (fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2Boolean v[]), (c, vr, n, v))
-FORWARD_C(fmi2GetString, (fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2String v[]), (c, vr, n, v))
-FORWARD_C(fmi2SetReal, (fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Real v[]), (c, vr, n, v))
+                                fmi2Real t1), (in, tolDef, tol, t0, stopDef, t1))
+FORWARD_C(fmi2EnterInitializationMode, (fmi2Component c), (in))
+FORWARD_C(fmi2ExitInitializationMode, (fmi2Component c), (in))
+FORWARD_C(fmi2Terminate, (fmi2Component c), (in))
+FORWARD_C(fmi2Reset, (fmi2Component c), (in))
+FORWARD_C(fmi2GetReal, (fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2Real v[]), (in, vr, n, v))
+FORWARD_C(fmi2GetInteger, (fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2Integer v[]), (in, vr, n, v))
+FORWARD_C(fmi2GetBoolean, (fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2Boolean v[]), (in, vr, n, v))
+FORWARD_C(fmi2GetString, (fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2String v[]), (in, vr, n, v))
+FORWARD_C(fmi2SetReal, (fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Real v[]), (in, vr, n, v))
 FORWARD_C(fmi2SetInteger, (fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Integer v[]),
-          (c, vr, n, v))
+          (in, vr, n, v))
 FORWARD_C(fmi2SetBoolean, (fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Boolean v[]),
-          (c, vr, n, v))
+          (in, vr, n, v))
 FORWARD_C(fmi2SetString, (fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2String v[]),
-          (c, vr, n, v))
-FORWARD_C(fmi2GetFMUstate, (fmi2Component c, fmi2FMUstate *s), (c, s))
-FORWARD_C(fmi2SetFMUstate, (fmi2Component c, fmi2FMUstate s), (c, s))
-FORWARD_C(fmi2FreeFMUstate, (fmi2Component c, fmi2FMUstate *s), (c, s))
-FORWARD_C(fmi2SerializedFMUstateSize, (fmi2Component c, fmi2FMUstate s, size_t *size), (c, s, size))
-FORWARD_C(fmi2SerializeFMUstate, (fmi2Component c, fmi2FMUstate s, fmi2Byte b[], size_t size), (c, s, b, size))
+          (in, vr, n, v))
+FORWARD_C(fmi2GetFMUstate, (fmi2Component c, fmi2FMUstate *s), (in, s))
+FORWARD_C(fmi2SetFMUstate, (fmi2Component c, fmi2FMUstate s), (in, s))
+FORWARD_C(fmi2FreeFMUstate, (fmi2Component c, fmi2FMUstate *s), (in, s))
+FORWARD_C(fmi2SerializedFMUstateSize, (fmi2Component c, fmi2FMUstate s, size_t *size), (in, s, size))
+FORWARD_C(fmi2SerializeFMUstate, (fmi2Component c, fmi2FMUstate s, fmi2Byte b[], size_t size), (in, s, b, size))
 FORWARD_C(fmi2DeSerializeFMUstate, (fmi2Component c, const fmi2Byte b[], size_t size, fmi2FMUstate *s),
-          (c, b, size, s))
+          (in, b, size, s))
 FORWARD_C(fmi2GetDirectionalDerivative, (fmi2Component c, const fmi2ValueReference u[], size_t nu,
                                          const fmi2ValueReference z[], size_t nz, const fmi2Real dv[], fmi2Real d[]),
-          (c, u, nu, z, nz, dv, d))
+          (in, u, nu, z, nz, dv, d))
 FORWARD_C(fmi2SetRealInputDerivatives, (fmi2Component c, const fmi2ValueReference vr[], size_t n,
-                                        const fmi2Integer order[], const fmi2Real v[]), (c, vr, n, order, v))
+                                        const fmi2Integer order[], const fmi2Real v[]), (in, vr, n, order, v))
 FORWARD_C(fmi2GetRealOutputDerivatives, (fmi2Component c, const fmi2ValueReference vr[], size_t n,
-                                         const fmi2Integer order[], fmi2Real v[]), (c, vr, n, order, v))
-FORWARD_C(fmi2DoStep, (fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolean noSetPrior), (c, t, h, noSetPrior))
-FORWARD_C(fmi2CancelStep, (fmi2Component c), (c))
-FORWARD_C(fmi2GetStatus, (fmi2Component c, const fmi2StatusKind k, fmi2Status *v), (c, k, v))
-FORWARD_C(fmi2GetRealStatus, (fmi2Component c, const fmi2StatusKind k, fmi2Real *v), (c, k, v))
-FORWARD_C(fmi2GetIntegerStatus, (fmi2Component c, const fmi2StatusKind k, fmi2Integer *v), (c, k, v))
-FORWARD_C(fmi2GetBooleanStatus, (fmi2Component c, const fmi2StatusKind k, fmi2Boolean *v), (c, k, v))
-FORWARD_C(fmi2GetStringStatus, (fmi2Component c, const fmi2StatusKind k, fmi2String *v), (c, k, v))
+                                         const fmi2Integer order[], fmi2Real v[]), (in, vr, n, order, v))
+FORWARD_C(fmi2DoStep, (fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolean noSetPrior), (in, t, h, noSetPrior))
+FORWARD_C(fmi2CancelStep, (fmi2Component c), (in))
+FORWARD_C(fmi2GetStatus, (fmi2Component c, const fmi2StatusKind k, fmi2Status *v), (in, k, v))
+FORWARD_C(fmi2GetRealStatus, (fmi2Component c, const fmi2StatusKind k, fmi2Real *v), (in, k, v))
+FORWARD_C(fmi2GetIntegerStatus, (fmi2Component c, const fmi2StatusKind k, fmi2Integer *v), (in, k, v))
+FORWARD_C(fmi2GetBooleanStatus, (fmi2Component c, const fmi2StatusKind k, fmi2Boolean *v), (in, k, v))
+FORWARD_C(fmi2GetStringStatus, (fmi2Component c, const fmi2StatusKind k, fmi2String *v), (in, k, v))

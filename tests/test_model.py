@@ -199,6 +199,43 @@ def test_api_argument_errors_name_every_bad_argument(table, args, message):
     assert str(err.value) == message
 
 
+@pytest.mark.parametrize("cover, names", [
+    # the diaphragm cannot carry the release: the compliance rule names the lever arm's parameters
+    ({"fulcrum_radius_m": 0.105}, ("release_compliance_m_per_N", "fulcrum_radius_m", "pressure_plate_radius_m",
+                                   "lever_ratio")),
+    ({"fulcrum_radius_m": 0.2}, ("radii must satisfy", "< fulcrum_radius_m <", "0.2 < 0.111")),
+    ({"diaphragm_cone_height_m": 0.01}, ("diaphragm_cone_height_m / diaphragm_thickness_m", "2 sqrt(2)")),
+    ({"diaphragm_poisson_ratio": math.nan}, ("p.cover.diaphragm_poisson_ratio = nan is out of range [0, 0.5)",)),
+])
+def test_api_errors_name_the_cover_rule(table, cover, names):
+    """Every cover problem reaches the API's error with the parameter and the rule (issue 31), in each
+    function that uses the cover; none of them says only "invalid arguments"."""
+    import dataclasses
+    from cushion_clutch.model import kiss_point, x_to_for_torque
+
+    p = ClutchParameters(cover=dataclasses.replace(CoverParameters(), **cover))
+    for call in (lambda: outputs(0.012, 400.0, table, p), lambda: x_to_for_torque(10.0, 400.0, table, p),
+                 lambda: kiss_point(400.0, table, p)):
+        with pytest.raises(ValueError) as err:
+            call()
+        text = str(err.value)
+        assert text.startswith("p.cover") and "invalid arguments" not in text, text
+        for name in names:
+            assert name in text, (name, text)
+
+
+def test_release_compliance_bound_in_the_message_is_the_rule(table):
+    """The largest compliance the message states is where the rule flips: 0.1 % below it passes, above fails."""
+    import dataclasses
+    import re
+
+    bad = ClutchParameters(cover=dataclasses.replace(CoverParameters(), fulcrum_radius_m=0.105))
+    c_max = float(re.search(r"= ([0-9.e+-]+) m/N", bad.problems()[0]).group(1))
+    for factor, ok in ((0.999, True), (1.001, False)):
+        p = ClutchParameters(cover=dataclasses.replace(bad.cover, release_compliance_m_per_N=factor * c_max))
+        assert (p.problems() == []) == ok, (factor, p.problems())
+
+
 def test_thermal_step_refuses_bad_arguments_and_parameters():
     with pytest.raises(ValueError) as err:
         thermal_step(300.0, 400.0, -1.0, ClutchParameters(C=0.0))

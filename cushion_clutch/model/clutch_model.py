@@ -209,7 +209,15 @@ def _argument_error(args: dict, p: ClutchParameters | None, names: tuple[str, ..
         if not ok:
             problems.append(f"{name} = {v!r} is outside {_range_text(lo, hi, lo_open, hi_open)}")
     if p is not None:
-        problems += [f"p.{q}" for q in p.problems() if q.split(" ", 1)[0] in names or q.startswith("U + H")]
+        # the function's own parameters (names), and, where it uses the cover (lever_ratio in names), every
+        # problem of the cover: its ranges and its rules (they name their parameters, not always first)
+        own = {f.name for f in fields(ClutchParameters)}
+        for q in p.problems():
+            first = q.split(" ", 1)[0]
+            if first in names or q.startswith("U + H"):
+                problems.append(f"p.{q}")
+            elif "lever_ratio" in names and first not in own:
+                problems.append(f"p.cover.{q}" if first in p.RANGES else f"p.cover: {q}")
     return ValueError("; ".join(problems) or f"invalid arguments {args!r}")
 
 

@@ -149,8 +149,12 @@ class CoverParameters:
             g = CoverMap(self, lever_ratio)
             e_max = self.diaphragm_youngs_modulus_Pa * (1.0 + self.diaphragm_modulus_drop_per_K * self.reference_temperature_K)
             if not g.x_slope_bound(e_max) > 0.0:
-                out.append(f"release_compliance_m_per_N = {self.release_compliance_m_per_N:g}: the release snaps "
-                           "through (x_to(s) not monotone on the diaphragm's falling branch); reduce it")
+                c_max = g.kb * g.L_b / -g.moment_slope(self.diaphragm_cone_height_m, e_max)
+                out.append(f"release_compliance_m_per_N = {self.release_compliance_m_per_N:g} must be < "
+                           f"L_b^2 / (e |M'(h)|) = {c_max:.4g} m/N with the lever arm L_b = lever_ratio "
+                           f"(pressure_plate_radius_m - fulcrum_radius_m) = {lever_ratio:g} x ({r_pp:g} - {r_f:g}) m "
+                           "(above, the release snaps through: x_to(s) not monotone on the diaphragm's falling "
+                           "branch); reduce it or lengthen the lever arm")
         return out
 
 

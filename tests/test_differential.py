@@ -1,0 +1,118 @@
+"""The pythonfmu FMU keeps the native FMU's contract: the same seeded random FMI call sequences through
+both FMI 2.0 Co-Simulation FMUs give the same status at every call and the same values (issue 31).
+
+The generator and the drivers are :mod:`cushion_clutch.benchmarks.differential` (which runs the same at a
+larger size); here 40 sequences, each FMU built once per session.
+"""
+import math
+
+import pytest
+
+from cushion_clutch.benchmarks import differential as D
+from cushion_clutch.data import DEFAULT_TABLES
+from cushion_clutch.fmu.build import build_fmu
+from native_builds import native_fmus
+
+pytestmark = pytest.mark.fmu
+
+SEQUENCES = 40
+
+
+@pytest.fixture(scope="module")
+def fmus(tmp_path_factory):
+    python = build_fmu(DEFAULT_TABLES, tmp_path_factory.mktemp("differential") / "python2.fmu", backend="python")
+    native, native3 = D.Fmi2CS(native_fmus()[2], "native2"), D.Fmi3CS(native_fmus()[3], "native3")
+    py = D.Fmi2CS(python, "python2")
+    yield native, py, native3
+    for f in (native, py, native3):
+        f.close()
+
+
+def test_sequences_cover_what_the_contract_is_about():
+    """The generator makes what the comparison needs: NaN, inf and out-of-range inputs, bad step sizes,
+    saved/restored states, resets, and reads right after a set."""
+    ops = [op for seed in range(SEQUENCES) for op in D.sequence(seed, 60, ["x_to", "torque"])]
+    values = [v for op in ops if op[0] == "set" for v in op[1].values()]
+    steps = [op[1] for op in ops if op[0] == "step"]
+    assert sum(math.isnan(v) for v in values) >= 10 and sum(math.isinf(v) for v in values) >= 5
+    assert sum(abs(v) > 1.0 for v in values if math.isfinite(v)) >= 10
+    assert sum(math.isnan(h) for h in steps) >= 5 and sum(h < 0 for h in steps) >= 5
+    kinds = [op[0] for op in ops]
+    assert min(kinds.count(k) for k in ("save", "restore", "reset")) >= 10
+    assert sum(a[0] == "set" and b[0] == "get" for a, b in zip(ops, ops[1:])) >= 100
+
+
+def test_pythonfmu_fmu_answers_every_call_as_the_native_one(fmus):
+    """40 seeded sequences: the same status at every call (fmi2Error and fmi2Warning too: the guard library
+    returns the slave's) and the same values to 1e-9, all the way to each sequence's end."""
+    native, python, _ = fmus
+    outcomes = D.run(native, python, range(SEQUENCES), calls=60)
+    diffs = [str(o.difference) for o in outcomes if o.difference is not None]
+    assert diffs == [], f"{len(diffs)} of {SEQUENCES} sequences differ:\n" + "\n".join(diffs[:3])
+    assert sum(o.calls for o in outcomes) == sum(len(D.sequence(s, 60, ["x"])) for s in range(SEQUENCES))
+    assert sum(o.discards for o in outcomes) >= 40                   # refused steps and reads were compared
+    assert sum(o.errors for o in outcomes) >= 3                      # e.g. a saved state with x_to = NaN
+    assert sum(o.warnings for o in outcomes) >= 3                    # a step not where the last one ended
+    assert sum(o.gets_after_set for o in outcomes) >= 100
+
+
+def test_native_fmi3_answers_every_call_as_fmi2(fmus):
+    """The native FMI 3.0 CS front end against the FMI 2.0 one on the same sequences."""
+    native, _, native3 = fmus
+    outcomes = D.run(native, native3, range(SEQUENCES), calls=60)
+    diffs = [str(o.difference) for o in outcomes if o.difference is not None]
+    assert diffs == [], "\n".join(diffs[:3])
+
+
+def test_an_output_read_right_after_set_follows_the_input(fmus):
+    """Issue 31's example: at x_to = 0 and 20 degC, set x_to = 8 mm and read the torque with no step in
+    between, then 4 mm: both FMUs answer the new input's torque (the Python model's), not the previous one."""
+    from cushion_clutch.model import ClutchParameters, load_table, outputs
+
+    table, p = load_table(), ClutchParameters()
+    for fmu in fmus[:2]:
+        fmu.instantiate()
+        try:
+            assert fmu.init(0.0, {}) == [0, 0, 0]
+            for x in (0.008, 0.004, 0.008):
+                assert fmu.set({"x_to": x}) == 0
+                status, (torque,) = fmu.get(["torque"])
+                expected = outputs(x, p.theta_cs_start, table, p, theta_cm=p.theta_a).torque
+                assert status == 0 and torque == pytest.approx(expected, rel=1e-9), (fmu.label, x)
+            assert expected > 100.0
+        finally:
+            fmu.free()
+
+
+def test_a_refused_value_is_forgotten_once_a_valid_one_comes(fmus):
+    """Issue 31's example: worn facings (2.5 mm) and a hot start (573.15 K) where the cover cannot hold, then
+    theta_cm = 1700 K and x_to = 12 mm: both FMUs recover and step (the pythonfmu FMU used to keep the
+    refusal forever)."""
+    for fmu in fmus[:2]:
+        fmu.instantiate()
+        try:
+            assert fmu.init(0.0, {"facing_wear": 2.5e-3, "theta_cs_start": 573.15}) == [0, 0, 0, 0]
+            assert fmu.step(0.0, 0.1) == 2                     # the cover cannot hold: discarded
+            assert fmu.set({"theta_cm": 1700.0, "x_to": 0.012}) == 0
+            status, (torque,) = fmu.get(["torque"])
+            assert status == 0 and torque == pytest.approx(65.188, abs=1e-3), fmu.label
+            assert fmu.step(0.0, 0.1) == 0
+        finally:
+            fmu.free()
+
+
+def test_error_and_warning_statuses_are_the_native_ones(fmus):
+    """The pythonfmu FMU returns fmi2Error and fmi2Warning where the native one does (through its guard
+    library), changes nothing on a refused call and is not left faulty by it."""
+    for fmu in fmus[:2]:
+        fmu.instantiate()
+        try:
+            assert fmu.init(0.0, {}) == [0, 0, 0], fmu.label
+            assert fmu.set({"torque": 1.0}) == 3, fmu.label           # an output
+            assert fmu.set({"x_to": 0.008, "mu": 0.5}) == 3, fmu.label  # a fixed parameter: refused as a whole
+            assert fmu.get(["x_to", "mu"]) == (0, [0.0, 0.28]), fmu.label
+            assert fmu.step(0.0, 0.1) == 0, fmu.label                  # not faulty afterwards
+            assert fmu.step(0.05, 0.1) == 1, fmu.label                 # not where the last step ended: warned
+            assert fmu.step(0.15, 0.1) == 0, fmu.label
+        finally:
+            fmu.free()

@@ -188,3 +188,69 @@ int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
     }
     return fto < 0.0 ? -1 : 0;
 }
+
+/* ---- what the cover can hold (cover.py: temperature_grid, _holds, hold_problem, wear_limit) */
+
+/* the temperatures (K) of the check: lo..hi in 25 K steps and every table temperature inside, sorted, unique;
+   g must hold CC_HOLD_GRID_MAX values; returns their number */
+int cc_cover_grid(const Table *tb, double lo, double hi, double *g) {
+    int n = (int)ceil((hi - lo) / 25.0), k, j, m = 0;
+    for (k = 0; k <= n && m < CC_HOLD_GRID_MAX; ++k) g[m++] = lo + (hi - lo) * k / n;
+    for (k = 0; k < tb->nt && m < CC_HOLD_GRID_MAX; ++k) {
+        double t = tb->theta[k] + KELVIN;
+        if (t >= lo && t <= hi) g[m++] = t;
+    }
+    for (k = 1; k < m; ++k) { /* insertion sort */
+        double v = g[k];
+        for (j = k - 1; j >= 0 && g[j] > v; --j) g[j + 1] = g[j];
+        g[j + 1] = v;
+    }
+    for (k = 1, j = 0; k < m; ++k)
+        if (g[k] != g[j]) g[++j] = g[k];
+    return m ? j + 1 : 0;
+}
+
+/* the smallest bearing force (N) of the cushion phase at one temperature pair: the solid point and 8
+   deflections between kiss and solid (< 0: the diaphragm cannot hold the cushion) */
+static double holds(const CcCover *cv, const Table *tb, double wear, double theta_cs, double theta_cm) {
+    const double *p = cv->p;
+    double th = theta_cs - KELVIN, e_mod = youngs(cv, theta_cs), worst = INFINITY, s_kiss, s_solid;
+    double stack = cc_table_delta(tb, th) +
+                   (p[CV_TF] * p[CV_AF] + p[CV_TPP] * p[CV_APP] + p[CV_LFW] * p[CV_AFW]) * (theta_cm - p[CV_TREF]);
+    int k;
+    s_kiss = p[CV_SINST] + (cv->u_full_ref + stack - wear) / cv->kp;
+    s_solid = s_kiss - cc_table_full(tb, th) / cv->kp;
+    for (k = 0; k <= 8; ++k) {
+        double s = s_solid + (s_kiss - s_solid) * k / 9;
+        double fto = (moment(cv, s, e_mod) - cc_table_force(tb, (s_kiss - s) * cv->kp, th) * cv->L_pp) / cv->L_b;
+        if (fto < worst) worst = fto;
+    }
+    return worst;
+}
+
+int cc_cover_holds(const CcCover *cv, const Table *tb, double wear, double lo, double hi, double *fto,
+                   double *theta_cs, double *theta_cm) {
+    double g[CC_HOLD_GRID_MAX];
+    int n = cc_cover_grid(tb, lo, hi, g), a, b;
+    for (a = 0; a < n; ++a)
+        for (b = 0; b < n; ++b) {
+            double f = holds(cv, tb, wear, g[a], g[b]);
+            if (f < 0.0) {
+                if (fto) *fto = f;
+                if (theta_cs) *theta_cs = g[a];
+                if (theta_cm) *theta_cm = g[b];
+                return 0;
+            }
+        }
+    return 1;
+}
+
+double cc_cover_wear_limit(const CcCover *cv, const Table *tb, double lo, double hi) {
+    double a = 0.0, b = 0.01;
+    if (!cc_cover_holds(cv, tb, 0.0, lo, hi, NULL, NULL, NULL)) return -1.0;
+    while (b - a > 1e-7) {
+        double mid = 0.5 * (a + b);
+        if (cc_cover_holds(cv, tb, mid, lo, hi, NULL, NULL, NULL)) a = mid; else b = mid;
+    }
+    return a;
+}

@@ -210,19 +210,20 @@ int cc_cover_grid(const Table *tb, double lo, double hi, double *g) {
     return m ? j + 1 : 0;
 }
 
-/* the smallest bearing force (N) of the cushion phase at one temperature pair: the solid point and 8
-   deflections between kiss and solid (< 0: the diaphragm cannot hold the cushion) */
+/* the smallest bearing force (N) of the cushion phase at one temperature pair (cover._holds): at the points
+   u_k = u_full (9 - k)/9, k = 0..8 (k = 0: solid), s_k = s_kiss - u_k / kp (< 0: cannot hold the cushion) */
 static double holds(const CcCover *cv, const Table *tb, double wear, double theta_cs, double theta_cm) {
     const double *p = cv->p;
-    double th = theta_cs - KELVIN, e_mod = youngs(cv, theta_cs), worst = INFINITY, s_kiss, s_solid;
-    double stack = cc_table_delta(tb, th) +
-                   (p[CV_TF] * p[CV_AF] + p[CV_TPP] * p[CV_APP] + p[CV_LFW] * p[CV_AFW]) * (theta_cm - p[CV_TREF]);
+    double th = theta_cs - KELVIN, e_mod = youngs(cv, theta_cs), worst = INFINITY, s_kiss, u_full;
+    double d = theta_cm - p[CV_TREF];
+    double stack = cc_table_delta(tb, th) + (p[CV_TF] * p[CV_AF] * d + p[CV_TPP] * p[CV_APP] * d +
+                                             p[CV_LFW] * p[CV_AFW] * d);
     int k;
     s_kiss = p[CV_SINST] + (cv->u_full_ref + stack - wear) / cv->kp;
-    s_solid = s_kiss - cc_table_full(tb, th) / cv->kp;
-    for (k = 0; k <= 8; ++k) {
-        double s = s_solid + (s_kiss - s_solid) * k / 9;
-        double fto = (moment(cv, s, e_mod) - cc_table_force(tb, (s_kiss - s) * cv->kp, th) * cv->L_pp) / cv->L_b;
+    u_full = cc_table_full(tb, th);
+    for (k = 0; k < 9; ++k) {
+        double u = u_full * (9 - k) / 9;
+        double fto = (moment(cv, s_kiss - u / cv->kp, e_mod) - cc_table_force(tb, u, th) * cv->L_pp) / cv->L_b;
         if (fto < worst) worst = fto;
     }
     return worst;

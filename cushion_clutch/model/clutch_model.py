@@ -370,7 +370,8 @@ def table_problems(table: SpringTable, p: ClutchParameters) -> list[str]:
     cushion at ``p.facing_wear`` for every temperature pair in [THETA_MIN_K, THETA_MAX_K] (:func:`cover.hold_problem`,
     the message names the wear limit). Cached for the last table, cover and wear. Assumes ``p.problems()`` is empty."""
     key = (p.lever_ratio, p.x_kiss_ref, p.facing_wear)
-    if not (_LAST_HOLD[0] is table and _LAST_HOLD[1] is p.cover and _LAST_HOLD[2] == key):
+    if not (_LAST_HOLD[0] is table and (_LAST_HOLD[1] is p.cover or _LAST_HOLD[1] == p.cover)
+            and _LAST_HOLD[2] == key):
         problem = hold_problem(p.cover, p.lever_ratio, table, p.x_kiss_ref, p.facing_wear, THETA_MIN_K, THETA_MAX_K)
         _LAST_HOLD[:] = [table, p.cover, key, problem]
     return [] if _LAST_HOLD[3] is None else [_LAST_HOLD[3]]

@@ -502,59 +502,89 @@ def temperature_grid(table, theta_min_K: float, theta_max_K: float, step_K: floa
     return sorted(grid)
 
 
-def _holds(g: CoverMap, table, x_kiss_ref: float, wear: float, theta_cs: float, theta_cm: float,
-           n_inner: int = 8) -> float:
-    """The smallest bearing force (N) of the cushion phase at one temperature pair: solid point and ``n_inner``
-    deflections between the kiss and the solid point (< 0: the diaphragm cannot hold the cushion)."""
-    s_kiss = g.s_kiss(theta_cs, theta_cm, wear, table)
+#: points of the cushion phase checked by the hold rule: the solid point and 8 more towards the kiss point
+HOLD_POINTS = 9
+
+
+def _hold_forces(g: CoverMap, table, theta_cs: float) -> tuple:
+    """What the hold rule needs at one cushion temperature: (E, delta_kiss, u_full, [(u_k, F_c(u_k))]) with
+    ``u_k = u_full (HOLD_POINTS - k) / HOLD_POINTS`` (k = 0: the solid point)."""
     th = theta_cs - 273.15
-    s_solid = s_kiss - table.full_compression(th) / g.kp
-    e_mod = g.youngs_modulus(theta_cs)
-    worst = math.inf
-    for k in range(n_inner + 1):
-        s = s_solid + (s_kiss - s_solid) * k / (n_inner + 1)
-        fto = (g.moment(s, e_mod) - table.force((s_kiss - s) * g.kp, th) * g.L_pp) / g.L_b
-        worst = min(worst, fto)
-    return worst
+    u_full = table.full_compression(th)
+    pts = []
+    for k in range(HOLD_POINTS):
+        u = u_full * (HOLD_POINTS - k) / HOLD_POINTS
+        pts.append((u, table.force(u, th)))
+    return g.youngs_modulus(theta_cs), table.delta_kiss(th), pts
+
+
+def _holds(g: CoverMap, wear: float, theta_cm: float, forces: tuple) -> float:
+    """The smallest bearing force (N) of the cushion phase at one temperature pair (``forces`` from
+    :func:`_hold_forces` at theta_cs): ``(M(s_k) - F_c(u_k) L_pp) / L_b`` at ``s_k = s_kiss - u_k e / L_pp``
+    (< 0: the diaphragm cannot hold the cushion)."""
+    c = g.c
+    e_mod, delta, pts = forces
+    d = theta_cm - c.reference_temperature_K
+    stack = delta + (c.facing_thickness_m * c.facing_expansion_per_K * d
+                     + c.pressure_plate_thickness_m * c.pressure_plate_expansion_per_K * d
+                     + c.flywheel_length_m * c.flywheel_expansion_per_K * d)
+    s_kiss = c.installed_deflection_m + (g._u_full_ref[1] + stack - wear) / g.kp
+    return min((g.moment(s_kiss - u / g.kp, e_mod) - f * g.L_pp) / g.L_b for u, f in pts)
+
+
+def _hold_setup(cover, lever_ratio, table, theta_min_K, theta_max_K):
+    g = CoverMap(cover, lever_ratio)
+    g.s_kiss(cover.reference_temperature_K, cover.reference_temperature_K, 0.0, table)   # caches u_full(theta_ref)
+    grid = temperature_grid(table, theta_min_K, theta_max_K)
+    forces = {a: _hold_forces(g, table, a) for a in grid}
+    return g, [(a, b, forces[a]) for a in grid for b in grid]
+
+
+def _failing(g, wear, pairs):
+    """The first (theta_cs, theta_cm, bearing force) of ``pairs`` where the diaphragm cannot hold, or None."""
+    for a, b, f in pairs:
+        fto = _holds(g, wear, b, f)
+        if fto < 0.0:
+            return a, b, fto
+    return None
 
 
 def hold_problem(cover: CoverParameters, lever_ratio: float, table, x_kiss_ref: float, wear: float,
                  theta_min_K: float, theta_max_K: float) -> str | None:
     """None if the diaphragm holds the cushion at ``wear`` (m) for every ``(theta_cs, theta_cm)`` of the
     temperature box (:func:`temperature_grid`); otherwise the rule broken, with the wear limit."""
-    g = CoverMap(cover, lever_ratio)
-    grid = temperature_grid(table, theta_min_K, theta_max_K)
-    for theta_cs in grid:
-        for theta_cm in grid:
-            fto = _holds(g, table, x_kiss_ref, wear, theta_cs, theta_cm)
-            if fto < 0.0:
-                limit = wear_limit(cover, lever_ratio, table, x_kiss_ref, theta_min_K, theta_max_K)
-                where = (f"the wear limit of this cover is {limit:.6g} m" if limit >= 0.0 else
-                         "this cover cannot hold the cushion even with new facings")
-                return (f"facing_wear = {wear:g} m: the diaphragm cannot hold the fully compressed cushion "
-                        f"(bearing force {fto:.4g} N < 0 at theta_cs = {theta_cs:g} K, theta_cm = {theta_cm:g} K); "
-                        f"{where} over theta in [{theta_min_K:g}, {theta_max_K:g}] K")
-    return None
+    g, pairs = _hold_setup(cover, lever_ratio, table, theta_min_K, theta_max_K)
+    bad = _failing(g, wear, pairs)
+    if bad is None:
+        return None
+    limit = wear_limit(cover, lever_ratio, table, x_kiss_ref, theta_min_K, theta_max_K)
+    where = (f"the wear limit of this cover is {limit:.6g} m" if limit >= 0.0 else
+             "this cover cannot hold the cushion even with new facings")
+    return (f"facing_wear = {wear:g} m: the diaphragm cannot hold the fully compressed cushion "
+            f"(bearing force {bad[2]:.4g} N < 0 at theta_cs = {bad[0]:g} K, theta_cm = {bad[1]:g} K); "
+            f"{where} over theta in [{theta_min_K:g}, {theta_max_K:g}] K")
 
 
 def wear_limit(cover: CoverParameters, lever_ratio: float, table, x_kiss_ref: float, theta_min_K: float,
                theta_max_K: float, tol_m: float = 1e-7) -> float:
     """The largest facing wear (m, to ``tol_m``) the cover holds at every temperature pair of the box;
     -1.0 if it cannot hold the cushion even new. Bisection on the wear (the bearing force at the solid point
-    falls with wear on the diaphragm's falling branch)."""
-    g = CoverMap(cover, lever_ratio)
-    grid = temperature_grid(table, theta_min_K, theta_max_K)
-
-    def ok(w):
-        return all(_holds(g, table, x_kiss_ref, w, a, b) >= 0.0 for a in grid for b in grid)
-
-    if not ok(0.0):
+    falls with wear on the diaphragm's rising branch). ``x_kiss_ref`` does not enter (kept for the signature)."""
+    g, pairs = _hold_setup(cover, lever_ratio, table, theta_min_K, theta_max_K)
+    if _failing(g, 0.0, pairs):
         return -1.0
-    lo, hi = 0.0, 0.01
-    while hi - lo > tol_m:
-        mid = 0.5 * (lo + hi)
-        lo, hi = (mid, hi) if ok(mid) else (lo, mid)
-    return lo
+    # bisect on the binding pairs only, then check the answer on the whole grid: both predicates are monotone in
+    # the wear, so once the whole grid holds at the result, the full bisection ends in the same dyadic interval
+    active = [min(pairs, key=lambda p: _holds(g, 0.005, p[1], p[2]))]
+    while True:
+        lo, hi = 0.0, 0.01
+        while hi - lo > tol_m:
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if _failing(g, mid, active) is None else (lo, mid)
+        bad = _failing(g, lo, pairs)
+        if bad is None:
+            return lo
+        active.append(next(p for p in pairs if p[:2] == bad[:2]))
 
 
 def wear_reserve(cover: CoverParameters, lever_ratio: float, table, x_kiss_ref: float, gain_m: float,

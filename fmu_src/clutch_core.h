@@ -66,6 +66,8 @@ typedef struct {
     double u_full_ref;                /* cushion full compression at the reference temperature, m */
     double xc;                        /* bearing-system constant X_c, m */
     int hint[2], hint_k[2];           /* last table intervals (Newton; kiss and solid points) */
+    const Curve *memo_c[4];           /* frame_cushion: curve, u and F of the solid (0, 1) and kiss (2, 3) points */
+    double memo_u[4], memo_f[4];
     /* the frame of the last (theta_cs K, theta_cm K, wear m): bracket, E, positions and forces */
     double f_theta_cs, f_theta_cm, f_wear, f_e, f_w;
     const Curve *f_c0, *f_c1;

@@ -58,6 +58,7 @@ void cc_cover_prepare(CcCover *cv, const double *par, double lever_ratio, double
     cv->xc = x_kiss_ref + cv->kb * s_k0 + par[CV_C] * f_to;
     cv->f_theta_cs = NAN; /* no frame yet */
     cv->hint[0] = cv->hint[1] = cv->hint_k[0] = cv->hint_k[1] = 0;
+    memset(cv->memo_c, 0, sizeof cv->memo_c);
 }
 
 /* -(dx_to/ds) at its smallest (open phase, s = h) at the largest E: > 0 means no snap-through */
@@ -100,6 +101,29 @@ static double cushion(const Bracket *b, double u, double *dfdu, int *hint) {
     return (1.0 - b->w) * f0 + b->w * f1;
 }
 
+/* the frame's cushion force at u (the full compression or the kiss point, slot 0 or 1): the curves' values
+   are kept per curve and u, so a new temperature inside the same table interval costs no curve evaluation
+   when u is unchanged (exact: the same numbers as cushion()) */
+static double frame_cushion(CcCover *cv, const Bracket *b, double u, int slot) {
+    double f0, f1, d;
+    const Curve *c[2];
+    int k;
+    c[0] = b->c0;
+    c[1] = b->c1;
+    for (k = 0; k < (b->w == 0.0 ? 1 : 2); ++k) {
+        int j = 2 * slot + k;
+        if (!(cv->memo_c[j] == c[k] && cv->memo_u[j] == u)) {
+            cv->memo_c[j] = c[k];
+            cv->memo_u[j] = u;
+            cv->memo_f[j] = curve_vd(c[k], u, &d, &cv->hint_k[k]);
+        }
+    }
+    f0 = cv->memo_f[2 * slot];
+    if (b->w == 0.0) return f0;
+    f1 = cv->memo_f[2 * slot + 1];
+    return (1.0 - b->w) * f0 + b->w * f1;
+}
+
 int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, double theta_cm, double wear,
                    CcCoverState *out) {
     const double *p = cv->p;
@@ -109,7 +133,7 @@ int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
     if (!(theta_cs == cv->f_theta_cs && theta_cm == cv->f_theta_cm && wear == cv->f_wear)) {
         /* the frame: everything that depends on temperature and wear, not on x_to */
         int i;
-        double w, stack, m_solid, dummy;
+        double w, stack, m_solid;
         Bracket b;
         e_mod = youngs(cv, theta_cs);
         cc_table_bracket(tb, th, &i, &w);
@@ -124,12 +148,12 @@ int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
         cv->f_w = w;
         cv->s_kiss = p[CV_SINST] + (cv->u_full_ref + stack - wear) / kp;
         cv->s_solid = cv->s_kiss - cc_table_full(tb, th) / kp;
-        cv->fc_solid = cushion(&b, (cv->s_kiss - cv->s_solid) * kp, &dummy, cv->hint_k);
+        cv->fc_solid = frame_cushion(cv, &b, (cv->s_kiss - cv->s_solid) * kp, 0);
         m_solid = moment(cv, cv->s_solid, e_mod);
         cv->m_solid = m_solid;
         cv->fto_solid = (m_solid - cv->fc_solid * cv->L_pp) / cv->L_b;
         cv->x_solid = cv->xc - kb * cv->s_solid - comp * cv->fto_solid;
-        fc = cushion(&b, 0.0, &dummy, cv->hint_k);
+        fc = frame_cushion(cv, &b, 0.0, 1);
         cv->fto_kiss = (moment(cv, cv->s_kiss, e_mod) - fc * cv->L_pp) / cv->L_b;
         cv->x_kiss = cv->xc - kb * cv->s_kiss - comp * cv->fto_kiss;
         cv->f_theta_cs = theta_cs;

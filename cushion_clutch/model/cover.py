@@ -370,7 +370,8 @@ class _Frame:
         self.fto_solid, self.fc_solid = self.f_to(s_solid)
         self.x_solid = xc - g.kb * s_solid - g.comp * self.fto_solid
         self.x_lift = self.x_solid + g.comp * max(self.fto_solid, 0.0)
-        self.x_kiss = self.x_of(s_kiss)
+        self.fto_kiss = self.f_to(s_kiss)[0]
+        self.x_kiss = xc - g.kb * s_kiss - g.comp * self.fto_kiss      # = self.x_of(s_kiss)
         if self.fto_solid < 0.0:
             raise ValueError(self._weak(self.fto_solid, "the solid position"))
 
@@ -410,8 +411,17 @@ class _Frame:
             fpp = (g.moment(self.s_solid, self.e_mod) - fto * g.L_b) / g.L_pp
             return CoverState(fpp, fto, self.fc_solid, u_full, self.s_solid, self.x_kiss, self.x_solid, self.x_lift)
         lo, hi = self.s_solid, (self.xc - x_to) / kb       # x_of(lo) > x_to >= x_of(hi)
-        s = hi
-        r = self.x_of(s) - x_to
+        # start (as the C core's, from the inputs only): the chord of x(s) between the solid and kiss points
+        # (cushion phase) or the rigid lever shifted by the kiss point's compliance (open)
+        if x_to >= self.x_kiss:
+            s = self.s_solid + (s_kiss - self.s_solid) * (self.x_solid - x_to) / (self.x_solid - self.x_kiss)
+        else:
+            s = (self.xc - x_to - comp * self.fto_kiss) / kb
+        if not lo < s < hi:
+            s = hi
+        xc = self.xc
+        fto, fc = self.f_to(s)
+        r = xc - kb * s - comp * fto - x_to                  # = self.x_of(s) - x_to
         for _ in range(100):
             if abs(r) <= tol * (1.0 + abs(x_to)) or hi - lo <= tol * (1.0 + hi):
                 break
@@ -424,8 +434,8 @@ class _Frame:
                                   + self.cushion_slope(u) * kp * g.L_pp) / g.L_b
             s_new = s - r / slope if slope < 0.0 else 0.5 * (lo + hi)
             s = s_new if lo < s_new < hi else 0.5 * (lo + hi)
-            r = self.x_of(s) - x_to
-        fto, fc = self.f_to(s)
+            fto, fc = self.f_to(s)
+            r = xc - kb * s - comp * fto - x_to
         if fto < 0.0:
             raise ValueError(self._weak(fto, f"x_to = {x_to:g} m"))
         return CoverState(fc, fto, fc, (s_kiss - s) * kp, s, self.x_kiss, self.x_solid, self.x_lift)

@@ -140,6 +140,14 @@ static int cover_consistent(CcModel *m, const double *r, const char *fn) {
     return ok;
 }
 
+/* 1 if every parameter of a equals that of b (bit for bit) */
+static int same_parameters(const double *a, const double *b) {
+    int k;
+    for (k = 0; k < CC_NVARS; ++k)
+        if (is_parameter((unsigned int)k) && memcmp(&a[k], &b[k], sizeof a[k]) != 0) return 0;
+    return 1;
+}
+
 /* every parameter problem is logged (prefix names the call); returns 1 if all are valid */
 static int check_parameters(CcModel *m, const double *r, const char *fn) {
     int k, ok = 1;
@@ -160,7 +168,9 @@ static int check_parameters(CcModel *m, const double *r, const char *fn) {
         cc_log(m, CC_ERROR, "%s: U + H must be > 0 (the cushion spring needs a heat path)", fn);
         ok = 0;
     }
-    if (ok && m->table_ok) { /* the diaphragm must hold the cushion at this wear at every temperature in range */
+    if (ok && m->table_ok && !(m->held_valid && same_parameters(m->held, r))) {
+        /* the diaphragm must hold the cushion at this wear at every temperature in range (about 1 ms: the
+           parameters that passed are kept, so restoring states of the same instance does not repeat it) */
         CcCover cv;
         double fto = 0.0, t_cs = 0.0, t_cm = 0.0;
         cc_cover_prepare(&cv, cover_params(r), r[VR_LEVER_RATIO], r[VR_X_KISS_REF], &m->table);
@@ -173,6 +183,9 @@ static int check_parameters(CcModel *m, const double *r, const char *fn) {
                    "cushion (bearing force %.4g N < 0 at theta_cs = %g K, theta_cm = %g K); %s over theta in "
                    "[%g, %g] K", fn, r[VR_FACING_WEAR], fto, t_cs, t_cm, where, THETA_MIN_K, THETA_MAX_K);
             ok = 0;
+        } else {
+            memcpy(m->held, r, sizeof m->held);
+            m->held_valid = 1;
         }
     }
     return ok;

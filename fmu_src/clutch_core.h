@@ -96,6 +96,8 @@ typedef struct {
     CcCover cover;
     int cover_ok;     /* cover prepared from the current parameters */
     int table_ok;
+    double held[CC_NVARS]; /* the last parameters the cover was found to hold (check_parameters) */
+    int held_valid;
     char table_error[600];
     CcLogger logger;
     void *log_ctx;

@@ -321,7 +321,7 @@ def calibrate(base: SpringParams, measured: Measured | Sequence[Measured], names
     model.forces(x0)                               # the start: its kiss shifts bound each curve's zero offset
     problems = offset_problems(measured, model.shifts[tuple(np.round(x0, 15))])
     if problems:
-        raise ParameterError("; ".join(problems))
+        raise ParameterError(problems)
 
     def rel(forces) -> np.ndarray:
         return np.concatenate([(f - m.force_N) / sc for f, m, sc in zip(forces, measured, scales)])

@@ -101,8 +101,8 @@ OMEGA_SLIP_START = 0.0
 #: (the gearbox input may spin against the engine)
 OMEGA_SLIP_LIMIT = 1500.0
 #: bearing stroke accepted, m: 2 mm behind the open position (actuator backlash) up to 25 mm. The default cover
-#: lifts the bearing off at 10.7 mm new and at 17.5 mm at its wear limit (2.25 mm of facing wear, 20 degC), so the
-#: stroke leaves 7.5 mm past the latest lift-off (tests/test_validity.py checks it)
+#: lifts the bearing off at 10.7 mm new and at 17.4 mm at its wear limit (2.25 mm of facing wear, 20 degC; 17.7 mm
+#: at the worst temperatures), so the stroke leaves 7.3 mm past the latest lift-off (tests/test_validity.py: >= 5 mm)
 X_TO_MIN = -0.002
 X_TO_MAX = 0.025
 #: temperatures accepted, K: below 200 K (-73 degC) a value is taken for degC typed into a kelvin input; above

@@ -12,8 +12,8 @@
 #include <string.h>
 
 #define KELVIN 273.15
-/* X_TO_LIMIT, THETA_CM_LIMIT, OMEGA_SLIP_LIMIT and the variable table CC_VARIABLES (names, causalities,
-   start values, parameter ranges) come from cushion_variables.h, generated from clutch_model */
+/* X_TO_MIN/MAX, THETA_MIN_K/MAX_K, OMEGA_SLIP_LIMIT and the variable table CC_VARIABLES (names, causalities,
+   start values, input and parameter ranges, units) come from cushion_variables.h, generated from clutch_model */
 #define VAR_NAME(vr) (CC_VARIABLES[vr].name)
 
 static int is_input(unsigned int vr) { return vr < CC_NVARS && CC_VARIABLES[vr].causality == CC_INPUT; }
@@ -48,7 +48,7 @@ void cc_log(CcModel *m, int status, const char *fmt, ...) {
     const char *cat = status == CC_OK ? "logAll" : status == CC_WARNING ? "logStatusWarning"
                     : status == CC_DISCARD ? "logStatusDiscard" : "logStatusError";
     if (!m->logger) return;
-    if (!m->logging_on && status <= CC_WARNING) return; /* errors and discards: always */
+    if (!m->logging_on && status < CC_WARNING) return; /* warnings, errors and discards: always */
     va_start(ap, fmt);
     vsnprintf(msg, sizeof msg, fmt, ap);
     va_end(ap);
@@ -114,6 +114,11 @@ static int cover_consistent(CcModel *m, const double *r, const char *fn) {
                       "(above, the diaphragm's valley force is negative: it snaps through)", fn, c[CV_H] / c[CV_T]);
         ok = 0;
     }
+    if (!(c[CV_SINST] <= 2.0 * c[CV_H])) {
+        if (m) cc_log(m, CC_ERROR, "%s: installed_deflection_m = %g must be <= 2 diaphragm_cone_height_m = %g m (past "
+                      "that the diaphragm is turned inside out)", fn, c[CV_SINST], 2.0 * c[CV_H]);
+        ok = 0;
+    }
     if (!(c[CV_KE] * (2000.0 - c[CV_TREF]) < 1.0)) {
         if (m) cc_log(m, CC_ERROR, "%s: diaphragm_modulus_drop_per_K: E(theta) must stay > 0 up to 2000 K", fn);
         ok = 0;
@@ -133,6 +138,14 @@ static int cover_consistent(CcModel *m, const double *r, const char *fn) {
         }
     }
     return ok;
+}
+
+/* 1 if every parameter of a equals that of b (bit for bit) */
+static int same_parameters(const double *a, const double *b) {
+    int k;
+    for (k = 0; k < CC_NVARS; ++k)
+        if (is_parameter((unsigned int)k) && memcmp(&a[k], &b[k], sizeof a[k]) != 0) return 0;
+    return 1;
 }
 
 /* every parameter problem is logged (prefix names the call); returns 1 if all are valid */
@@ -155,26 +168,63 @@ static int check_parameters(CcModel *m, const double *r, const char *fn) {
         cc_log(m, CC_ERROR, "%s: U + H must be > 0 (the cushion spring needs a heat path)", fn);
         ok = 0;
     }
+    if (ok && m->table_ok && !(m->held_valid && same_parameters(m->held, r))) {
+        /* the diaphragm must hold the cushion at this wear at every temperature in range (about 1 ms: the
+           parameters that passed are kept, so restoring states of the same instance does not repeat it) */
+        CcCover cv;
+        double fto = 0.0, t_cs = 0.0, t_cm = 0.0;
+        cc_cover_prepare(&cv, cover_params(r), r[VR_LEVER_RATIO], r[VR_X_KISS_REF], &m->table);
+        if (!cc_cover_holds(&cv, &m->table, r[VR_FACING_WEAR], THETA_MIN_K, THETA_MAX_K, &fto, &t_cs, &t_cm)) {
+            double limit = cc_cover_wear_limit(&cv, &m->table, THETA_MIN_K, THETA_MAX_K);
+            char where[120];
+            if (limit >= 0.0) snprintf(where, sizeof where, "the wear limit of this cover is %.6g m", limit);
+            else snprintf(where, sizeof where, "this cover cannot hold the cushion even with new facings");
+            cc_log(m, CC_ERROR, "%s: parameter facing_wear = %g m: the diaphragm cannot hold the fully compressed "
+                   "cushion (bearing force %.4g N < 0 at theta_cs = %g K, theta_cm = %g K); %s over theta in "
+                   "[%g, %g] K", fn, r[VR_FACING_WEAR], fto, t_cs, t_cm, where, THETA_MIN_K, THETA_MAX_K);
+            ok = 0;
+        } else {
+            memcpy(m->held, r, sizeof m->held);
+            m->held_valid = 1;
+        }
+    }
     return ok;
 }
 
 static int inputs_ok(const double *r) {
-    return isfinite(r[VR_X_TO]) && fabs(r[VR_X_TO]) <= X_TO_LIMIT && isfinite(r[VR_THETA_CM]) &&
-           r[VR_THETA_CM] > 0.0 && r[VR_THETA_CM] < THETA_CM_LIMIT && isfinite(r[VR_OMEGA_SLIP]) &&
-           fabs(r[VR_OMEGA_SLIP]) <= OMEGA_SLIP_LIMIT;
+    return r[VR_X_TO] >= X_TO_MIN && r[VR_X_TO] <= X_TO_MAX && r[VR_THETA_CM] >= THETA_MIN_K &&
+           r[VR_THETA_CM] <= THETA_MAX_K && fabs(r[VR_OMEGA_SLIP]) <= OMEGA_SLIP_LIMIT; /* false for NaN */
 }
 
+/* every input outside its range (INPUT_RANGES), named with value, range and unit; a temperature below its
+   range is said to be in kelvin */
 static void log_inputs(CcModel *m, int status, double t, const char *what) {
-    double *r = m->r;
-    if (!(isfinite(r[VR_X_TO]) && fabs(r[VR_X_TO]) <= X_TO_LIMIT))
-        cc_log(m, status, "t = %g s: input x_to = %g m is not finite or |x_to| > %g m; %s", t, r[VR_X_TO],
-               X_TO_LIMIT, what);
-    if (!(isfinite(r[VR_THETA_CM]) && r[VR_THETA_CM] > 0.0 && r[VR_THETA_CM] < THETA_CM_LIMIT))
-        cc_log(m, status, "t = %g s: input theta_cm = %g K is not finite or outside (0, %g) K; %s", t,
-               r[VR_THETA_CM], THETA_CM_LIMIT, what);
-    if (!(isfinite(r[VR_OMEGA_SLIP]) && fabs(r[VR_OMEGA_SLIP]) <= OMEGA_SLIP_LIMIT))
-        cc_log(m, status, "t = %g s: input omega_slip = %g rad/s is not finite or |omega_slip| > %g rad/s; %s", t,
-               r[VR_OMEGA_SLIP], OMEGA_SLIP_LIMIT, what);
+    int k;
+    for (k = 0; k < CC_NVARS; ++k) {
+        const double *g = CC_VARIABLES[k].range;
+        const char *unit = CC_VARIABLES[k].unit;
+        double v = m->r[k];
+        if (!is_input((unsigned int)k) || range_ok(k, v)) continue;
+        if (!strcmp(unit, "K") && v < g[0])
+            cc_log(m, status, "t = %g s: input %s = %g K is outside %c%g, %g%c K (the input is in kelvin: %g degC "
+                   "would be %g K); %s", t, VAR_NAME(k), v, g[2] ? '(' : '[', g[0], g[1], g[3] ? ')' : ']', v,
+                   v + KELVIN, what);
+        else
+            cc_log(m, status, "t = %g s: input %s = %g %s is not finite or outside %c%g, %g%c %s; %s", t, VAR_NAME(k),
+                   v, unit, g[2] ? '(' : '[', g[0], g[1], g[3] ? ')' : ']', unit, what);
+    }
+}
+
+/* the validity output (clutch_model.validity): 2 facings above their damage limit, 1 a temperature beyond the
+   tables (cushion table for theta_cs, friction table for theta_cm), 0 inside */
+static int validity(const CcModel *m) {
+    const double *r = m->r;
+    const Table *tb = &m->table;
+    if (r[VR_THETA_CM] > r[VR_FACING_DAMAGE_TEMPERATURE_K]) return 2;
+    if (!(tb->theta[0] + KELVIN <= r[VR_THETA_CS] && r[VR_THETA_CS] <= tb->theta[tb->nt - 1] + KELVIN)) return 1;
+    if (tb->f_mu && !(tb->f_theta[0] + KELVIN <= r[VR_THETA_CM] && r[VR_THETA_CM] <= tb->f_theta[tb->ntf - 1] + KELVIN))
+        return 1;
+    return 0;
 }
 
 /* -------------------------------------------------------------------- model */
@@ -205,12 +255,19 @@ static int update_outputs(CcModel *m) {
     r[VR_CLAMP_FORCE] = st.clamp;
     r[VR_BEARING_FORCE] = st.bearing;
     m->dirty = 0;
-    if (!(tb->theta[0] + KELVIN <= r[VR_THETA_CS] && r[VR_THETA_CS] <= tb->theta[tb->nt - 1] + KELVIN) &&
-        !m->range_warned) {
-        m->range_warned = 1;
-        cc_log(m, CC_WARNING, "theta_cs = %.2f K is outside the table range [%.2f, %.2f] K; F and the kiss point "
-               "are clamped to the nearest table temperature (warned once)", r[VR_THETA_CS],
-               tb->theta[0] + KELVIN, tb->theta[tb->nt - 1] + KELVIN);
+    {
+        int v = validity(m);
+        r[VR_VALIDITY] = v;
+        if (v != m->range_warned && v == 2)
+            cc_log(m, CC_WARNING, "facing temperature theta_cm = %.2f K is above facing_damage_temperature_K = %.2f K: "
+                   "the facings are being damaged; the model keeps answering with clamped tables (validity = 2)",
+                   r[VR_THETA_CM], r[VR_FACING_DAMAGE_TEMPERATURE_K]);
+        else if (v != m->range_warned && v == 1)
+            cc_log(m, CC_WARNING, "temperature beyond the tables: theta_cs = %.2f K (table [%.2f, %.2f] K), "
+                   "theta_cm = %.2f K; F, the kiss shift and mu are clamped to the nearest table temperature "
+                   "(validity = 1; warned once per entry)", r[VR_THETA_CS], tb->theta[0] + KELVIN,
+                   tb->theta[tb->nt - 1] + KELVIN, r[VR_THETA_CM]);
+        m->range_warned = v;
     }
     return CC_OK;
 }
@@ -299,6 +356,7 @@ int cc_exit_init(CcModel *m, const char *fn) {
     if (!cc_allowed(m, PH_INIT, fn)) return CC_ERROR;
     if (!check_parameters(m, m->r, fn)) {
         m->r[VR_TORQUE] = m->r[VR_FORCE] = m->r[VR_U_F] = m->r[VR_CLAMP_FORCE] = m->r[VR_BEARING_FORCE] = 0.0;
+        m->r[VR_VALIDITY] = 0.0;
         m->phase = PH_ERROR;
         return CC_ERROR;
     }
@@ -371,8 +429,9 @@ int cc_set_time(CcModel *m, double t, const char *fn) {
 
 int cc_set_state_value(CcModel *m, double theta_cs, const char *fn) {
     if (!cc_allowed(m, PH_CONT, fn)) return CC_ERROR;
-    if (!(isfinite(theta_cs) && theta_cs > 0.0 && theta_cs < THETA_CM_LIMIT)) {
-        cc_log(m, CC_ERROR, "%s: theta_cs = %g K is not finite or outside (0, %g) K", fn, theta_cs, THETA_CM_LIMIT);
+    if (!(theta_cs >= THETA_MIN_K && theta_cs <= THETA_MAX_K)) {
+        cc_log(m, CC_ERROR, "%s: theta_cs = %g K is not finite or outside [%g, %g] K", fn, theta_cs, THETA_MIN_K,
+               THETA_MAX_K);
         return CC_ERROR;
     }
     m->r[VR_THETA_CS] = theta_cs;
@@ -437,8 +496,8 @@ int cc_state_check(CcModel *m, const void *bytes, size_t size, const char *fn) {
             cc_log(m, CC_ERROR, "%s: the state's %s = %g is not finite", fn, VAR_NAME(k), s.r[k]);
             return 0;
         }
-    if (!isfinite(s.time) || !(s.r[VR_THETA_CS] > 0.0 && s.r[VR_THETA_CS] < THETA_CM_LIMIT) ||
-        !(s.range_warned == 0 || s.range_warned == 1) || !(s.terminated == 0 || s.terminated == 1)) {
+    if (!isfinite(s.time) || !(s.r[VR_THETA_CS] >= THETA_MIN_K && s.r[VR_THETA_CS] <= THETA_MAX_K) ||
+        !(s.range_warned >= 0 && s.range_warned <= 2) || !(s.terminated == 0 || s.terminated == 1)) {
         cc_log(m, CC_ERROR, "%s: the state's time, theta_cs or flags are out of range", fn);
         return 0;
     }

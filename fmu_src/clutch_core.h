@@ -75,6 +75,8 @@ typedef struct {
     double u_full_ref;                /* cushion full compression at the reference temperature, m */
     double xc;                        /* bearing-system constant X_c, m */
     int hint[2], hint_k[2];           /* last table intervals (Newton; kiss and solid points) */
+    const Curve *memo_c[4];           /* frame_cushion: curve, u and F of the solid (0, 1) and kiss (2, 3) points */
+    double memo_u[4], memo_f[4];
     /* the frame of the last (theta_cs K, theta_cm K, wear m): bracket, E, positions and forces */
     double f_theta_cs, f_theta_cm, f_wear, f_e;
     TBracket f_br;
@@ -96,13 +98,15 @@ typedef struct {
     int phase;
     int me;           /* 1: Model Exchange instance, 0: Co-Simulation */
     int dirty;        /* outputs and derivative need recomputing */
-    int range_warned;
+    int range_warned; /* the validity of the last outputs (0, 1, 2): a warning is logged on each change to 1 or 2 */
     int terminated;   /* CS: the last step was refused (fmi2Terminated / terminateSimulation) */
     int logging_on;
     Table table;
     CcCover cover;
     int cover_ok;     /* cover prepared from the current parameters */
     int table_ok;
+    double held[CC_NVARS]; /* the last parameters the cover was found to hold (check_parameters) */
+    int held_valid;
     char table_error[600];
     CcLogger logger;
     void *log_ctx;
@@ -110,7 +114,7 @@ typedef struct {
 
 /* the serialized (and saved) FMU state: versioned, checksummed, validated before use */
 #define CC_STATE_MAGIC 0x43434653u /* "CCFS" */
-#define CC_STATE_VERSION 3u /* 3: the cover variables */
+#define CC_STATE_VERSION 4u /* 3: the cover variables; 4: validity (range_warned = last validity 0..2) */
 typedef struct {
     uint32_t magic, version, size;
     int32_t phase, me, range_warned, terminated, reserved;
@@ -135,6 +139,14 @@ double cc_cover_slope_bound(const CcCover *cv);
 /* 0, or -1 if the diaphragm cannot hold the cushion (bearing force < 0); out is filled either way */
 int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, double theta_cm, double wear,
                    CcCoverState *out);
+/* what the cover can hold (cover.hold_problem / wear_limit): the temperature grid of the check (K), 1 if the
+   diaphragm holds the cushion at wear for every pair of it (else 0, with the first failing pair), and the
+   largest such wear (m; -1 if none) */
+#define CC_HOLD_GRID_MAX 128
+int cc_cover_grid(const Table *tb, double lo, double hi, double *g);
+int cc_cover_holds(const CcCover *cv, const Table *tb, double wear, double lo, double hi, double *fto,
+                   double *theta_cs, double *theta_cm);
+double cc_cover_wear_limit(const CcCover *cv, const Table *tb, double lo, double hi);
 
 /* ---- model (clutch_core.c) */
 int cc_instantiate(CcModel *m, const char *resource_dir, int me, CcLogger logger, void *ctx, int logging_on);

@@ -58,6 +58,7 @@ void cc_cover_prepare(CcCover *cv, const double *par, double lever_ratio, double
     cv->xc = x_kiss_ref + cv->kb * s_k0 + par[CV_C] * f_to;
     cv->f_theta_cs = NAN; /* no frame yet */
     cv->hint[0] = cv->hint[1] = cv->hint_k[0] = cv->hint_k[1] = 0;
+    memset(cv->memo_c, 0, sizeof cv->memo_c);
 }
 
 /* -(dx_to/ds) at its smallest (open phase, s = h) at the largest E: > 0 means no snap-through */
@@ -100,6 +101,32 @@ static double cushion(const TBracket *b, double u, double *dfdu, int *hint) {
     return (1.0 - b->w) * f0 + b->w * f1;
 }
 
+/* the frame's cushion force at u (the full compression or the kiss point, slot 0 or 1): the curves' values
+   are kept per curve and the curve's own compression, so a new temperature that reads a curve at the same
+   point costs no curve evaluation (exact: the same numbers as cushion()) */
+static double frame_cushion(CcCover *cv, const TBracket *b, double u, int slot) {
+    double f0, f1, d, v = u - b->first;
+    const Curve *c[2];
+    double uk[2];
+    int k;
+    c[0] = b->c0;
+    c[1] = b->c1;
+    uk[0] = b->w == 0.0 ? u : b->c0->x_first + v * b->r0;
+    uk[1] = b->c1->x_first + v * b->r1;
+    for (k = 0; k < (b->w == 0.0 ? 1 : 2); ++k) {
+        int j = 2 * slot + k;
+        if (!(cv->memo_c[j] == c[k] && cv->memo_u[j] == uk[k])) {
+            cv->memo_c[j] = c[k];
+            cv->memo_u[j] = uk[k];
+            cv->memo_f[j] = curve_vd(c[k], uk[k], &d, &cv->hint_k[k]);
+        }
+    }
+    f0 = cv->memo_f[2 * slot];
+    if (b->w == 0.0) return f0;
+    f1 = cv->memo_f[2 * slot + 1];
+    return (1.0 - b->w) * f0 + b->w * f1;
+}
+
 int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, double theta_cm, double wear,
                    CcCoverState *out) {
     const double *p = cv->p;
@@ -108,7 +135,7 @@ int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
     int k;
     if (!(theta_cs == cv->f_theta_cs && theta_cm == cv->f_theta_cm && wear == cv->f_wear)) {
         /* the frame: everything that depends on temperature and wear, not on x_to */
-        double stack, m_solid, dummy;
+        double stack, m_solid;
         TBracket b;
         e_mod = youngs(cv, theta_cs);
         cc_table_bracket(tb, th, &b);
@@ -118,12 +145,12 @@ int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
         cv->f_br = b;
         cv->s_kiss = p[CV_SINST] + (cv->u_full_ref + stack - wear) / kp;
         cv->s_solid = cv->s_kiss - b.full / kp;
-        cv->fc_solid = cushion(&b, (cv->s_kiss - cv->s_solid) * kp, &dummy, cv->hint_k);
+        cv->fc_solid = frame_cushion(cv, &b, (cv->s_kiss - cv->s_solid) * kp, 0);
         m_solid = moment(cv, cv->s_solid, e_mod);
         cv->m_solid = m_solid;
         cv->fto_solid = (m_solid - cv->fc_solid * cv->L_pp) / cv->L_b;
         cv->x_solid = cv->xc - kb * cv->s_solid - comp * cv->fto_solid;
-        fc = cushion(&b, 0.0, &dummy, cv->hint_k);
+        fc = frame_cushion(cv, &b, 0.0, 1);
         cv->fto_kiss = (moment(cv, cv->s_kiss, e_mod) - fc * cv->L_pp) / cv->L_b;
         cv->x_kiss = cv->xc - kb * cv->s_kiss - comp * cv->fto_kiss;
         cv->f_theta_cs = theta_cs;
@@ -178,4 +205,71 @@ int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
         out->s = s;
     }
     return fto < 0.0 ? -1 : 0;
+}
+
+/* ---- what the cover can hold (cover.py: temperature_grid, _holds, hold_problem, wear_limit) */
+
+/* the temperatures (K) of the check: lo..hi in 25 K steps and every table temperature inside, sorted, unique;
+   g must hold CC_HOLD_GRID_MAX values; returns their number */
+int cc_cover_grid(const Table *tb, double lo, double hi, double *g) {
+    int n = (int)ceil((hi - lo) / 25.0), k, j, m = 0;
+    for (k = 0; k <= n && m < CC_HOLD_GRID_MAX; ++k) g[m++] = lo + (hi - lo) * k / n;
+    for (k = 0; k < tb->nt && m < CC_HOLD_GRID_MAX; ++k) {
+        double t = tb->theta[k] + KELVIN;
+        if (t >= lo && t <= hi) g[m++] = t;
+    }
+    for (k = 1; k < m; ++k) { /* insertion sort */
+        double v = g[k];
+        for (j = k - 1; j >= 0 && g[j] > v; --j) g[j + 1] = g[j];
+        g[j + 1] = v;
+    }
+    for (k = 1, j = 0; k < m; ++k)
+        if (g[k] != g[j]) g[++j] = g[k];
+    return m ? j + 1 : 0;
+}
+
+/* the smallest bearing force (N) of the cushion phase at one temperature pair (cover._holds): at the points
+   u_k = u_full (9 - k)/9, k = 0..8 (k = 0: solid), s_k = s_kiss - u_k / kp (< 0: cannot hold the cushion) */
+static double holds(const CcCover *cv, const Table *tb, double wear, double theta_cs, double theta_cm) {
+    const double *p = cv->p;
+    double th = theta_cs - KELVIN, e_mod = youngs(cv, theta_cs), worst = INFINITY, s_kiss, u_full;
+    double d = theta_cm - p[CV_TREF];
+    double stack = cc_table_delta(tb, th) + (p[CV_TF] * p[CV_AF] * d + p[CV_TPP] * p[CV_APP] * d +
+                                             p[CV_LFW] * p[CV_AFW] * d);
+    int k;
+    s_kiss = p[CV_SINST] + (cv->u_full_ref + stack - wear) / cv->kp;
+    u_full = cc_table_full(tb, th);
+    for (k = 0; k < 9; ++k) {
+        double u = u_full * (9 - k) / 9;
+        double fto = (moment(cv, s_kiss - u / cv->kp, e_mod) - cc_table_force(tb, u, th) * cv->L_pp) / cv->L_b;
+        if (fto < worst) worst = fto;
+    }
+    return worst;
+}
+
+int cc_cover_holds(const CcCover *cv, const Table *tb, double wear, double lo, double hi, double *fto,
+                   double *theta_cs, double *theta_cm) {
+    double g[CC_HOLD_GRID_MAX];
+    int n = cc_cover_grid(tb, lo, hi, g), a, b;
+    for (a = 0; a < n; ++a)
+        for (b = 0; b < n; ++b) {
+            double f = holds(cv, tb, wear, g[a], g[b]);
+            if (f < 0.0) {
+                if (fto) *fto = f;
+                if (theta_cs) *theta_cs = g[a];
+                if (theta_cm) *theta_cm = g[b];
+                return 0;
+            }
+        }
+    return 1;
+}
+
+double cc_cover_wear_limit(const CcCover *cv, const Table *tb, double lo, double hi) {
+    double a = 0.0, b = 0.01;
+    if (!cc_cover_holds(cv, tb, 0.0, lo, hi, NULL, NULL, NULL)) return -1.0;
+    while (b - a > 1e-7) {
+        double mid = 0.5 * (a + b);
+        if (cc_cover_holds(cv, tb, mid, lo, hi, NULL, NULL, NULL)) a = mid; else b = mid;
+    }
+    return a;
 }

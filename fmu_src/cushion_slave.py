@@ -56,6 +56,7 @@ from pythonfmu.enums import Fmi2Status
 
 from clutch_model import (OMEGA_SLIP_LIMIT, THETA_CM_LIMIT, VARIABLES, X_TO_LIMIT, ClutchParameters, SpringTable,
                           outputs, start_values, thermal_step)
+from clutch_model import table_problems, validity_warning  # issue 28 (validity): the shared model decides
 from table_format import table_set_x_kiss_ref
 
 CAUSALITY = {"input": (Fmi2Causality.input, Fmi2Variability.continuous),
@@ -116,7 +117,7 @@ class CushionClutch(Fmi2Slave):
         defaults = ClutchParameters() if x_kiss_ref is None else ClutchParameters(x_kiss_ref=x_kiss_ref)
         for name, value in start_values(defaults).items():
             setattr(self, name, value)
-        self._range_warned = False
+        self._range_warned = 0
         self._params = defaults
         self._dirty = True                  # outputs are stale: recomputed at the next get
         self._phase = "instantiated"
@@ -182,6 +183,8 @@ class CushionClutch(Fmi2Slave):
             problems.append(self._table_error or "tables missing")
         params = self._current_parameters()
         problems += [f"parameter {p}" for p in params.problems()]
+        if not problems:                # issue 28: what the cover cannot hold with this table (the wear limit)
+            problems += [f"parameter {p}" for p in table_problems(self._table, params)]
         self.theta_cs = params.theta_cs_start
         self._dirty = True
         if problems:
@@ -338,12 +341,12 @@ class CushionClutch(Fmi2Slave):
     def _set_outputs(self, out) -> None:
         for name in OUTPUTS:
             setattr(self, name, getattr(out, name))
-        if out.clamped and not self._range_warned:
-            self._range_warned = True
-            self.log(f"theta_cs = {self.theta_cs:.2f} K is outside the table range "
-                     f"[{self._table.theta_min_K:.2f}, {self._table.theta_max_K:.2f}] K; "
-                     "F and the kiss point are clamped to the nearest table temperature "
-                     "(warned once)", Fmi2Status.warning)
+        # issue 28: _range_warned holds the last validity (0, 1, 2); a warning on each entry into 1 or 2
+        msg = validity_warning(int(self._range_warned), int(out.validity), self.theta_cs, self.theta_cm,
+                               self._table, self._params)
+        self._range_warned = int(out.validity)
+        if msg:
+            self.log(msg, Fmi2Status.warning)
 
     # -- state -------------------------------------------------------------------
     def _get_fmu_state(self):
@@ -380,7 +383,7 @@ class CushionClutch(Fmi2Slave):
         for name, _, _, _ in VARIABLES:
             setattr(self, name, float(state[name]))
         self._phase, self._time = state["_phase"], state["_time"]
-        self._range_warned = bool(state.get("_range_warned"))
+        self._range_warned = int(state.get("_range_warned") or 0)
         self._dirty = True                 # outputs of the restored inputs and state, at the next get
         if self._phase in ("stepping", "terminated"):
             self._params = ClutchParameters.from_flat({p: float(state[p]) for p in PARAMETERS})

@@ -21,8 +21,26 @@
  * sends a message of category CC_STATUS_CATEGORY with the status the call returns (cushion_slave.py,
  * STATUS_CATEGORY). Such a message is not passed on; the call returns the worst of the wrapper's
  * status and the slave's. The wrapper runs with loggingOn = true (it would drop every message,
- * these too, otherwise); the guard passes on what the native FMU would: Discard and worse always,
- * OK and Warning messages only with loggingOn.
+ * these too, otherwise); the guard passes on what the native FMU would: Warning and worse always (the
+ * validity warnings of issue 28 reach every host's log), OK messages only with loggingOn.
+ *
+ * The host never aborts at exit (issue 28; Linux). pythonfmu 0.7's wrapper keeps its interpreter state in a
+ * static std::shared_ptr and resets it again in a library destructor (finalizePythonInterpreter). At process
+ * exit the static's destructor (an atexit entry) runs first and frees the state; the library destructor
+ * (run later by the dynamic linker) then releases the freed block again: a use-after-free and double free
+ * that valgrind shows and that aborts the host after a complete, correct run (free(): corrupted ... chunks,
+ * exit -6; how often depends on the heap layout). Two things here:
+ *   - right after loading the wrapper the guard registers an exit handler that calls the wrapper's own
+ *     release (finalizePythonInterpreter, exported). Exit handlers run last-registered first, so it runs
+ *     before the wrapper's static destructor, while the state is alive; the static destructor and the library
+ *     destructor then find an empty pointer. (Unloading the wrapper instead does not work: as a C++ library
+ *     with unique symbols it is never unmapped.) The guard pins itself in memory (RTLD_NODELETE) so that the
+ *     handler's code is still there at exit after a host's dlclose;
+ *   - where the host has not started Python itself, the guard starts it (Py_InitializeEx(0): no signal
+ *     handlers, then releases the GIL) before the wrapper's first instance. The wrapper then sees a running
+ *     interpreter, which it never finalizes (its finalizer is the other code that ran at exit), and neither
+ *     does the guard. A Python host (fmpy) is left as it is.
+ * On Windows the wrapper behaves as shipped (its Python DLL is not reachable from here).
  */
 #ifndef _WIN32
 #define _GNU_SOURCE /* dladdr */
@@ -67,9 +85,18 @@ static void guard_logger(fmi2ComponentEnvironment env, fmi2String name, fmi2Stat
         if ((int)status > g->status) g->status = (int)status;
         return;
     }
-    if (!g->logging_on && status < fmi2Discard) return;
+    if (!g->logging_on && status < fmi2Warning) return;
     g->host.logger(g->host.componentEnvironment, name, status, category, message ? message : "");
 }
+
+#ifndef _WIN32
+/* at process exit, before the wrapper's static destructors: the wrapper's own release of its interpreter
+   state (its library destructor's job, which would otherwise run after the state was freed; see the top) */
+static void unload_wrapper_at_exit(void) {
+    void (*fin)(void) = wrapper ? (void (*)(void))dlsym(wrapper, "finalizePythonInterpreter") : NULL;
+    if (fin) fin(); /* releases the interpreter state while it is alive; later releases find it empty */
+}
+#endif
 
 static void refuse(const fmi2CallbackFunctions *functions, fmi2String name, const char *fmt, const char *arg) {
     char msg[PATH_MAX_LEN + 512];
@@ -130,6 +157,10 @@ static int load_wrapper(char *err, size_t errlen) {
             snprintf(err, errlen, "cannot load %s: %s", path, dlerror());
             return -1;
         }
+        /* after the wrapper's own exit entries, so it runs before them. The handler's code must still be there at
+           exit: this library pins itself (RTLD_NODELETE), so a host's dlclose leaves it, and the wrapper, loaded */
+        (void)dlopen(info.dli_fname, RTLD_NOW | RTLD_NOLOAD | RTLD_NODELETE);
+        atexit(unload_wrapper_at_exit);
     }
 #endif
     return 0;
@@ -141,6 +172,40 @@ static void *sym(const char *name) {
     return (void *)GetProcAddress((HMODULE)wrapper, name);
 #else
     return dlsym(wrapper, name);
+#endif
+}
+
+#ifndef _WIN32
+/* libpython's entry points, from the wrapper's dependencies or (a preloaded libpython) the global scope */
+static void *py_sym(const char *name) {
+    void *f = sym(name);
+    return f ? f : dlsym(RTLD_DEFAULT, name);
+}
+#endif
+
+/* start the interpreter once, before the wrapper's first instance, unless it runs (see the top) */
+static void keep_interpreter(void) {
+#ifndef _WIN32
+    static int done = 0;
+    typedef int (*IsInitTYPE)(void);
+    typedef void (*InitExTYPE)(int);
+    typedef void *(*SaveThreadTYPE)(void);
+    IsInitTYPE is_init;
+    InitExTYPE init_ex;
+    SaveThreadTYPE save_thread;
+    if (done) return;
+    done = 1;
+    is_init = (IsInitTYPE)py_sym("Py_IsInitialized");
+    init_ex = (InitExTYPE)py_sym("Py_InitializeEx");
+    save_thread = (SaveThreadTYPE)py_sym("PyEval_SaveThread");
+    if (is_init) { /* keep libpython loaded for good, whoever loaded it: the interpreter outlives the wrapper */
+        Dl_info info;
+        if (dladdr((void *)is_init, &info) && info.dli_fname) (void)dlopen(info.dli_fname, RTLD_NOW | RTLD_NOLOAD);
+    }
+    if (is_init && init_ex && save_thread && !is_init()) {
+        init_ex(0);
+        (void)save_thread(); /* the wrapper takes the GIL with PyGILState_Ensure in every call */
+    }
 #endif
 }
 
@@ -207,6 +272,7 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
         refuse(functions, instanceName, "fmi2Instantiate: %s", err);
         return NULL;
     }
+    keep_interpreter();
     real = (fmi2InstantiateTYPE *)sym("fmi2Instantiate");
     if (!real) {
         refuse(functions, instanceName, "fmi2Instantiate: %s", "the pythonfmu wrapper exports no fmi2Instantiate");

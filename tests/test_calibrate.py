@@ -136,3 +136,38 @@ def test_a_hot_curve_is_read_from_the_reference_kiss_point(coarse, case_cache):
     kiss = p.sweep.kiss_force_N
     assert hot[0] == pytest.approx(kiss, rel=1e-6) and cold[1] == pytest.approx(kiss, rel=1e-6)
     assert cold[0] < kiss < hot[1]
+
+
+def test_hot_curve_may_start_earlier_by_its_kiss_shift(tmp_path):
+    """Issue 28: the allowed negative zero offset is the FE kiss shift at the curve's temperature plus 0.2 mm."""
+    from cushion_clutch.fe.studies.calibrate import offset_problems
+    from cushion_clutch.fe.studies.measured import parse_measured
+    cold = write_csv(tmp_path / "cold.csv", "u_m,force_N\n-0.0001,0\n0,10\n0.0005,300\n0.001,900\n")
+    hot = write_csv(tmp_path / "hot.csv", "u_m,force_N\n-0.000375,0\n-0.00019,10\n0.0005,350\n0.001,950\n")
+    ms = parse_measured([f"20={cold}", f"195={hot}"])            # read: the hot curve's -0.375 mm is kept
+    assert offset_problems(ms, [0.0, 0.19e-3]) == []               # 0.19 mm shift + 0.2 mm >= 0.375 mm
+    text = "; ".join(offset_problems(ms, [0.0, 0.1e-3]))
+    assert "at 195 degC starts at u_m = -0.000375 m; allowed >= -0.0003 m (the FE kiss shift 0.0001 m" in text
+    assert "20 degC" not in text
+    too_early = write_csv(tmp_path / "cold2.csv", "u_m,force_N\n-0.00025,0\n0,10\n0.0005,300\n0.001,900\n")
+    with pytest.raises(Exception, match=r"allowed >= -0.0002 m"):
+        parse_measured([str(too_early)])                           # the reference curve keeps 0.2 mm
+
+
+@pytest.mark.ccx
+def test_calibrate_refuses_a_curve_before_the_hot_first_touch(coarse, case_cache):
+    """The FE's kiss shift at 195 degC decides: from -(shift + 0.2 mm) the curve is fitted, before it refused."""
+    from cushion_clutch.fe.studies.calibrate import _Model, offset_problems
+    p = coarse.replace(sweep={"temperatures_degC": (20.0, 195.0)})
+    u = np.linspace(0.0, 0.5e-3, 6)
+    measured = [Measured(u, 1e3 * u + 1, "pair", 20.0), Measured(u, 1e3 * u + 1, "pair", 195.0)]
+    model = _Model(p, fit_keys(p, ["thickness_m"]), measured, case_cache, 1, None, None)
+    model.forces([p.geometry.thickness_m])
+    shift = model.shifts[(p.geometry.thickness_m,)][1]
+    assert shift > 20e-6 and model.shifts[(p.geometry.thickness_m,)][0] == 0.0
+    ok = Measured(np.r_[-(shift + 0.19e-3), u], np.r_[0.0, 1e3 * u + 1], "pair", 195.0)
+    bad = Measured(np.r_[-(shift + 0.21e-3), u], np.r_[0.0, 1e3 * u + 1], "pair", 195.0)
+    assert offset_problems([measured[0], ok], [0.0, shift]) == []
+    assert offset_problems([measured[0], bad], [0.0, shift])
+    with pytest.raises(ParameterError, match="FE kiss shift"):
+        calibrate(p, [measured[0], bad], ["thickness_m"], cache_dir=case_cache, jobs=1)

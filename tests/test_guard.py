@@ -95,3 +95,43 @@ def test_guard_under_wine_refuses_with_a_message_and_never_crashes(py_fmu, tmp_p
                              text=True, timeout=120)
         assert res.returncode == 1, (uri, res.returncode, res.stderr[-1500:])
         assert text in res.stderr and "fmi2Instantiate failed" in res.stderr, (uri, res.stderr[-1500:])
+
+
+def test_c_host_never_aborts_at_exit(py_fmu, tmp_path):
+    """Issue 28: pythonfmu 0.7's wrapper released its interpreter state twice at process exit (a static
+    destructor, then its library destructor reading the freed block): a C host aborted after a complete,
+    correct run (12 of 12 runs before the guard's exit handler). Now every run exits 0 with its outputs."""
+    import os
+    import sysconfig
+    from pathlib import Path
+
+    import numpy
+
+    from cushion_clutch.benchmarks.fmu import compile_host
+    _, unzip, guid = py_fmu
+    host = compile_host(tmp_path / "host")
+    env = dict(os.environ, LD_PRELOAD=os.path.join(sysconfig.get_config_var("LIBDIR"),
+                                                   sysconfig.get_config_var("LDLIBRARY")),
+               PYTHONPATH=str(Path(numpy.__file__).parents[1]))
+    for run in range(6):
+        res = subprocess.run([str(host), str(unzip / "binaries" / "linux64" / "CushionClutch.so"),
+                              (unzip / "resources").as_uri(), guid, "20", "0.001"], capture_output=True, text=True,
+                             timeout=120, env=env)
+        assert res.returncode == 0, (run, res.returncode, res.stderr[-1500:])
+        assert res.stdout.startswith("outputs "), (run, res.stdout)
+
+
+FMPY_RUNS = r"""
+import sys
+from fmpy import simulate_fmu
+for k in range(3):                      # fmpy loads and unloads the library for each run
+    r = simulate_fmu(sys.argv[1], stop_time=0.02, output_interval=0.01, start_values={"x_to": 0.008})
+print("torque", r["torque"][-1])
+"""
+
+
+def test_fmpy_runs_and_exits_cleanly(py_fmu):
+    fmu, _, _ = py_fmu
+    for run in range(3):
+        res = subprocess.run([sys.executable, "-c", FMPY_RUNS, str(fmu)], capture_output=True, text=True, timeout=300)
+        assert res.returncode == 0 and "torque" in res.stdout, (run, res.returncode, res.stderr[-1500:])

@@ -129,7 +129,7 @@ def test_steady_gain_and_time_constant():
 @pytest.mark.parametrize("theta_c", [20.0, 137.0, 195.0, 300.0])
 def test_inverse_gives_back_the_torque(table, theta_c):
     theta = theta_c + KELVIN
-    t_full = outputs(1.0, theta, table, P).torque
+    t_full = outputs(0.025, theta, table, P).torque
     for frac in (0.02, 0.1, 0.5, 0.9, 0.99):
         x = x_to_for_torque(frac * t_full, theta, table, P)
         assert outputs(x, theta, table, P).torque == pytest.approx(frac * t_full, rel=1e-7)
@@ -138,7 +138,7 @@ def test_inverse_gives_back_the_torque(table, theta_c):
 def test_inverse_saturates(table):
     theta = 195.0 + KELVIN
     x_full = x_to_for_torque(1e9, theta, table, P)
-    assert outputs(x_full, theta, table, P).torque == pytest.approx(outputs(1.0, theta, table, P).torque)
+    assert outputs(x_full, theta, table, P).torque == pytest.approx(outputs(0.025, theta, table, P).torque)
     # first contact, back through the cover's Newton solve: zero to rounding (1e-15 N.m)
     assert outputs(x_to_for_torque(0.0, theta, table, P), theta, table, P).torque == pytest.approx(0.0, abs=1e-12)
 
@@ -188,10 +188,12 @@ def test_api_refuses_bad_clutch_parameters(table, bad, message):
 
 
 @pytest.mark.parametrize("args, message", [
-    ((math.inf, 400.0), "x_to = inf is outside [-1, 1]"),
-    ((0.006, 0.0), "theta_cs = 0.0 is outside (0, 2000)"),
-    ((0.006, 2000.0), "theta_cs = 2000.0 is outside (0, 2000)"),
-    ((2.0, -1.0), "x_to = 2.0 is outside [-1, 1]; theta_cs = -1.0 is outside (0, 2000)"),
+    ((math.inf, 400.0), "x_to = inf m is outside [-0.002, 0.025] m"),
+    ((0.006, 100.0), "theta_cs = 100.0 K is outside [200, 1000] K (the input is in kelvin: 100.0 degC would be "
+                     "373.15 K)"),
+    ((0.006, 1000.5), "theta_cs = 1000.5 K is outside [200, 1000] K"),
+    ((0.1, 190.0), "x_to = 0.1 m is outside [-0.002, 0.025] m; theta_cs = 190.0 K is outside [200, 1000] K "
+                   "(the input is in kelvin: 190.0 degC would be 463.15 K)"),
 ])
 def test_api_argument_errors_name_every_bad_argument(table, args, message):
     with pytest.raises(ValueError) as err:
@@ -239,7 +241,7 @@ def test_release_compliance_bound_in_the_message_is_the_rule(table):
 def test_thermal_step_refuses_bad_arguments_and_parameters():
     with pytest.raises(ValueError) as err:
         thermal_step(300.0, 400.0, -1.0, ClutchParameters(C=0.0))
-    assert str(err.value) == "dt = -1.0 is outside [0, 1e+09]; p.C = 0.0 is out of range (0, 1e+06]"
+    assert str(err.value) == "dt = -1.0 s is outside [0, 1e+09] s; p.C = 0.0 is out of range (0, 1e+06]"
 
 
 def test_cold_characteristic_error_grows_with_temperature(table):
@@ -248,7 +250,7 @@ def test_cold_characteristic_error_grows_with_temperature(table):
     torque, 312 N.m) when the spring is hot, more the hotter it is (the kiss point moves 0.56 mm towards the
     open side at 250 degC, cushion and stack growth less the release compliance; the over-delivery at 250 degC
     is 110 %, 45 % and 9.9 % at the three levels); the temperature-aware inverse has no such error."""
-    full = outputs(1.0, 20.0 + KELVIN, table, P).torque
+    full = outputs(0.025, 20.0 + KELVIN, table, P).torque
     for frac in (0.02, 0.1, 0.3):
         target = frac * full
         x_cold = x_to_for_torque(target, 20.0 + KELVIN, table, P)
@@ -264,8 +266,8 @@ def test_cold_characteristic_error_grows_with_temperature(table):
 #: (not read from the code): (low, high, low_open, high_open)
 DOCUMENTED_RANGES = {"n_surfaces": (1.0, 16.0, False, False), "mu": (0.0, 2.0, False, False),
                      "R_eq": (0.0, 1.0, True, False), "U": (0.0, 1e4, False, False), "H": (0.0, 1e4, False, False),
-                     "C": (0.0, 1e6, True, False), "theta_a": (0.0, 2000.0, True, False),
-                     "theta_cs_start": (0.0, 2000.0, True, False), "x_kiss_ref": (-1.0, 1.0, False, False),
+                     "C": (0.0, 1e6, True, False), "theta_a": (200.0, 1000.0, False, False),
+                     "theta_cs_start": (200.0, 1000.0, False, False), "x_kiss_ref": (-1.0, 1.0, False, False),
                      "lever_ratio": (0.0, 100.0, True, False)}
 
 
@@ -296,17 +298,19 @@ def test_a_spring_without_a_heat_path_is_refused():
 
 
 def test_argument_bounds(table):
-    """Closed bounds are accepted, open ones refused (x_to in [-1, 1] m, theta_cs in (0, 2000) K,
-    omega_slip in [-1e4, 1e4] rad/s, dt in [0, 1e9] s)."""
-    for x in (-1.0, 1.0):
+    """Closed bounds are accepted, values past them refused (x_to in [-0.002, 0.025] m, theta_cs in
+    [200, 1000] K, omega_slip in [-1500, 1500] rad/s, dt in [0, 1e9] s)."""
+    for x in (-0.002, 0.025):
         outputs(x, 400.0, table, P)
-    for w in (-1e4, 1e4):
+    for w in (-1500.0, 1500.0):
         outputs(0.006, 400.0, table, P, omega_slip=w)
     with pytest.raises(ValueError) as err:
-        outputs(0.006, 400.0, table, P, omega_slip=1e4 * (1 + 1e-12))
-    assert str(err.value).startswith("omega_slip = 10000.00000001 is outside [-10000, 10000]")
-    for bad in (0.0, 2000.0):
-        with pytest.raises(ValueError, match=r"^theta_cs = .* is outside \(0, 2000\)$"):
+        outputs(0.006, 400.0, table, P, omega_slip=1500.0 * (1 + 1e-12))
+    assert str(err.value).startswith("omega_slip = 1500.0000000015002 rad/s is outside [-1500, 1500] rad/s")
+    for ok in (200.0, 1000.0):
+        outputs(0.006, ok, table, P)
+    for bad in (199.999, 1000.001):
+        with pytest.raises(ValueError, match=r"^theta_cs = .* K is outside \[200, 1000\] K"):
             outputs(0.006, bad, table, P)
     assert thermal_step(300.0, 400.0, 0.0, P) == 300.0
     assert thermal_step(300.0, 400.0, 1e9, P) == pytest.approx((P.U * 400.0 + P.H * P.theta_a) / (P.U + P.H))

@@ -27,12 +27,12 @@ def test_header_lists_every_variable_in_value_reference_order():
     names = [line.strip().rstrip(",") for line in body.splitlines()[1:] if line.strip()]
     assert names == [*(enum_name(n) for n, _, _, _ in clutch_model.VARIABLES), "CC_VR_DER_THETA_CS", "CC_NVARS"]
     starts = clutch_model.start_values()
-    for name, causality, _, _ in clutch_model.VARIABLES:
+    for name, causality, unit, _ in clutch_model.VARIABLES:
         row = next(line for line in text.splitlines() if line.startswith(f'    {{"{name}", '))
         assert f"CC_{causality.upper()}, {starts[name]!r}, " in row
-        if causality == "parameter":
-            lo, hi, lo_open, hi_open = clutch_model.ClutchParameters.RANGES[name]
-            assert row.endswith(f"{{{lo!r}, {hi!r}, {int(lo_open)}, {int(hi_open)}}}}},")
+        if causality in ("parameter", "input"):
+            lo, hi, lo_open, hi_open = {**clutch_model.ClutchParameters.RANGES, **clutch_model.INPUT_RANGES}[name]
+            assert row.endswith(f'{{{lo!r}, {hi!r}, {int(lo_open)}, {int(hi_open)}}}, "{unit}"}},')
 
 
 def test_a_parameter_without_a_range_is_refused(monkeypatch):

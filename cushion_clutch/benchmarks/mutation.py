@@ -99,9 +99,9 @@ MUTANTS = (
            "        kp = kp[np.argsort(kp[:, 0])]\n", "",
            ("tests/test_spring_table.py",), "pythonfmu loader ignores the row order of kiss_point.csv"),
     Mutant("py-api-parameters", "cushion_clutch/model/clutch_model.py",
-           "            and (theta_cm is None or 0.0 < theta_cm < THETA_CM_LIMIT) and _clutch_ok(p)):\n"
+           "            and (theta_cm is None or THETA_MIN_K <= theta_cm <= THETA_MAX_K) and _clutch_ok(p)):\n"
            "        raise _argument_error({\"x_to\"",
-           "            and (theta_cm is None or 0.0 < theta_cm < THETA_CM_LIMIT)):\n"
+           "            and (theta_cm is None or THETA_MIN_K <= theta_cm <= THETA_MAX_K)):\n"
            "        raise _argument_error({\"x_to\"",
            ("tests/test_model.py",), "the Python API no longer rejects bad clutch parameters"),
     Mutant("py-writer-swap", "cushion_clutch/fe/tables.py",

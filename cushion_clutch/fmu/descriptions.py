@@ -8,6 +8,10 @@ variable ``time`` [s] (the next one, today 19). In Model Exchange ``theta_cs`` i
 the continuous state; torque, force, u_f and x_kiss depend directly on the inputs
 (ModelStructure lists the dependencies). The model is read when a description
 is written, so the descriptions follow ``VARIABLES`` as it stands.
+
+Every input and parameter carries ``min``, ``max`` and ``nominal`` from the model's one validity table
+(:func:`bounds_attributes`, from ``clutch_model.variable_bounds``); the pythonfmu backend writes the same
+attributes into its description with the same function.
 """
 from __future__ import annotations
 
@@ -44,6 +48,7 @@ def dependencies(has_friction: bool) -> dict[int, list[int]]:
     torque = cover + ([omega] if has_friction else [])
     return {_vr("torque"): sorted(torque), _vr("force"): cover, theta_cs: [theta_cs], _vr("u_f"): cover,
             _vr("x_kiss"): [theta_cm, theta_cs], _vr("clamp_force"): cover, _vr("bearing_force"): cover,
+            _vr("validity"): [theta_cm, theta_cs],
             vr_der(): [theta_cm, theta_cs]}
 
 
@@ -57,6 +62,12 @@ def _variables(x_kiss_ref_m: float | None = None):
     for vr, (name, causality, unit, desc) in enumerate(clutch_model.VARIABLES):
         yield vr, name, causality, unit, desc, starts[name] if causality in ("input", "parameter") else None
     yield vr_der(), "der(theta_cs)", "local", "K/s", "rate of change of theta_cs (paper eq. 3)", None
+
+
+def bounds_attributes(name: str) -> dict[str, str]:
+    """``min``, ``max`` and ``nominal`` (XML attribute text) of an input or parameter; {} for other variables."""
+    b = clutch_model.variable_bounds().get(name)
+    return {} if b is None else {"min": repr(b[0]), "max": repr(b[1]), "nominal": repr(b[2])}
 
 
 def _units(root: ET.Element) -> None:
@@ -106,6 +117,8 @@ def fmi2_description(guid: str, has_friction: bool, x_kiss_ref_m: float | None =
             real.set("displayUnit", "degC")
         if vr == vr_der():
             real.set("derivative", str(_vr("theta_cs") + 1))
+        for key, value in bounds_attributes(name).items():
+            real.set(key, value)
         if start is not None:
             real.set("start", repr(start))
     deps = dependencies(has_friction)
@@ -146,6 +159,7 @@ def fmi3_description(token: str, has_friction: bool, x_kiss_ref_m: float | None 
             attrs["displayUnit"] = "degC"
         if vr == vr_der():
             attrs["derivative"] = str(_vr("theta_cs"))
+        attrs.update(bounds_attributes(name))
         if start is not None:
             attrs["start"] = repr(start)
         ET.SubElement(variables, "Float64", attrs)

@@ -18,6 +18,7 @@ from xml.etree import ElementTree as ET
 from ..model import clutch_model
 from ..model.table_format import FMU_FILES
 from .constants import BASE_UNITS, FMU_SRC, SLAVE, SLAVE_MODULES
+from .descriptions import bounds_attributes
 from .guard import guard_fmu
 
 FMU_OPTIONS = dict(needsExecutionTool=False, canHandleVariableCommunicationStepSize=True,
@@ -46,6 +47,8 @@ def complete_model_description(xml_text: str) -> str:
         real.set("unit", var_units[name])
         if var_units[name] == "K":
             real.set("displayUnit", "degC")
+        for key, value in bounds_attributes(name).items():     # min, max, nominal (issue 28)
+            real.set(key, value)
         if var.get("causality") == "output":
             outputs.append(index)
     structure = root.find("ModelStructure")

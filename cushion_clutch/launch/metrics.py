@@ -25,6 +25,12 @@ Each metric measures one cause (SI units unless a name says otherwise):
     Peak-to-peak vehicle acceleration in the :data:`SHUFFLE_WINDOW_S` after
     lock-up (driveline shuffle; it includes any acceleration trend there).
 
+``peak_theta_cm_degC``, ``peak_theta_cs_degC``, ``beyond_tables_s``, ``above_damage_s``
+    Where the plant model leaves what it knows (issue 28; :func:`temperature_metrics`, from the
+    recorded time series): the peak facing and cushion-spring temperatures, the time with
+    ``theta_cs`` outside the cushion table's temperatures (the model clamps the table there) and
+    the time with the facings above ``facing_damage_temperature_K`` (validity 2).
+
 Also: cushion-spring temperature at the start and the TCU's error in it,
 kiss-point error (believed minus true, at the start), engagement time, slip
 energy, peak jerk (acceleration low-passed at 20 ms), engine stall.
@@ -39,7 +45,9 @@ METRIC_COLUMNS = ("tcu", "launch", "demand_level", "theta_cs_start_degC", "chara
                   "characteristic_error_max_Nm", "tracking_error_rms_Nm", "tracking_error_max_Nm",
                   "creep_error_Nm", "lockup_accel_step_m_s2", "shuffle_amplitude_m_s2", "kiss_point_error_mm",
                   "engagement_time_s", "slip_energy_kJ", "peak_jerk_m_s3", "engine_stall", "theta_cs_error_K",
-                  "hot", "phase")
+                  "hot", "phase", "peak_theta_cm_degC", "peak_theta_cs_degC", "beyond_tables_s", "above_damage_s")
+#: the temperature columns added by temperature_metrics
+TEMPERATURE_COLUMNS = METRIC_COLUMNS[-4:]
 #: demand up to which the creep error is taken, N.m
 CREEP_NM = 30.0
 #: windows before and after lock-up for the acceleration step, s
@@ -173,7 +181,8 @@ SUMMARY = (("characteristic_error_rms_Nm", "max"), ("characteristic_error_max_Nm
            ("tracking_error_rms_Nm", "max"), ("tracking_error_max_Nm", "max"), ("creep_error_Nm", "absmax"),
            ("lockup_accel_step_m_s2", "absmax"), ("shuffle_amplitude_m_s2", "max"),
            ("kiss_point_error_mm", "absmax"), ("theta_cs_error_K", "absmax"), ("engagement_time_s", "max"),
-           ("slip_energy_kJ", "max"))
+           ("slip_energy_kJ", "max"), ("peak_theta_cm_degC", "max"), ("peak_theta_cs_degC", "max"),
+           ("beyond_tables_s", "max"), ("above_damage_s", "max"))
 
 
 def summarise(rows: list[dict], select) -> dict:
@@ -186,10 +195,43 @@ def summarise(rows: list[dict], select) -> dict:
     out: dict = {"n": len(rows), "stalls": sum(bool(r["engine_stall"]) for r in rows),
                  "no_lockup": sum(math.isnan(r["engagement_time_s"]) for r in rows)}
     for col, how in SUMMARY:
-        vals = [r[col] for r in rows if not math.isnan(r[col])]
+        vals = [r[col] for r in rows if col in r and not math.isnan(r[col])]
         if not vals:
             out[col + "_mean"] = out[col + "_worst"] = float("nan")
             continue
         out[col + "_mean"] = sum(vals) / len(vals)
         out[col + "_worst"] = max(vals, key=abs) if how == "absmax" else max(vals)
     return out
+
+
+def temperature_metrics(series, theta_min_K: float, theta_max_K: float, damage_K: float) -> dict[int, dict]:
+    """Per launch of a recorded time series (fields ``time_s``, ``launch``, ``theta_cm_K``, ``theta_cs_K``): the
+    peak temperatures (degC) and the time (s) beyond the cushion table (``theta_cs`` outside
+    [``theta_min_K``, ``theta_max_K``]) and above the facing damage limit (``theta_cm > damage_K``).
+
+    A row stands for the time to the next recorded row (the last row of a series: none), so the times are
+    resolved to the recording interval and the peaks are those of the recorded rows.
+    """
+    t, launch = series["time_s"], series["launch"]
+    cm, cs = series["theta_cm_K"], series["theta_cs_K"]
+    out: dict[int, dict] = {}
+    for i in range(len(t)):
+        k = int(launch[i])
+        d = out.setdefault(k, {"peak_theta_cm_degC": -math.inf, "peak_theta_cs_degC": -math.inf,
+                               "beyond_tables_s": 0.0, "above_damage_s": 0.0})
+        dt = float(t[i + 1] - t[i]) if i + 1 < len(t) else 0.0
+        d["peak_theta_cm_degC"] = max(d["peak_theta_cm_degC"], float(cm[i]) - KELVIN)
+        d["peak_theta_cs_degC"] = max(d["peak_theta_cs_degC"], float(cs[i]) - KELVIN)
+        if not theta_min_K <= cs[i] <= theta_max_K:
+            d["beyond_tables_s"] += dt
+        if cm[i] > damage_K:
+            d["above_damage_s"] += dt
+    return out
+
+
+def add_temperature_metrics(metrics: list[dict], series, theta_min_K: float, theta_max_K: float,
+                            damage_K: float) -> None:
+    """Add :data:`TEMPERATURE_COLUMNS` to each launch's row of ``metrics`` (NaN for a launch not recorded)."""
+    per = temperature_metrics(series, theta_min_K, theta_max_K, damage_K)
+    for row in metrics:
+        row.update(per.get(int(row["launch"]), dict.fromkeys(TEMPERATURE_COLUMNS, math.nan)))

@@ -6,8 +6,8 @@ import math
 from pathlib import Path
 from typing import Callable, Iterable
 
-from ..model import SpringTable
-from .metrics import METRIC_COLUMNS, SUMMARY, summarise
+from ..model import ClutchParameters, SpringTable
+from .metrics import METRIC_COLUMNS, SUMMARY, add_temperature_metrics, summarise
 from .scenario import Scenario
 from .simulate import COLUMNS, LaunchResult, simulate_launches
 from .tcu import VARIANTS
@@ -20,11 +20,14 @@ GROUPS = (("hot", lambda r: r["hot"] and r["phase"] == "repeated"),
 
 def run_all(fmu: Path, sc: Scenario, table: SpringTable, variants: Iterable[str] = tuple(VARIANTS),
             progress: Callable[[str, float], None] | None = None) -> dict[str, LaunchResult]:
-    """Every TCU variant on the same scenario and plant FMU."""
+    """Every TCU variant on the same scenario and plant FMU; each launch's metrics carry the peak temperatures
+    and the time beyond the tables and above the facing damage limit (metrics.add_temperature_metrics)."""
     out = {}
+    damage = ClutchParameters().facing_damage_temperature_K
     for name in variants:
         cb = (lambda t, n=name: progress(n, t)) if progress else None
         out[name] = simulate_launches(fmu, sc, table, name, progress=cb)
+        add_temperature_metrics(out[name].metrics, out[name].series, table.theta_min_K, table.theta_max_K, damage)
     return out
 
 
@@ -65,7 +68,7 @@ def write_outputs(results: dict[str, LaunchResult], out: Path) -> list[Path]:
         w.writerow(METRIC_COLUMNS)
         for name, res in results.items():
             for m in res.metrics:
-                w.writerow([name] + [m[c] for c in METRIC_COLUMNS[1:]])
+                w.writerow([name] + [m.get(c, math.nan) for c in METRIC_COLUMNS[1:]])
     paths.append(path)
     rows = summary_rows(results)
     path = out / "launch_summary.csv"
@@ -110,6 +113,10 @@ SUMMARY_LABELS = {
     "theta_cs_error_K": ("theta_cs_error_K", ".1f"),
     "engagement_time_s": ("engagement_time_s", ".2f"),
     "slip_energy_kJ": ("slip_energy_kJ", ".1f"),
+    "peak_theta_cm_degC": ("peak_theta_cm_degC", ".0f"),
+    "peak_theta_cs_degC": ("peak_theta_cs_degC", ".0f"),
+    "beyond_tables_s": ("beyond_tables_s", ".1f"),
+    "above_damage_s": ("above_damage_s", ".1f"),
 }
 
 

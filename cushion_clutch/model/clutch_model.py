@@ -27,19 +27,21 @@ from dataclasses import dataclass, field, fields
 from functools import lru_cache
 
 try:                                    # inside the pythonfmu FMU the modules are siblings
-    from .cover import CoverMap, CoverParameters, range_problems
+    from .cover import CoverMap, CoverParameters, hold_problem, range_problems
     from .friction import FrictionTable
     from .spring_table import KELVIN, Curve, SpringTable, pchip_slopes
     from .table_format import load_csv
 except ImportError:
-    from cover import CoverMap, CoverParameters, range_problems
+    from cover import CoverMap, CoverParameters, hold_problem, range_problems
     from friction import FrictionTable
     from spring_table import KELVIN, Curve, SpringTable, pchip_slopes
     from table_format import load_csv
 
 __all__ = ["KELVIN", "VARIABLES", "ClutchParameters", "CoverParameters", "CoverMap", "cover_frame", "Outputs", "SpringTable", "FrictionTable", "Curve",
            "load_csv", "pchip_slopes", "thermal_step", "friction_coefficient", "outputs", "x_to_for_torque", "kiss_point",
-           "OMEGA_SLIP_START", "OMEGA_SLIP_LIMIT", "start_values"]
+           "OMEGA_SLIP_START", "OMEGA_SLIP_LIMIT", "start_values", "INPUT_RANGES", "X_TO_MIN", "X_TO_MAX",
+           "THETA_MIN_K", "THETA_MAX_K", "validity", "validity_warning", "table_problems", "variable_bounds",
+           "range_message"]
 
 #: The FMU interface, in value-reference order: (name, causality, unit, description).
 #: Both FMUs (pythonfmu and native C) expose exactly these; parameters take
@@ -87,15 +89,40 @@ VARIABLES = (
     ("flywheel_length_m", "parameter", "m", "flywheel, cover mounting face to friction face"),
     ("flywheel_expansion_per_K", "parameter", "1/K", "flywheel expansion coefficient"),
     ("reference_temperature_K", "parameter", "K", "temperature of E_ref and of zero thermal growth"),
+    # validity (issue 28): appended, so the value references above keep their numbers
+    ("facing_damage_temperature_K", "parameter", "K", "facing temperature above which the facings are damaged "
+                                                      "(validity = 2); seed paper: 350-400 degC"),
+    ("validity", "output", "1", "0: inside the tables; 1: a temperature beyond the tables (clamped, see docs); "
+                                "2: facing temperature above facing_damage_temperature_K"),
 )
 #: start value of the optional slip-speed input, rad/s (mu does not depend on it without a friction table)
 OMEGA_SLIP_START = 0.0
-#: largest |omega_slip| accepted by the FMUs, rad/s
-OMEGA_SLIP_LIMIT = 1e4
-#: largest |x_to| accepted by the FMUs, m (a bearing stroke is centimetres)
-X_TO_LIMIT = 1.0
-#: open upper bound of an accepted facing temperature, K
-THETA_CM_LIMIT = 2000.0
+#: largest |omega_slip| accepted, rad/s: 1500 rad/s = 14300 rpm, twice a passenger-car engine's speed limit
+#: (the gearbox input may spin against the engine)
+OMEGA_SLIP_LIMIT = 1500.0
+#: bearing stroke accepted, m: 2 mm behind the open position (actuator backlash) up to 25 mm. The default cover
+#: lifts the bearing off at 10.7 mm new and at 17.4 mm at its wear limit (2.25 mm of facing wear, 20 degC; 17.7 mm
+#: at the worst temperatures), so the stroke leaves 7.3 mm past the latest lift-off (tests/test_validity.py: >= 5 mm)
+X_TO_MIN = -0.002
+X_TO_MAX = 0.025
+#: temperatures accepted, K: below 200 K (-73 degC) a value is taken for degC typed into a kelvin input; above
+#: 1000 K the facings and the cushion spring are destroyed long before (facing damage from 623 K)
+THETA_MIN_K = 200.0
+THETA_MAX_K = 1000.0
+#: legacy names of the bounds (the pythonfmu slave): |x_to| <= X_TO_LIMIT, theta_cm < THETA_CM_LIMIT
+X_TO_LIMIT = X_TO_MAX
+THETA_CM_LIMIT = THETA_MAX_K
+#: the inputs' ranges: (low, high, low_open, high_open)
+INPUT_RANGES = {
+    "x_to": (X_TO_MIN, X_TO_MAX, False, False),
+    "theta_cm": (THETA_MIN_K, THETA_MAX_K, False, False),
+    "omega_slip": (-OMEGA_SLIP_LIMIT, OMEGA_SLIP_LIMIT, False, False),
+}
+#: nominal values (FMI ``nominal``) where the default is 0 or not a scale: the rest use |default|
+NOMINAL_OVERRIDES = {"x_to": 0.01, "theta_cm": 373.15, "omega_slip": 100.0, "facing_wear": 0.001,
+                     "x_kiss_ref": 0.004, "diaphragm_modulus_drop_per_K": 1e-4}
+#: validity codes of the output ``validity``
+VALID, BEYOND_TABLES, ABOVE_DAMAGE = 0, 1, 2
 
 
 @dataclass
@@ -113,6 +140,7 @@ class ClutchParameters:
     x_kiss_ref: float = 0.004     #: kiss point at the bearing at the table's reference temperature, m
     lever_ratio: float = 3.0      #: diaphragm-spring lever ratio, bearing travel / pressure-plate travel, 1
     facing_wear: float = 0.0      #: axial wear of the facings (both together) since new, m
+    facing_damage_temperature_K: float = 623.15   #: facing damage above (validity 2): 350 degC, seed paper, K
     cover: CoverParameters = field(default_factory=CoverParameters)  #: diaphragm-spring cover and axial stack
 
     #: allowed ranges: (low, high, low_open, high_open)
@@ -123,12 +151,13 @@ class ClutchParameters:
         "U": (0.0, 1e4, False, False),
         "H": (0.0, 1e4, False, False),
         "C": (0.0, 1e6, True, False),
-        "theta_a": (0.0, 2000.0, True, False),
-        "theta_cs_start": (0.0, 2000.0, True, False),
+        "theta_a": (THETA_MIN_K, THETA_MAX_K, False, False),
+        "theta_cs_start": (THETA_MIN_K, THETA_MAX_K, False, False),
         "x_kiss_ref": (-1.0, 1.0, False, False),
         "lever_ratio": (0.0, 100.0, True, False),
         "facing_wear": (0.0, 0.004, False, False),
         **CoverParameters.RANGES,
+        "facing_damage_temperature_K": (373.15, THETA_MAX_K, False, False),
     }
 
     def flat(self) -> dict[str, float]:
@@ -152,6 +181,28 @@ class ClutchParameters:
         if not out and self.U + self.H <= 0.0:
             out.append("U + H must be > 0 (the cushion spring needs a heat path)")
         return out + self.cover.problems(self.lever_ratio if "lever_ratio" not in " ".join(out) else None)
+
+
+def variable_bounds() -> dict[str, tuple[float, float, float]]:
+    """``(min, max, nominal)`` of every input and parameter of :data:`VARIABLES` (the FMU's modelDescription):
+    the ranges of :data:`INPUT_RANGES` and ``ClutchParameters.RANGES`` (an open bound is given as its value:
+    FMI min/max are inclusive; the model refuses the bound itself), nominal |default| or
+    :data:`NOMINAL_OVERRIDES`.
+
+    Raises
+    ------
+    KeyError
+        Naming an input or parameter without a range.
+    """
+    defaults = start_values()
+    out = {}
+    for name, causality, _, _ in VARIABLES:
+        if causality not in ("input", "parameter"):
+            continue
+        lo, hi = (INPUT_RANGES if causality == "input" else ClutchParameters.RANGES)[name][:2]
+        nominal = NOMINAL_OVERRIDES.get(name, abs(defaults[name]) or 1.0)
+        out[name] = (float(lo), float(hi), float(nominal))
+    return out
 
 
 def start_values(p: ClutchParameters | None = None) -> dict[str, float]:
@@ -185,10 +236,8 @@ def start_values(p: ClutchParameters | None = None) -> dict[str, float]:
 
 #: allowed ranges of the function arguments: (low, high, low_open, high_open)
 ARGUMENT_RANGES = {
-    "x_to": (-X_TO_LIMIT, X_TO_LIMIT, False, False),
-    "theta_cs": (0.0, THETA_CM_LIMIT, True, True),
-    "theta_cm": (0.0, THETA_CM_LIMIT, True, True),
-    "omega_slip": (-OMEGA_SLIP_LIMIT, OMEGA_SLIP_LIMIT, False, False),
+    **INPUT_RANGES,
+    "theta_cs": INPUT_RANGES["theta_cm"],
     "dt": (0.0, 1e9, False, False),
     "torque": (-1e9, 1e9, False, False),
     "tol_m": (0.0, 1.0, True, False),
@@ -199,6 +248,20 @@ def _range_text(lo: float, hi: float, lo_open: bool, hi_open: bool) -> str:
     return f"{'(' if lo_open else '['}{lo:g}, {hi:g}{')' if hi_open else ']'}"
 
 
+#: units of the function arguments (messages)
+ARGUMENT_UNITS = {"x_to": "m", "theta_cs": "K", "theta_cm": "K", "omega_slip": "rad/s", "dt": "s", "torque": "N.m",
+                  "tol_m": "m"}
+
+
+def range_message(name: str, value, unit: str, rng: tuple) -> str:
+    """``name = value unit is outside [lo, hi] unit``, plus the kelvin hint for a temperature below its range."""
+    lo, hi, lo_open, hi_open = rng[:4]
+    text = f"{name} = {value!r} {unit} is outside {_range_text(lo, hi, lo_open, hi_open)} {unit}"
+    if unit == "K" and isinstance(value, (int, float)) and value < lo:
+        text += f" (the input is in kelvin: {value!r} degC would be {value + KELVIN:g} K)"
+    return text
+
+
 def _argument_error(args: dict, p: ClutchParameters | None, names: tuple[str, ...]) -> ValueError:
     """The ValueError naming every bad argument and parameter (slow path, only on failure)."""
     problems = []
@@ -207,7 +270,7 @@ def _argument_error(args: dict, p: ClutchParameters | None, names: tuple[str, ..
         ok = isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) and (
             v > lo if lo_open else v >= lo) and (v < hi if hi_open else v <= hi)
         if not ok:
-            problems.append(f"{name} = {v!r} is outside {_range_text(lo, hi, lo_open, hi_open)}")
+            problems.append(range_message(name, v, ARGUMENT_UNITS.get(name, ""), (lo, hi, lo_open, hi_open)))
     if p is not None:
         # the function's own parameters (names), and, where it uses the cover (lever_ratio in names), every
         # problem of the cover: its ranges and its rules (they name their parameters, not always first)
@@ -228,11 +291,12 @@ def thermal_step(theta_cs: float, theta_cm: float, dt: float, p: ClutchParameter
     ------
     ValueError
         Naming the argument or parameter if one is not finite or outside its range
-        (``dt`` in [0, 1e9] s, temperatures in (0, 2000) K, ``C`` > 0, ``U + H`` > 0).
+        (``dt`` in [0, 1e9] s, temperatures in [THETA_MIN_K, THETA_MAX_K] = [200, 1000] K, ``C`` > 0,
+        ``U + H`` > 0).
     """
-    if not (0.0 < theta_cs < THETA_CM_LIMIT and 0.0 < theta_cm < THETA_CM_LIMIT and 0.0 <= dt <= 1e9
+    if not (THETA_MIN_K <= theta_cs <= THETA_MAX_K and THETA_MIN_K <= theta_cm <= THETA_MAX_K and 0.0 <= dt <= 1e9
             and 0.0 <= p.U <= 1e4 and 0.0 <= p.H <= 1e4 and 0.0 < p.C <= 1e6
-            and 0.0 < p.theta_a <= 2000.0 and p.U + p.H > 0.0):
+            and THETA_MIN_K <= p.theta_a <= THETA_MAX_K and p.U + p.H > 0.0):
         raise _argument_error({"theta_cs": theta_cs, "theta_cm": theta_cm, "dt": dt}, p,
                               ("U", "H", "C", "theta_a"))
     g = p.U + p.H
@@ -251,6 +315,7 @@ class Outputs:
     clamped: bool     #: theta_cs was outside the table and was clamped
     clamp_force: float = 0.0    #: pressure-plate (clamp) force F_pp from the cover's force balance, N
     bearing_force: float = 0.0  #: release-bearing force F_to, N
+    validity: float = 0.0       #: 0 inside the tables, 1 beyond them, 2 facings above their damage limit (validity())
 
 
 @lru_cache(maxsize=32)
@@ -305,6 +370,57 @@ def _clutch_ok(p: ClutchParameters) -> bool:
             and 0.0 <= p.facing_wear <= 0.004 and not _cover_problems(p.cover, p.lever_ratio))
 
 
+_LAST_HOLD: list = [None, None, None, None]     # table, cover, (lever, x_kiss_ref, wear), problem
+
+
+def table_problems(table: SpringTable, p: ClutchParameters) -> list[str]:
+    """The rules the parameters break together with the table: the diaphragm must hold the fully compressed
+    cushion at ``p.facing_wear`` for every temperature pair in [THETA_MIN_K, THETA_MAX_K] (:func:`cover.hold_problem`,
+    the message names the wear limit). Cached for the last table, cover and wear. Assumes ``p.problems()`` is empty."""
+    key = (p.lever_ratio, p.x_kiss_ref, p.facing_wear)
+    if not (_LAST_HOLD[0] is table and (_LAST_HOLD[1] is p.cover or _LAST_HOLD[1] == p.cover)
+            and _LAST_HOLD[2] == key):
+        problem = hold_problem(p.cover, p.lever_ratio, table, p.x_kiss_ref, p.facing_wear, THETA_MIN_K, THETA_MAX_K)
+        _LAST_HOLD[:] = [table, p.cover, key, problem]
+    return [] if _LAST_HOLD[3] is None else [_LAST_HOLD[3]]
+
+
+def _check_table_parameters(table: SpringTable, p: ClutchParameters) -> None:
+    problems = table_problems(table, p)
+    if problems:
+        raise ValueError("p: " + "; ".join(problems))
+
+
+def validity(theta_cs: float, theta_cm: float | None, table: SpringTable, p: ClutchParameters) -> int:
+    """The ``validity`` output: 2 if the facings (``theta_cm``, K) are above ``p.facing_damage_temperature_K``,
+    else 1 if ``theta_cs`` (K) is outside the cushion table's temperatures (or ``theta_cm`` outside the friction
+    table's, if the set has one), else 0. The model answers in all three (clamped tables, module docstring)."""
+    if theta_cm is not None and theta_cm > p.facing_damage_temperature_K:
+        return ABOVE_DAMAGE
+    if not table.theta_min_K <= theta_cs <= table.theta_max_K:
+        return BEYOND_TABLES
+    fr = table.friction
+    if fr is not None and theta_cm is not None and not (
+            float(fr.theta_degC[0]) + KELVIN <= theta_cm <= float(fr.theta_degC[-1]) + KELVIN):
+        return BEYOND_TABLES
+    return VALID
+
+
+def validity_warning(previous: int, current: int, theta_cs: float, theta_cm: float | None, table: SpringTable,
+                     p: ClutchParameters) -> str | None:
+    """The warning to log when ``validity`` changes from ``previous`` to a non-zero ``current`` (once per entry
+    into a region), else None."""
+    if current == previous or current == VALID:
+        return None
+    if current == ABOVE_DAMAGE:
+        return (f"facing temperature theta_cm = {theta_cm:.2f} K is above facing_damage_temperature_K = "
+                f"{p.facing_damage_temperature_K:.2f} K: the facings are being damaged; the model keeps answering "
+                "with clamped tables (validity = 2)")
+    return (f"temperature beyond the tables: theta_cs = {theta_cs:.2f} K (table [{table.theta_min_K:.2f}, "
+            f"{table.theta_max_K:.2f}] K){'' if theta_cm is None else f', theta_cm = {theta_cm:.2f} K'}; F, the kiss "
+            "shift and mu are clamped to the nearest table temperature (validity = 1; warned once per entry)")
+
+
 @lru_cache(maxsize=32)
 def _cover_problems_cached(cover: CoverParameters, lever_ratio: float) -> tuple[str, ...]:
     return tuple(cover.problems(lever_ratio))
@@ -346,16 +462,17 @@ def outputs(x_to: float, theta_cs: float, table: SpringTable, p: ClutchParameter
     ValueError
         Naming the argument or parameter if one is not finite or outside its range.
     """
-    if not (-X_TO_LIMIT <= x_to <= X_TO_LIMIT and 0.0 < theta_cs < THETA_CM_LIMIT
+    if not (X_TO_MIN <= x_to <= X_TO_MAX and THETA_MIN_K <= theta_cs <= THETA_MAX_K
             and -OMEGA_SLIP_LIMIT <= omega_slip <= OMEGA_SLIP_LIMIT
-            and (theta_cm is None or 0.0 < theta_cm < THETA_CM_LIMIT) and _clutch_ok(p)):
+            and (theta_cm is None or THETA_MIN_K <= theta_cm <= THETA_MAX_K) and _clutch_ok(p)):
         raise _argument_error({"x_to": x_to, "theta_cs": theta_cs, "omega_slip": omega_slip,
                                **({} if theta_cm is None else {"theta_cm": theta_cm})}, p, CLUTCH_PARAMETERS)
+    _check_table_parameters(table, p)
     st = cover_frame(table, p, theta_cs, theta_cs if theta_cm is None else theta_cm).state(x_to)
     clamped = not (table.theta_min_K <= theta_cs <= table.theta_max_K)
     mu = friction_coefficient(table, p, theta_cm, omega_slip)
     return Outputs(p.n_surfaces * mu * p.R_eq * st.clamp_force, st.cushion_force, max(st.u, 0.0), st.x_kiss, clamped,
-                   st.clamp_force, st.bearing_force)
+                   st.clamp_force, st.bearing_force, float(validity(theta_cs, theta_cm, table, p)))
 
 
 def kiss_point(theta_cs: float, table: SpringTable, p: ClutchParameters, theta_cm: float | None = None) -> float:
@@ -370,7 +487,7 @@ def kiss_point(theta_cs: float, table: SpringTable, p: ClutchParameters, theta_c
     ValueError
         Naming the argument or parameter if one is not finite or outside its range.
     """
-    if not (0.0 < theta_cs < THETA_CM_LIMIT and (theta_cm is None or 0.0 < theta_cm < THETA_CM_LIMIT)
+    if not (THETA_MIN_K <= theta_cs <= THETA_MAX_K and (theta_cm is None or THETA_MIN_K <= theta_cm <= THETA_MAX_K)
             and _clutch_ok(p)):
         raise _argument_error({"theta_cs": theta_cs, **({} if theta_cm is None else {"theta_cm": theta_cm})}, p,
                               CLUTCH_PARAMETERS)
@@ -395,11 +512,12 @@ def x_to_for_torque(torque: float, theta_cs: float, table: SpringTable, p: Clutc
         Naming the argument or parameter if one is not finite or outside its range
         (``torque`` in [-1e9, 1e9] N.m).
     """
-    if not (-1e9 <= torque <= 1e9 and 0.0 < theta_cs < THETA_CM_LIMIT and 0.0 < tol_m <= 1.0
+    if not (-1e9 <= torque <= 1e9 and THETA_MIN_K <= theta_cs <= THETA_MAX_K and 0.0 < tol_m <= 1.0
             and -OMEGA_SLIP_LIMIT <= omega_slip <= OMEGA_SLIP_LIMIT
-            and (theta_cm is None or 0.0 < theta_cm < THETA_CM_LIMIT) and _clutch_ok(p)):
+            and (theta_cm is None or THETA_MIN_K <= theta_cm <= THETA_MAX_K) and _clutch_ok(p)):
         raise _argument_error({"torque": torque, "theta_cs": theta_cs, "tol_m": tol_m, "omega_slip": omega_slip,
                                **({} if theta_cm is None else {"theta_cm": theta_cm})}, p, CLUTCH_PARAMETERS)
+    _check_table_parameters(table, p)
     gain = p.n_surfaces * friction_coefficient(table, p, theta_cm, omega_slip) * p.R_eq
     frame = cover_frame(table, p, theta_cs, theta_cs if theta_cm is None else theta_cm)
     return frame.x_for_clamp(torque / gain if gain > 0.0 else 0.0, tol_m)

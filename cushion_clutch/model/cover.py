@@ -70,13 +70,31 @@ pressure-plate travel, paper: 3). Arms ``L_pp = r_pp - r_f``, ``L_b = r_f - r_b 
 The forward map (``x_to`` -> ``s``) is solved by a safeguarded Newton iteration on ``s``
 bracketed by ``[s_solid, s_rigid]`` (``s_rigid`` = the ``c = 0`` answer); the inverse
 (clamp force -> ``x_to``) is explicit: the cushion table is inverted for ``u``.
+
+7. What the cover can hold (:func:`hold_problem`, :func:`wear_limit`). The balance needs
+   ``F_to >= 0`` while the cushion compresses, i.e. ``M(s) >= F_c(u(s)) L_pp`` from the kiss to
+   the solid position. Facing wear lowers ``s_solid`` by ``w e / L_pp`` onto the diaphragm's
+   falling branch; past the *wear limit* the diaphragm can no longer compress the cushion
+   fully. The limit is the smallest over the temperature box ``[THETA_MIN_K, THETA_MAX_K]^2``
+   of ``(theta_cs, theta_cm)`` (grid: every table temperature, the box edges and 25 K steps).
+   The *wear reserve* is the wear at which the closed capacity at the reference temperature,
+   ``n mu R_eq F_pp,closed``, falls below ``RESERVE_FACTOR`` times ``ENGINE_TORQUE_NM``.
+
+Release compliance (:func:`finger_compliance`): the default ``c = 1.0e-6 m/N`` is derived, not
+fitted. The diaphragm fingers' bending at the bearing gives 0.69 um/N for the default cover: each
+of ``N_FINGERS`` = 18 fingers is a cantilever clamped at ``b`` and loaded at ``r_b``, its width
+tapering linearly from ``2 pi b / N - slot`` to ``2 pi r_b / N - slot`` (slot 3 mm), thickness ``t``:
+``c_f = (1/N) int_0^L x^2 / (E I(x)) dx``, ``x`` from the load, ``I = w t^3 / 12``. The remaining
+0.31 um/N is an assumed allowance for the release bearing and the hydraulic line (a release
+system of about 3 N/um); with a different release system, set the parameter.
 """
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass, fields
 
-__all__ = ["range_problems", "CoverParameters", "CoverState", "k1", "almen_laszlo_force", "almen_laszlo_slope", "CoverMap"]
+__all__ = ["range_problems", "finger_compliance", "hold_problem", "wear_limit", "wear_reserve",
+           "ENGINE_TORQUE_NM", "RESERVE_FACTOR", "CoverParameters", "CoverState", "k1", "almen_laszlo_force", "almen_laszlo_slope", "CoverMap"]
 
 
 @dataclass(frozen=True)
@@ -84,20 +102,23 @@ class CoverParameters:
     """Diaphragm-spring cover, finger lever and axial stack (SI; temperatures in K).
 
     The default is a 240 mm passenger-car cover sized (by its geometry) for about 6.3 kN of
-    clamp load with new facings at 20 degC.
+    clamp load with new facings at 20 degC. Its installed deflection puts the diaphragm's
+    force peak mid-way through the wear reserve (issue 28): the clamp load rises with wear to
+    its peak near 0.8 mm and is back at the new load near 1.5 mm (``docs/cover_wear.png``,
+    written by ``python -m cushion_clutch.benchmarks.cover_wear``).
     """
 
     diaphragm_outer_radius_m: float = 0.1125            #: diaphragm outer radius a, m
     diaphragm_inner_radius_m: float = 0.085             #: diaphragm inner radius b (finger roots), m
-    diaphragm_thickness_m: float = 0.0026               #: diaphragm sheet thickness t, m
+    diaphragm_thickness_m: float = 0.00265              #: diaphragm sheet thickness t, m
     diaphragm_cone_height_m: float = 0.0052             #: free cone height h between the edges, m
     diaphragm_youngs_modulus_Pa: float = 206e9          #: E at reference_temperature_K, Pa
     diaphragm_modulus_drop_per_K: float = 2.7e-4  #: E(theta) = E_ref (1 - k (theta - theta_ref)), 1/K
     diaphragm_poisson_ratio: float = 0.3                #: nu, 1
     pressure_plate_radius_m: float = 0.111    #: load circle on the pressure plate r_pp, m
     fulcrum_radius_m: float = 0.089           #: cover fulcrum (pivot ring) radius r_f, m
-    installed_deflection_m: float = 0.0036    #: edge deflection s of the closed clutch, new facings, at theta_ref, m
-    release_compliance_m_per_N: float = 1.0e-6  #: finger + bearing + release-system compliance c, m/N
+    installed_deflection_m: float = 0.0041    #: edge deflection s of the closed clutch, new facings, at theta_ref, m
+    release_compliance_m_per_N: float = 1.0e-6  #: finger + bearing + release-system compliance c, m/N (see module)
     facing_thickness_m: float = 0.007         #: both facings together, m
     facing_expansion_per_K: float = 3.0e-5    #: facings' through-thickness expansion, 1/K
     pressure_plate_thickness_m: float = 0.016  #: pressure plate, friction face to diaphragm contact, m
@@ -117,7 +138,7 @@ class CoverParameters:
         "diaphragm_poisson_ratio": (0.0, 0.5, False, True),
         "pressure_plate_radius_m": (0.0, 1.0, True, False),
         "fulcrum_radius_m": (0.0, 1.0, True, False),
-        "installed_deflection_m": (0.0, 0.1, False, False),
+        "installed_deflection_m": (0.0, 0.1, True, False),
         "release_compliance_m_per_N": (0.0, 1e-3, False, False),
         "facing_thickness_m": (0.0, 0.05, False, False),
         "facing_expansion_per_K": (0.0, 1e-3, False, False),
@@ -125,7 +146,7 @@ class CoverParameters:
         "pressure_plate_expansion_per_K": (0.0, 1e-3, False, False),
         "flywheel_length_m": (0.0, 0.2, False, False),
         "flywheel_expansion_per_K": (0.0, 1e-3, False, False),
-        "reference_temperature_K": (0.0, 2000.0, True, True),
+        "reference_temperature_K": (200.0, 1000.0, False, False),
     }
 
     def problems(self, lever_ratio: float | None = None) -> list[str]:
@@ -140,6 +161,9 @@ class CoverParameters:
         if not self.diaphragm_cone_height_m < 2.0 * math.sqrt(2.0) * self.diaphragm_thickness_m:
             out.append(f"diaphragm_cone_height_m / diaphragm_thickness_m = {self.diaphragm_cone_height_m / self.diaphragm_thickness_m:g} must be < 2 sqrt(2) "
                        "(above, the diaphragm's valley force is negative: it snaps through)")
+        if self.installed_deflection_m > 2.0 * self.diaphragm_cone_height_m:
+            out.append(f"installed_deflection_m = {self.installed_deflection_m:g} must be <= 2 diaphragm_cone_height_m "
+                       f"= {2.0 * self.diaphragm_cone_height_m:g} m (past that the diaphragm is turned inside out)")
         if self.diaphragm_modulus_drop_per_K * (2000.0 - self.reference_temperature_K) >= 1.0:
             out.append("diaphragm_modulus_drop_per_K: E(theta) must stay > 0 up to 2000 K")
         if lever_ratio is not None and not out and not lever_ratio * (r_pp - r_f) < r_f:
@@ -348,7 +372,8 @@ class _Frame:
         self.fto_solid, self.fc_solid = self.f_to(s_solid)
         self.x_solid = xc - g.kb * s_solid - g.comp * self.fto_solid
         self.x_lift = self.x_solid + g.comp * max(self.fto_solid, 0.0)
-        self.x_kiss = self.x_of(s_kiss)
+        self.fto_kiss = self.f_to(s_kiss)[0]
+        self.x_kiss = xc - g.kb * s_kiss - g.comp * self.fto_kiss      # = self.x_of(s_kiss)
         if self.fto_solid < 0.0:
             raise ValueError(self._weak(self.fto_solid, "the solid position"))
 
@@ -386,8 +411,17 @@ class _Frame:
             fpp = (g.moment(self.s_solid, self.e_mod) - fto * g.L_b) / g.L_pp
             return CoverState(fpp, fto, self.fc_solid, u_full, self.s_solid, self.x_kiss, self.x_solid, self.x_lift)
         lo, hi = self.s_solid, (self.xc - x_to) / kb       # x_of(lo) > x_to >= x_of(hi)
-        s = hi
-        r = self.x_of(s) - x_to
+        # start (as the C core's, from the inputs only): the chord of x(s) between the solid and kiss points
+        # (cushion phase) or the rigid lever shifted by the kiss point's compliance (open)
+        if x_to >= self.x_kiss:
+            s = self.s_solid + (s_kiss - self.s_solid) * (self.x_solid - x_to) / (self.x_solid - self.x_kiss)
+        else:
+            s = (self.xc - x_to - comp * self.fto_kiss) / kb
+        if not lo < s < hi:
+            s = hi
+        xc = self.xc
+        fto, fc = self.f_to(s)
+        r = xc - kb * s - comp * fto - x_to                  # = self.x_of(s) - x_to
         for _ in range(100):
             if abs(r) <= tol * (1.0 + abs(x_to)) or hi - lo <= tol * (1.0 + hi):
                 break
@@ -400,8 +434,8 @@ class _Frame:
                                   + self.cushion_slope(u) * kp * g.L_pp) / g.L_b
             s_new = s - r / slope if slope < 0.0 else 0.5 * (lo + hi)
             s = s_new if lo < s_new < hi else 0.5 * (lo + hi)
-            r = self.x_of(s) - x_to
-        fto, fc = self.f_to(s)
+            fto, fc = self.f_to(s)
+            r = xc - kb * s - comp * fto - x_to
         if fto < 0.0:
             raise ValueError(self._weak(fto, f"x_to = {x_to:g} m"))
         return CoverState(fc, fto, fc, (s_kiss - s) * kp, s, self.x_kiss, self.x_solid, self.x_lift)
@@ -433,3 +467,163 @@ class _Frame:
                 u_new += 0.5 * tol if r < 0.0 else -0.5 * tol
             u = u_new if lo < u_new < hi else 0.5 * (lo + hi)
         return self.x_of(self.s_kiss - hi / g.kp)
+
+
+#: the engine torque the wear reserve is stated against (the default launch engine's peak), N.m
+ENGINE_TORQUE_NM = 240.0
+#: the wear reserve ends where the closed capacity at the reference temperature falls below this multiple
+RESERVE_FACTOR = 1.25
+#: diaphragm fingers of the default cover and the slot between two fingers (finger_compliance)
+N_FINGERS = 18
+FINGER_SLOT_M = 0.003
+
+
+def finger_compliance(cover: CoverParameters, lever_ratio: float, n_fingers: int = N_FINGERS,
+                      slot_m: float = FINGER_SLOT_M, steps: int = 400) -> float:
+    """Bending compliance of the diaphragm fingers at the release bearing, m/N (the derivation of the default
+    ``release_compliance_m_per_N``; see the module docstring).
+
+    Each finger is a cantilever clamped at the finger roots ``b`` and loaded at the bearing radius
+    ``r_b = r_f - i (r_pp - r_f)``, width tapering linearly from ``2 pi b / n - slot`` to
+    ``2 pi r_b / n - slot``, thickness ``t``, modulus ``E_ref``; the bearing force is shared by the ``n``
+    fingers: ``c = (1/n) int_0^L x^2 / (E w(x) t^3 / 12) dx`` (midpoint rule, ``x`` from the load).
+    """
+    c = cover
+    r_b = c.fulcrum_radius_m - lever_ratio * (c.pressure_plate_radius_m - c.fulcrum_radius_m)
+    length = c.diaphragm_inner_radius_m - r_b
+    w_root = 2.0 * math.pi * c.diaphragm_inner_radius_m / n_fingers - slot_m
+    w_tip = 2.0 * math.pi * r_b / n_fingers - slot_m
+    if not (length > 0.0 and w_tip > 0.0):
+        raise ValueError(f"fingers of length {length:g} m and tip width {w_tip:g} m: no cantilever")
+    total = 0.0
+    for k in range(steps):
+        x = (k + 0.5) * length / steps                  # from the load point
+        w = w_tip + (w_root - w_tip) * x / length
+        total += x * x / (c.diaphragm_youngs_modulus_Pa * w * c.diaphragm_thickness_m ** 3 / 12.0)
+    return total * length / steps / n_fingers
+
+
+def temperature_grid(table, theta_min_K: float, theta_max_K: float, step_K: float = 25.0) -> list[float]:
+    """Temperatures (K) at which :func:`hold_problem` checks the cover: the box edges, every table temperature
+    inside and ``step_K`` steps."""
+    n = int(math.ceil((theta_max_K - theta_min_K) / step_K))
+    grid = {theta_min_K + (theta_max_K - theta_min_K) * k / n for k in range(n + 1)}
+    grid |= {float(t) + 273.15 for t in table.theta_degC if theta_min_K <= float(t) + 273.15 <= theta_max_K}
+    return sorted(grid)
+
+
+#: points of the cushion phase checked by the hold rule: the solid point and 8 more towards the kiss point
+HOLD_POINTS = 9
+
+
+def _hold_forces(g: CoverMap, table, theta_cs: float) -> tuple:
+    """What the hold rule needs at one cushion temperature: (E, delta_kiss, u_full, [(u_k, F_c(u_k))]) with
+    ``u_k = u_full (HOLD_POINTS - k) / HOLD_POINTS`` (k = 0: the solid point)."""
+    th = theta_cs - 273.15
+    u_full = table.full_compression(th)
+    pts = []
+    for k in range(HOLD_POINTS):
+        u = u_full * (HOLD_POINTS - k) / HOLD_POINTS
+        pts.append((u, table.force(u, th)))
+    return g.youngs_modulus(theta_cs), table.delta_kiss(th), pts
+
+
+def _holds(g: CoverMap, wear: float, theta_cm: float, forces: tuple) -> float:
+    """The smallest bearing force (N) of the cushion phase at one temperature pair (``forces`` from
+    :func:`_hold_forces` at theta_cs): ``(M(s_k) - F_c(u_k) L_pp) / L_b`` at ``s_k = s_kiss - u_k e / L_pp``
+    (< 0: the diaphragm cannot hold the cushion)."""
+    c = g.c
+    e_mod, delta, pts = forces
+    d = theta_cm - c.reference_temperature_K
+    stack = delta + (c.facing_thickness_m * c.facing_expansion_per_K * d
+                     + c.pressure_plate_thickness_m * c.pressure_plate_expansion_per_K * d
+                     + c.flywheel_length_m * c.flywheel_expansion_per_K * d)
+    s_kiss = c.installed_deflection_m + (g._u_full_ref[1] + stack - wear) / g.kp
+    return min((g.moment(s_kiss - u / g.kp, e_mod) - f * g.L_pp) / g.L_b for u, f in pts)
+
+
+def _hold_setup(cover, lever_ratio, table, theta_min_K, theta_max_K):
+    g = CoverMap(cover, lever_ratio)
+    g.s_kiss(cover.reference_temperature_K, cover.reference_temperature_K, 0.0, table)   # caches u_full(theta_ref)
+    grid = temperature_grid(table, theta_min_K, theta_max_K)
+    forces = {a: _hold_forces(g, table, a) for a in grid}
+    return g, [(a, b, forces[a]) for a in grid for b in grid]
+
+
+def _failing(g, wear, pairs):
+    """The first (theta_cs, theta_cm, bearing force) of ``pairs`` where the diaphragm cannot hold, or None."""
+    for a, b, f in pairs:
+        fto = _holds(g, wear, b, f)
+        if fto < 0.0:
+            return a, b, fto
+    return None
+
+
+def hold_problem(cover: CoverParameters, lever_ratio: float, table, x_kiss_ref: float, wear: float,
+                 theta_min_K: float, theta_max_K: float) -> str | None:
+    """None if the diaphragm holds the cushion at ``wear`` (m) for every ``(theta_cs, theta_cm)`` of the
+    temperature box (:func:`temperature_grid`); otherwise the rule broken, with the wear limit."""
+    g, pairs = _hold_setup(cover, lever_ratio, table, theta_min_K, theta_max_K)
+    bad = _failing(g, wear, pairs)
+    if bad is None:
+        return None
+    limit = wear_limit(cover, lever_ratio, table, x_kiss_ref, theta_min_K, theta_max_K)
+    where = (f"the wear limit of this cover is {limit:.6g} m" if limit >= 0.0 else
+             "this cover cannot hold the cushion even with new facings")
+    return (f"facing_wear = {wear:g} m: the diaphragm cannot hold the fully compressed cushion "
+            f"(bearing force {bad[2]:.4g} N < 0 at theta_cs = {bad[0]:g} K, theta_cm = {bad[1]:g} K); "
+            f"{where} over theta in [{theta_min_K:g}, {theta_max_K:g}] K")
+
+
+def wear_limit(cover: CoverParameters, lever_ratio: float, table, x_kiss_ref: float, theta_min_K: float,
+               theta_max_K: float, tol_m: float = 1e-7) -> float:
+    """The largest facing wear (m, to ``tol_m``) the cover holds at every temperature pair of the box;
+    -1.0 if it cannot hold the cushion even new. Bisection on the wear (the bearing force at the solid point
+    falls with wear on the diaphragm's rising branch). ``x_kiss_ref`` does not enter (kept for the signature)."""
+    g, pairs = _hold_setup(cover, lever_ratio, table, theta_min_K, theta_max_K)
+    if _failing(g, 0.0, pairs):
+        return -1.0
+    # bisect on the binding pairs only, then check the answer on the whole grid: both predicates are monotone in
+    # the wear, so once the whole grid holds at the result, the full bisection ends in the same dyadic interval
+    active = [min(pairs, key=lambda p: _holds(g, 0.005, p[1], p[2]))]
+    while True:
+        lo, hi = 0.0, 0.01
+        while hi - lo > tol_m:
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if _failing(g, mid, active) is None else (lo, mid)
+        bad = _failing(g, lo, pairs)
+        if bad is None:
+            return lo
+        active.append(next(p for p in pairs if p[:2] == bad[:2]))
+
+
+def wear_reserve(cover: CoverParameters, lever_ratio: float, table, x_kiss_ref: float, gain_m: float,
+                 engine_torque_Nm: float = ENGINE_TORQUE_NM, factor: float = RESERVE_FACTOR,
+                 limit_m: float | None = None, tol_m: float = 1e-7) -> float:
+    """The facing wear (m) at which the closed capacity ``gain_m * F_pp,closed`` (``gain_m = n mu R_eq``) at the
+    reference temperature first falls below ``factor * engine_torque_Nm`` (scanned in 0.01 mm steps up to
+    ``limit_m``, then bisected); ``limit_m`` if it never does, 0.0 if new facings are already below."""
+    g = CoverMap(cover, lever_ratio)
+    theta = cover.reference_temperature_K
+    need = factor * engine_torque_Nm
+    top = limit_m if limit_m is not None else 0.01
+
+    def cap(w):
+        try:
+            return gain_m * g.prepare(theta, theta, w, table, x_kiss_ref).clamp_installed()
+        except ValueError:
+            return -math.inf
+
+    if cap(0.0) < need:
+        return 0.0
+    w = 0.0
+    while w < top:
+        nxt = min(w + 1e-5, top)
+        if cap(nxt) < need:
+            lo, hi = w, nxt
+            while hi - lo > tol_m:
+                mid = 0.5 * (lo + hi)
+                lo, hi = (mid, hi) if cap(mid) >= need else (lo, mid)
+            return lo
+        w = nxt
+    return top

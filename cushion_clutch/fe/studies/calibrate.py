@@ -28,7 +28,7 @@ from ..cases import DEFAULT_CACHE
 from ..params import SpringParams
 from ..sweep import run_sweep
 from ..tables import curve_from_case
-from .measured import Measured
+from .measured import U_OFFSET_LIMIT_M, Measured
 
 log = logging.getLogger(__name__)
 
@@ -223,6 +223,8 @@ class _Model:
         self.keys, self.measured, self.cache_dir = keys, measured, Path(cache_dir)
         self.jobs, self.scheduler, self.on_case = jobs, scheduler, on_case
         self.memo: dict[tuple, np.ndarray] = {}
+        #: per parameter vector: the FE kiss shift of each measured curve's temperature, m
+        self.shifts: dict[tuple, list[float]] = {}
         self.solved = self.cached = 0
 
     def forces(self, values) -> list[np.ndarray]:
@@ -244,14 +246,33 @@ class _Model:
         self.solved += len(outcomes)
         if self.on_case:
             self.on_case(self.solved)
-        out = []
+        out, shifts = [], []
         for m in self.measured:
             n = p.n_pairs if m.basis == "spring" else 1
             curves = {t: curve_from_case(o.result, n, p.sweep.kiss_force_N) for t, o in outcomes.items()}
             shift = kiss_shift(list(curves.values()), self.ref)[m.theta_degC]
+            shifts.append(float(shift))
             c = curves[m.theta_degC]
             out.append(_interp_extrapolate(m.u_m + shift, c.u_m, c.force_N))
+        self.shifts[tuple(np.round(values, 15))] = shifts
         return out
+
+
+def offset_problems(measured: Sequence[Measured], shifts: Sequence[float],
+                    u_offset_limit_m: float = U_OFFSET_LIMIT_M) -> list[str]:
+    """Every measured curve starting before the FE's first touch: a curve's compression, counted from the
+    reference temperature's kiss point, may go down to ``-(shift + u_offset_limit_m)``, where ``shift`` is the
+    kiss shift the FE predicts at its temperature (0 at the reference temperature: the plain zero offset).
+    A hot spring has grown by ``shift``, so a bench curve started where it first touches begins that much earlier.
+    """
+    out = []
+    for m, shift in zip(measured, shifts):
+        allowed = -(max(shift, 0.0) + u_offset_limit_m)
+        if float(np.min(m.u_m)) < allowed:
+            out.append(f"measured curve {m.source or '(in code)'} at {m.theta_degC:g} degC starts at u_m = "
+                       f"{float(np.min(m.u_m)):g} m; allowed >= {allowed:.4g} m (the FE kiss shift {shift:.4g} m at "
+                       f"{m.theta_degC:g} degC plus a zero offset of {u_offset_limit_m:g} m)")
+    return out
 
 
 def _interp_extrapolate(x, xp, fp) -> np.ndarray:
@@ -276,6 +297,12 @@ def calibrate(base: SpringParams, measured: Measured | Sequence[Measured], names
     ``carrier.temperature_ratio`` or ``geometry.far_end_stiffness_N_per_m`` are
     fitted by the kiss-point shift and the hot curve's shape). Parameters are
     scaled by their start values. Returns the calibrated parameter set and a report.
+
+    Raises
+    ------
+    ParameterError
+        A curve starting before the spring first touches at its temperature (:func:`offset_problems`), besides
+        the errors of :func:`fit_keys` and :func:`check_bounds`.
     """
     from scipy.optimize import least_squares
 
@@ -291,6 +318,10 @@ def calibrate(base: SpringParams, measured: Measured | Sequence[Measured], names
     model = _Model(base, keys, measured, cache_dir, jobs, scheduler, on_case)
     scales = [float(np.max(m.force_N)) for m in measured]
     t0 = time.perf_counter()
+    model.forces(x0)                               # the start: its kiss shifts bound each curve's zero offset
+    problems = offset_problems(measured, model.shifts[tuple(np.round(x0, 15))])
+    if problems:
+        raise ParameterError(problems)
 
     def rel(forces) -> np.ndarray:
         return np.concatenate([(f - m.force_N) / sc for f, m, sc in zip(forces, measured, scales)])

@@ -20,6 +20,10 @@ from ...errors import ParameterError, TableError
 
 #: a raw curve may start this far before the kiss point (zero offset of the bench's travel), m
 U_OFFSET_LIMIT_M = 0.2e-3
+#: a hot curve (measured from the reference temperature's kiss point) may begin where the hot spring first
+#: touches, earlier by its kiss shift: read down to this, then checked against the FE's kiss shift at its temperature
+#: by :func:`cushion_clutch.fe.studies.calibrate.offset_problems`, m
+HOT_U_READ_LIMIT_M = 2e-3
 #: ... and its force may dip this far below zero (load-cell zero offset), fraction of its largest force
 F_OFFSET_LIMIT = 0.05
 
@@ -50,11 +54,12 @@ class Measured:
     source: str = ""
 
 
-def read_measured(path: str | Path, basis: str = "pair", theta_degC: float = 20.0) -> Measured:
+def read_measured(path: str | Path, basis: str = "pair", theta_degC: float = 20.0,
+                  u_offset_limit_m: float = U_OFFSET_LIMIT_M) -> Measured:
     """Read and check a measured curve CSV with the header ``u_m,force_N``, keeping it as measured.
 
     Noise, points where the force falls, repeated or backward u and a small
-    zero offset (u down to ``-U_OFFSET_LIMIT_M``, force down to
+    zero offset (u down to ``-u_offset_limit_m``, default ``U_OFFSET_LIMIT_M``; force down to
     ``-F_OFFSET_LIMIT`` of the largest force) are accepted and fitted as they are.
 
     Raises
@@ -89,10 +94,10 @@ def read_measured(path: str | Path, basis: str = "pair", theta_degC: float = 20.
     f_max = float(np.max(a[:, 1]))
     if f_max <= 0:
         raise TableError(f"{path}: force_N never rises above 0 N")
-    if np.min(a[:, 0]) < -U_OFFSET_LIMIT_M:
+    if np.min(a[:, 0]) < -u_offset_limit_m:
         i = int(np.argmin(a[:, 0])) + 2
         raise TableError(f"{path}, line {i}: u_m = {a[i - 2, 0]:g} m; u_m is the compression from the kiss "
-                         f"point, allowed >= {-U_OFFSET_LIMIT_M:g} m (a small zero offset)")
+                         f"point, allowed >= {-u_offset_limit_m:g} m (a small zero offset)")
     if np.min(a[:, 1]) < -F_OFFSET_LIMIT * f_max:
         i = int(np.argmin(a[:, 1])) + 2
         raise TableError(f"{path}, line {i}: force_N = {a[i - 2, 1]:g} N, below the allowed zero offset "
@@ -131,4 +136,6 @@ def parse_measured(items: Sequence[str], basis: str = "pair",
                         "(hot curves are measured from its kiss point)")
     if problems:
         raise ParameterError(problems)
-    return [read_measured(f, basis, t) for t, f in out]
+    # hot curves may start earlier by the kiss shift: calibrate checks them against the FE's (issue 28)
+    return [read_measured(f, basis, t, U_OFFSET_LIMIT_M if t == reference_degC else HOT_U_READ_LIMIT_M)
+            for t, f in out]

@@ -185,13 +185,13 @@ class CushionClutch(Fmi2Slave):
         problems += [f"parameter {p}" for p in params.problems()]
         if not problems:                # issue 28: what the cover cannot hold with this table (the wear limit)
             problems += [f"parameter {p}" for p in table_problems(self._table, params)]
-        self.theta_cs = params.theta_cs_start
         self._dirty = True
-        if problems:
+        if problems:                    # as the native FMU: theta_cs as it was, the outputs zero
             self._refuse("fmi2ExitInitializationMode", problems)
-            self.torque = self.force = self.u_f = self.clamp_force = self.bearing_force = 0.0
+            self.torque = self.force = self.u_f = self.clamp_force = self.bearing_force = self.validity = 0.0
             self._phase = "error"
             return
+        self.theta_cs = params.theta_cs_start
         self._params = params
         if not self._input_problems():
             self._update_outputs("fmi2ExitInitializationMode")

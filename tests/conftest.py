@@ -52,3 +52,29 @@ def wine_env(tmp_path_factory):
     env = dict(os.environ, WINEPREFIX=str(prefix), WINEDEBUG="-all", WINEDLLOVERRIDES="mscoree,mshtml=")
     subprocess.run([str(WINE), "wineboot", "--init"], env=env, capture_output=True, timeout=300)
     return env
+
+
+_FMPY_LOGGER = []     # fmpy's default printer behind its printf proxy, kept for the whole session
+
+
+@pytest.fixture(autouse=True)
+def _fmpy_logger_proxy():
+    """Point fmpy's native printf proxy back at a logger that lives as long as the session.
+
+    fmpy's ``logging`` library keeps ONE global pointer to the Python logger of the last
+    ``addLoggerProxy`` call; ``simulate_fmu`` (and any custom callbacks) leave it pointing at a logger
+    that is freed when they return. An instance made later with fmpy's default callbacks then calls a
+    freed function as soon as the FMU logs: the native FMU logs its Warnings whatever ``loggingOn``
+    (issue 28), so a test of it after such a test crashed the interpreter. Our code is not involved.
+    """
+    from ctypes import byref
+
+    from fmpy.fmi2 import fmi2CallbackFunctions, fmi2CallbackLoggerTYPE, printLogMessage
+    from fmpy.logging import addLoggerProxy
+
+    if not _FMPY_LOGGER:
+        _FMPY_LOGGER.extend([fmi2CallbackFunctions(), fmi2CallbackLoggerTYPE(printLogMessage)])
+    cb, printer = _FMPY_LOGGER
+    cb.logger = printer               # addLoggerProxy swaps in its proxy: give it the printer each time
+    addLoggerProxy(byref(cb))
+    yield

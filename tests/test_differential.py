@@ -85,20 +85,27 @@ def test_an_output_read_right_after_set_follows_the_input(fmus):
 
 
 def test_a_refused_value_is_forgotten_once_a_valid_one_comes(fmus):
-    """Issue 31's example: worn facings (2.5 mm) and a hot start (573.15 K) where the cover cannot hold, then
-    theta_cm = 1700 K and x_to = 12 mm: both FMUs recover and step (the pythonfmu FMU used to keep the
-    refusal forever)."""
+    """Issue 31's example, on the cover of issue 28: worn facings (2.5 mm, past this cover's wear limit) and a
+    hot start are refused at initialisation with fmi2Error in both FMUs; after fmi2Reset a valid start works,
+    a refused input (x_to = 0.1 m) is discarded, and the next valid input recovers (the pythonfmu FMU used to
+    keep a refusal forever)."""
+    answers = []
     for fmu in fmus[:2]:
         fmu.instantiate()
         try:
-            assert fmu.init(0.0, {"facing_wear": 2.5e-3, "theta_cs_start": 573.15}) == [0, 0, 0, 0]
-            assert fmu.step(0.0, 0.1) == 2                     # the cover cannot hold: discarded
-            assert fmu.set({"theta_cm": 1700.0, "x_to": 0.012}) == 0
+            assert fmu.init(0.0, {"facing_wear": 2.5e-3, "theta_cs_start": 573.15})[-1] == 3, fmu.label
+            assert fmu.reset() == 0
+            assert fmu.init(0.0, {"facing_wear": 2.0e-3, "theta_cs_start": 573.15}) == [0, 0, 0, 0], fmu.label
+            assert fmu.set({"x_to": 0.1}) == 0
+            assert fmu.step(0.0, 0.1) == 2, fmu.label              # refused input: discarded
+            assert fmu.set({"theta_cm": 900.0, "x_to": 0.012}) == 0
             status, (torque,) = fmu.get(["torque"])
-            assert status == 0 and torque == pytest.approx(65.188, abs=1e-3), fmu.label
-            assert fmu.step(0.0, 0.1) == 0
+            assert status == 0 and torque > 0.0, fmu.label
+            assert fmu.step(0.0, 0.1) in (0, 1), fmu.label         # steps again (a Warning: beyond the tables)
+            answers.append(torque)
         finally:
             fmu.free()
+    assert answers[0] == pytest.approx(answers[1], rel=1e-9)
 
 
 def test_error_and_warning_statuses_are_the_native_ones(fmus):

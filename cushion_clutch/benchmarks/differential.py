@@ -124,6 +124,10 @@ class _Log:
 _LOGS: dict[str, _Log] = {}
 
 
+#: the ctypes logger given to fmpy's printf proxy (never freed: the proxy holds it in a C global)
+_LOGGER_C = None
+
+
 def _fmi2_logger(env, instance, status, category, message):
     log = _LOGS.get((instance or b"").decode("utf-8", "replace"))
     if log is not None:
@@ -163,9 +167,11 @@ class Fmi2CS:
                                fmi2CallbackLoggerTYPE)
         from fmpy.logging import addLoggerProxy
 
+        global _LOGGER_C
         cb = fmi2CallbackFunctions()
-        self._logger = fmi2CallbackLoggerTYPE(_fmi2_logger)     # kept alive with the instance
-        cb.logger = self._logger
+        if _LOGGER_C is None:   # one for the process: fmpy's proxy keeps a global pointer to the last one
+            _LOGGER_C = fmi2CallbackLoggerTYPE(_fmi2_logger)
+        cb.logger = _LOGGER_C
         cb.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
         cb.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
         addLoggerProxy(byref(cb))                           # fmpy formats the printf message

@@ -103,7 +103,9 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
     else:
         ctl = TcuController(VARIANTS[name], sc, table, p, theta0, dl.j_d, dl.t_load_rest, dl.j_e, engine.w_idle)
         sense = None
-    net = ThermalNetwork(sc.plant_thermal, theta_a, theta0) if sc.plant_thermal.enabled else None
+    # the plant's thermal network (a prescribed profile_csv overrides it; disabled: the lumped facing)
+    net = ThermalNetwork(sc.plant_thermal, theta_a, theta0) if sc.plant_thermal.enabled and not fac.profile_csv \
+        else None
     net_every = max(1, int(round(tc.period_s / h)))     # the network's time constants are seconds: 10 ms steps
     net_n, net_e = 0, 0.0
     sensors = SpeedSensors(sc.sensors)

@@ -320,15 +320,24 @@ class ThermalNetwork:
         return a / c[:, None], np.array(sink_g) * np.array(sink_t) / c
 
     def step(self, dt: float, p_slip_W: float, w_engine: float, w_disc: float, clamped: bool) -> None:
-        """Advance ``dt`` s with the slip power (W), speeds (rad/s) and clamp state held."""
-        links, sink_g, sink_t = self.conductances(w_engine, w_disc, clamped)
-        th, caps, shares = self.theta, self.caps, self.shares
+        """Advance ``dt`` s with the slip power (W), speeds (rad/s) and clamp state held.
+
+        The same conductances as :meth:`conductances`, evaluated inline (this runs every TCU period).
+        """
+        p, c = self.p, self.coef
+        links = [la + lc for la, lc in zip(c["link_always"], c["link_clamped"])] if clamped else c["link_always"]
+        wr = p.convection_reference_rad_s
+        h0, hr = p.still_air_W_per_m2_K, p.rotating_W_per_m2_K
+        hs = (h0 + hr * (abs(w_engine) / wr) ** 0.8, h0 + hr * (abs(w_disc) / wr) ** 0.8)
+        theta_e, ta = p.engine_degC + KELVIN, self.theta_a
+        th, caps, shares, area, eng = self.theta, self.caps, self.shares, c["area_cooled"], c["engine"]
         last = N_NODES - 1
         for i in range(N_NODES):
             gl = links[i - 1] if i > 0 else 0.0
             gr = links[i] if i < last else 0.0
-            gs = gl + gr + sink_g[i]
-            flow = shares[i] * p_slip_W + sink_g[i] * sink_t[i] + (gl * th[i - 1] if i > 0 else 0.0) + \
+            conv = area[i] * hs[SPEED_OF_NODE[i]]
+            gs = gl + gr + conv + eng[i]
+            flow = shares[i] * p_slip_W + conv * ta + eng[i] * theta_e + (gl * th[i - 1] if i > 0 else 0.0) + \
                 (gr * th[i + 1] if i < last else 0.0)
             if gs > 0.0:
                 inf = flow / gs

@@ -1,7 +1,7 @@
 """Benchmark: real-time factor of a launch scenario for every TCU variant, or the README's launch tables.
 
     python -m cushion_clutch.benchmarks.launch [--scenario NAME|FILE] [--backend native|python] [--repeat N]
-    python -m cushion_clutch.benchmarks.launch --markdown [--scenarios default,creep,cooldown,fade,wear,tolerance]
+    python -m cushion_clutch.benchmarks.launch --markdown [--scenarios default,trailer,creep,cooldown,fade,wear,tolerance]
 
 The first form also times one FMU step (set inputs, doStep, get outputs)
 through the master's cffi client and through fmpy's ``FMU2Slave`` in the
@@ -125,7 +125,7 @@ def main(argv=None) -> None:
     ap.add_argument("--backend", default="native", choices=("native", "python"))
     ap.add_argument("--repeat", type=int, default=1, help="runs per variant; the median is printed")
     ap.add_argument("--markdown", action="store_true", help="print the README's launch results tables")
-    ap.add_argument("--scenarios", default="default,creep,cooldown,fade,wear,tolerance", help="with --markdown")
+    ap.add_argument("--scenarios", default="default,trailer,creep,cooldown,fade,wear,tolerance", help="with --markdown")
     args = ap.parse_args(argv)
     if args.markdown:
         for part in markdown(args.scenarios.split(","), args.backend):

@@ -181,3 +181,22 @@ def test_temperatures_are_corrected_only_above_their_torque(table):
         assert (not np.array_equal(ekf.s[:5], s0[:5])) == thermal
         assert (ekf.s[IX_LOSS] != s0[IX_LOSS]) == thermal          # facings 100 K above ambient
         assert ekf.s[IX_DX] != s0[IX_DX] or torque > EkfParams().touch_torque_max_Nm
+
+
+def test_discretisation_matches_scipy_expm():
+    """The EKF's scaling-and-squaring exponential of its network (9 temperatures, surface layers at 0.2 s)."""
+    from scipy.linalg import expm
+
+    from cushion_clutch.launch.ekf import N_T, _exp_and_integral
+
+    table = load_table()
+    ekf = ClutchEkf(TcuNetworkParams(), EkfParams(), table, ClutchParameters(), TA, TA)
+    a_link, a_sink, _, _ = ekf._parts(190.0, 60.0, True)
+    a = a_link + np.diag(1.3 * a_sink)
+    for dt in (0.01, 0.1, 1.0):
+        phi, psi = _exp_and_integral(a, dt)
+        aug = np.zeros((2 * N_T, 2 * N_T))
+        aug[:N_T, :N_T], aug[:N_T, N_T:] = a * dt, np.eye(N_T) * dt
+        ref = expm(aug)
+        assert np.max(np.abs(phi - ref[:N_T, :N_T])) < 1e-12
+        assert np.max(np.abs(psi - ref[:N_T, N_T:])) < 1e-12 * dt

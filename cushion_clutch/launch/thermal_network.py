@@ -271,7 +271,7 @@ class ThermalNetwork:
         Temperature of every node at the start, K.
     """
 
-    __slots__ = ("p", "theta_a", "theta", "caps", "coef", "shares")
+    __slots__ = ("p", "theta_a", "theta", "caps", "coef", "shares", "_cache")
 
     def __init__(self, p: NetworkParams, theta_a: float, theta0: float):
         self.p, self.theta_a = p, theta_a
@@ -279,6 +279,7 @@ class ThermalNetwork:
         self.caps = list(self.coef["caps"])
         self.shares = list(self.coef["shares"])
         self.theta = [theta0] * N_NODES
+        self._cache: dict = {}
 
     @property
     def theta_cm(self) -> float:
@@ -319,31 +320,63 @@ class ThermalNetwork:
         a[np.diag_indices(N_NODES)] = -(g.sum(axis=1) + np.array(sink_g))
         return a / c[:, None], np.array(sink_g) * np.array(sink_t) / c
 
+    def _table(self, clamped: bool) -> tuple:
+        """Per node ``(cap, g_left, g_right, area_cooled, speed index, g_engine * theta_engine, g_fixed, share)``
+        for one clamp state (``g_fixed``: links and engine, the part of the node's conductance without speed)."""
+        c = self.coef
+        links = [la + lc for la, lc in zip(c["link_always"], c["link_clamped"])] if clamped else c["link_always"]
+        theta_e = self.p.engine_degC + KELVIN
+        rows = []
+        for i in range(N_NODES):
+            gl = links[i - 1] if i > 0 else 0.0
+            gr = links[i] if i < N_NODES - 1 else 0.0
+            rows.append((self.caps[i], gl, gr, c["area_cooled"][i], SPEED_OF_NODE[i], c["engine"][i] * theta_e,
+                         gl + gr + c["engine"][i], self.shares[i]))
+        return tuple(rows)
+
     def step(self, dt: float, p_slip_W: float, w_engine: float, w_disc: float, clamped: bool) -> None:
         """Advance ``dt`` s with the slip power (W), speeds (rad/s) and clamp state held.
 
-        The same conductances as :meth:`conductances`, evaluated inline (this runs every TCU period).
+        The same conductances as :meth:`conductances`, evaluated inline (this runs every TCU period); the
+        decay factors of the nodes without convection are cached per step and clamp state (``shares`` and
+        ``caps`` are read at the first step).
         """
-        p, c = self.p, self.coef
-        links = [la + lc for la, lc in zip(c["link_always"], c["link_clamped"])] if clamped else c["link_always"]
+        key = (clamped, dt)
+        cache = self._cache
+        hit = cache.get(key)
+        if hit is None:
+            rows = self._table(clamped)
+            fixed = tuple(math.exp(-dt * r[6] / r[0]) if r[3] == 0.0 and r[6] > 0.0 else None for r in rows)
+            hit = cache[key] = (rows, fixed)
+        rows, fixed = hit
+        p = self.p
         wr = p.convection_reference_rad_s
         h0, hr = p.still_air_W_per_m2_K, p.rotating_W_per_m2_K
         hs = (h0 + hr * (abs(w_engine) / wr) ** 0.8, h0 + hr * (abs(w_disc) / wr) ** 0.8)
-        theta_e, ta = p.engine_degC + KELVIN, self.theta_a
-        th, caps, shares, area, eng = self.theta, self.caps, self.shares, c["area_cooled"], c["engine"]
-        last = N_NODES - 1
+        ta = self.theta_a
+        th = self.theta
+        left = 0.0
         for i in range(N_NODES):
-            gl = links[i - 1] if i > 0 else 0.0
-            gr = links[i] if i < last else 0.0
-            conv = area[i] * hs[SPEED_OF_NODE[i]]
-            gs = gl + gr + conv + eng[i]
-            flow = shares[i] * p_slip_W + conv * ta + eng[i] * theta_e + (gl * th[i - 1] if i > 0 else 0.0) + \
-                (gr * th[i + 1] if i < last else 0.0)
+            cap, gl, gr, area, sp, ge_te, gfix, share = rows[i]
+            flow = share * p_slip_W + ge_te
+            if gl:
+                flow += gl * left
+            if gr:
+                flow += gr * th[i + 1]
+            decay = fixed[i]
+            if decay is None:
+                conv = area * hs[sp]
+                gs = gfix + conv
+                flow += conv * ta
+                if gs > 0.0:
+                    decay = math.exp(-dt * gs / cap)
+            else:
+                gs = gfix
             if gs > 0.0:
                 inf = flow / gs
-                th[i] = inf + (th[i] - inf) * math.exp(-dt * gs / caps[i])
+                left = th[i] = inf + (th[i] - inf) * decay
             else:
-                th[i] += flow * dt / caps[i]
+                left = th[i] = th[i] + flow * dt / cap
 
 
 @dataclass(frozen=True)

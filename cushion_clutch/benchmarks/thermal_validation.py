@@ -149,8 +149,8 @@ def main(argv: list[str] | None = None) -> None:
                   f"{x['pressure_plate_start_degC']:6.1f} | {x['theta_cs_start_degC']:6.1f}")
         s = runs[name].series
         print(f"  max: theta_cm {s['theta_cm_K'].max() - KELVIN:.1f} degC, surface "
-              f"{s['theta_surface_K'].max() - KELVIN:.1f} degC, pressure plate {s['theta_pressure_plate_K'].max() - KELVIN:.1f}"
-              f" degC, theta_cs {s['theta_cs_K'].max() - KELVIN:.1f} degC")
+              f"{s['theta_surface_K'].max() - KELVIN:.1f} degC, pressure plate "
+              f"{s['theta_pressure_plate_K'].max() - KELVIN:.1f} degC, theta_cs {s['theta_cs_K'].max() - KELVIN:.1f} degC")
     print(f"\ndefault on the lumped 450 J/K facing: theta_cm max {lumped.series['theta_cm_K'].max() - KELVIN:.1f} degC,"
           f" theta_cs max {lumped.series['theta_cs_K'].max() - KELVIN:.1f} degC")
     worst = float(np.max(np.abs(rise[t >= 0.25] - closed[t >= 0.25]) / closed[t >= 0.25]))

@@ -105,25 +105,25 @@ def test_parameters_are_checked():
     assert "ekf.scale_min" in str(err.value) and "ekf.loss_scale_sd" in str(err.value)
 
 
-def lumped_pair(tcu_loss_factor):
-    """A lumped plant mapped onto the network (450 J/K, 1.35 W/K, all slip heat into the facings) and the
-    TCU's copy with its heat-loss conductance times ``tcu_loss_factor`` (everything else matched)."""
-    lumped = dict(facing_capacity_J_per_K=225.0, convection_gain_at_reference=1.0,
-                  metal_effusivity_W_s05_per_m2_K=1.0, contact_W_per_K=0.0, disc_W_per_K=100.0,
-                  engine_W_per_K=0.0)
-    return (NetworkParams(facing_convection_W_per_K=0.675, **lumped),
-            TcuNetworkParams(facing_convection_W_per_K=0.675 * tcu_loss_factor, **lumped))
+def network_pair(tcu_loss_factor):
+    """The plant's physical network and the TCU's copy with every heat-loss conductance (still air,
+    rotating, engine block) times ``tcu_loss_factor`` (everything else matched)."""
+    plant, matched = matched_network()
+    tcu = dataclasses.replace(matched, still_air_W_per_m2_K=plant.still_air_W_per_m2_K * tcu_loss_factor,
+                              rotating_W_per_m2_K=plant.rotating_W_per_m2_K * tcu_loss_factor,
+                              engine_W_per_K=plant.engine_W_per_K * tcu_loss_factor)
+    return plant, tcu
 
 
 def hot_launches_then_cool_down(table, e, tcu_loss_factor, hot=8, cool=3):
-    """Launches of 3 s slip at 50 rad/s (10 to 150 N.m, then 150 N.m) every 60 s, then every 300 s;
+    """Launches of 3 s slip at 150 rad/s (10 to 150 N.m, then 150 N.m) every 60 s, then every 300 s;
     the measured torque is the exact model at the plant's temperatures. Returns the EKF and the
     theta_cs error (estimate minus truth) at the start of every launch, K."""
-    plant, tcu = lumped_pair(tcu_loss_factor)
+    plant, tcu = network_pair(tcu_loss_factor)
     p = ClutchParameters()
     net = ThermalNetwork(plant, TA, TA)
     ekf = ClutchEkf(tcu, e, table, p, TA, TA)
-    theta_cs, errors, dt, w_slip = TA, [], 0.1, 50.0
+    theta_cs, errors, dt, w_slip = TA, [], 0.1, 150.0
     ramp = np.concatenate([np.linspace(10.0, 150.0, 20), np.full(10, 150.0)])
     for period in [60.0] * hot + [300.0] * cool:
         errors.append(ekf.theta_cs - theta_cs)
@@ -145,17 +145,19 @@ def hot_launches_then_cool_down(table, e, tcu_loss_factor, hot=8, cool=3):
 
 
 def test_augmented_ekf_learns_a_heat_loss_mismatch(table):
-    """The TCU's network loses 20 % too little heat (true loss scale 1.25): the scale is learned from the
-    torque (through the temperatures' covariance with it) and halves the cool-down error."""
+    """The TCU's network loses 20 % too little heat (true loss scale 1.25): the scale moves towards it from
+    the torque (through the temperatures' covariance with it) and cuts the cool-down error. On the physical
+    network (most heat in the metal, cooling over minutes) the error it corrects is a few kelvin only, so the
+    scale is learned in part (1.10 after eight launches and three cool-downs)."""
     e = EkfParams(torque_sd_Nm=0.5)                 # the synthetic torque is exact: a good torque sensor
     ekf, err = hot_launches_then_cool_down(table, e, 0.8)
     fixed, err_fixed = hot_launches_then_cool_down(table, dataclasses.replace(e, loss_scale_sd=0.0), 0.8)
     assert fixed.loss_scale == 1.0
-    assert 1.1 < ekf.loss_scale < 1.35
-    assert np.sqrt(ekf.P[IX_LOSS, IX_LOSS]) < 0.6 * e.loss_scale_sd          # it was informative
+    assert 1.05 < ekf.loss_scale < 1.35
+    assert np.sqrt(ekf.P[IX_LOSS, IX_LOSS]) < 0.85 * e.loss_scale_sd         # it was informative
     cool = slice(-3, None)                          # the cool-down launches
-    assert max(abs(x) for x in err_fixed[cool]) > 8.0                      # K: the wrong losses, unlearned
-    assert max(abs(x) for x in err[cool]) < 0.5 * max(abs(x) for x in err_fixed[cool])
+    assert max(abs(x) for x in err_fixed[cool]) > 4.0                      # K: the wrong losses, unlearned
+    assert max(abs(x) for x in err[cool]) < 0.8 * max(abs(x) for x in err_fixed[cool])
 
 
 def test_matched_network_keeps_its_scales(table):
@@ -179,3 +181,22 @@ def test_temperatures_are_corrected_only_above_their_torque(table):
         assert (not np.array_equal(ekf.s[:5], s0[:5])) == thermal
         assert (ekf.s[IX_LOSS] != s0[IX_LOSS]) == thermal          # facings 100 K above ambient
         assert ekf.s[IX_DX] != s0[IX_DX] or torque > EkfParams().touch_torque_max_Nm
+
+
+def test_discretisation_matches_scipy_expm():
+    """The EKF's scaling-and-squaring exponential of its network (9 temperatures, surface layers at 0.2 s)."""
+    from scipy.linalg import expm
+
+    from cushion_clutch.launch.ekf import N_T, _exp_and_integral
+
+    table = load_table()
+    ekf = ClutchEkf(TcuNetworkParams(), EkfParams(), table, ClutchParameters(), TA, TA)
+    a_link, a_sink, _, _ = ekf._parts(190.0, 60.0, True)
+    a = a_link + np.diag(1.3 * a_sink)
+    for dt in (0.01, 0.1, 1.0):
+        phi, psi = _exp_and_integral(a, dt)
+        aug = np.zeros((2 * N_T, 2 * N_T))
+        aug[:N_T, :N_T], aug[:N_T, N_T:] = a * dt, np.eye(N_T) * dt
+        ref = expm(aug)
+        assert np.max(np.abs(phi - ref[:N_T, :N_T])) < 1e-12
+        assert np.max(np.abs(psi - ref[:N_T, N_T:])) < 1e-12 * dt

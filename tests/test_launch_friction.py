@@ -67,7 +67,9 @@ def test_fade_table_lowers_the_torque_by_its_ratio(tmp_path):
 
 def test_fade_scenario_delivers_less_torque_when_hot(tmp_path):
     sc = load_scenario(scenario_path("fade"))
-    sc = dataclasses.replace(short(sc, launches=2, initial_degC=300.0))
+    drive = sc.tcu.drive_time_s               # trailer duty: the constant-mu launches lock up after 4-6.5 s
+    sc = short(sc, launches=2, initial_degC=300.0)
+    sc = dataclasses.replace(sc, tcu=dataclasses.replace(sc.tcu, drive_time_s=drive))
     fmu = build_plant_fmu(DEFAULT_TABLES, sc, tmp_path / "fade.fmu")
     plain = build_fmu(DEFAULT_TABLES, tmp_path / "p" / "plain.fmu")
     fade = simulate_launches(fmu, sc, load_table(), "aware").metrics
@@ -76,4 +78,4 @@ def test_fade_scenario_delivers_less_torque_when_hot(tmp_path):
         assert f["characteristic_error_rms_Nm"] > c["characteristic_error_rms_Nm"] + 5.0
         # the closed slip loop pushes the bearing further; the engine does not stall (a faded clutch may
         # not hold a hard launch's engine torque at all: then no lock-up, reported as NaN)
-        assert not f["engine_stall"] and c["engagement_time_s"] < 6.0
+        assert not f["engine_stall"] and c["engagement_time_s"] < drive

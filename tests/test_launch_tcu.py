@@ -10,7 +10,8 @@ from cushion_clutch.fmu.build import build_fmu
 from cushion_clutch.data import DEFAULT_TABLES
 from cushion_clutch.model import load_table
 from cushion_clutch.launch.fmu_client import ClutchFmu
-from cushion_clutch.launch.scenario import load_scenario
+from cushion_clutch.launch.scenario import load_scenario, scenario_path
+from cushion_clutch.launch.thermal_network import NetworkParams
 from cushion_clutch.launch.tcu_params import Observer
 from cushion_clutch.launch.simulate import simulate_launches
 
@@ -30,23 +31,24 @@ def quiet(sc):
 
 
 def matched(sc):
-    f = sc.facing
-    return dataclasses.replace(sc, observer=Observer(capacity_J_per_K=f.capacity_J_per_K,
-                                                     loss_W_per_K=f.loss_W_per_K, heat_share=f.heat_share))
+    """The observer's network with the plant's parameters."""
+    p = sc.plant_thermal
+    return dataclasses.replace(sc, observer=Observer(**{f.name: getattr(p, f.name)
+                                                        for f in dataclasses.fields(NetworkParams)}))
 
 
 def test_observer_with_matched_parameters_reproduces_theta_cm(fmu):
-    sc = quiet(matched(short(load_scenario(), launches=3)))
+    sc = quiet(matched(short(load_scenario(scenario_path("trailer")), launches=3)))
     s = simulate_launches(fmu, sc, load_table(), "aware_estimated").series
     rise = s["theta_cm_K"].max() - s["theta_cm_K"][0]
-    assert rise > 60.0                                    # it did heat up
+    assert rise > 30.0                                    # it did heat up
     assert np.max(np.abs(s["theta_cm_tcu_K"] - s["theta_cm_K"])) < 0.5
     assert np.max(np.abs(s["theta_cs_tcu_K"] - s["theta_cs_K"])) < 0.5
 
 
 def test_observer_with_mismatch_stays_bounded_and_is_reported(fmu):
     sc = short(load_scenario(), launches=4)               # shipped mismatch (C +15 %, G -20 %) and noise
-    assert sc.observer.capacity_J_per_K != sc.facing.capacity_J_per_K
+    assert sc.observer.flywheel_capacity_J_per_K != sc.plant_thermal.flywheel_capacity_J_per_K
     res = simulate_launches(fmu, sc, load_table(), "aware_estimated")
     s = res.series
     err = np.abs(s["theta_cm_tcu_K"] - s["theta_cm_K"])
@@ -72,7 +74,7 @@ def test_adaptation_converges_to_the_true_kiss_point_at_constant_temperature(fmu
 
 
 def test_compensated_adaptation_follows_the_temperature_between_adaptations(fmu):
-    sc = short(load_scenario(), launches=4)
+    sc = short(load_scenario(scenario_path("trailer")), launches=4)
     comp = simulate_launches(fmu, sc, load_table(), "adaptive_aware_estimated")
     plain = simulate_launches(fmu, sc, load_table(), "adaptive")
     worst = lambda res: max(abs(m["kiss_point_error_mm"]) for m in res.metrics)

@@ -1,9 +1,9 @@
 """The production TCU's estimator: an extended Kalman filter on its own thermal network, with touch-point,
 mu and thermal-parameter adaptation.
 
-State (K, K, K, K, K, m, 1, 1, 1)::
+State (K for each network node and the cushion spring, m, 1, 1, 1)::
 
-    s = [theta_fw, theta_f1, theta_f2, theta_pp, theta_cs, dx_kiss, mu_scale, k_loss, k_heat]
+    s = [theta_node for the network's NODES..., theta_cs, dx_kiss, mu_scale, k_loss, k_heat]
 
 * **Prediction**: the TCU's own :class:`~.thermal_network.ThermalNetwork`
   (parameters ``[tcu_thermal]``, deliberately not the plant's) heated by
@@ -82,23 +82,22 @@ import numpy as np
 
 from ..config import Checked
 from ..model import ClutchParameters, SpringTable, outputs
-from .thermal_network import NetworkParams, ThermalNetwork
+from .thermal_network import FACINGS, N_NODES, TcuNetworkBase, ThermalNetwork
 
-IX_CS, IX_DX, IX_MU, IX_LOSS, IX_HEAT = 4, 5, 6, 7, 8   #: state indices
-N_STATE = 9
+#: state indices: the network's nodes, then these
+IX_CS, IX_DX, IX_MU, IX_LOSS, IX_HEAT = N_NODES, N_NODES + 1, N_NODES + 2, N_NODES + 3, N_NODES + 4
+N_STATE = N_NODES + 5
+N_T = N_NODES + 1          #: temperatures (the nodes and the cushion spring)
+F1, F2 = FACINGS
 #: speed band of the cached discretisation (convection), rad/s
 SPEED_BAND = 10.0
 
 
 @dataclass(frozen=True)
-class TcuNetworkParams(NetworkParams):
-    """Section ``[tcu_thermal]``: the TCU's own thermal network, mismatched with the plant's by default."""
+class TcuNetworkParams(TcuNetworkBase):
+    """Section ``[tcu_thermal]``: the TCU's own thermal network, the plant's physical network with the
+    mismatch stated in :class:`~.thermal_network.TcuNetworkBase`."""
 
-    flywheel_capacity_J_per_K: float = 2900.0
-    pressure_plate_capacity_J_per_K: float = 1700.0
-    facing_capacity_J_per_K: float = 220.0
-    contact_W_per_K: float = 6.5
-    engine_W_per_K: float = 1.6
     spring_U_W_per_K: float = 0.1
     spring_H_W_per_K: float = 0.04
     spring_C_J_per_K: float = 1.0
@@ -171,6 +170,25 @@ class EkfParams(Checked):
             yield "ekf.touch_torque_max_Nm: must exceed ekf.touch_torque_min_Nm"
 
 
+def _exp_and_integral(a: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:
+    """``(exp(A dt), int_0^dt exp(A s) ds)`` by scaling and squaring the augmented matrix ``[[A, I], [0, 0]] dt``."""
+    n = a.shape[0]
+    aug = np.zeros((2 * n, 2 * n))
+    aug[:n, :n] = a * dt
+    aug[:n, n:] = np.eye(n) * dt
+    norm = float(np.max(np.sum(np.abs(aug), axis=1)))
+    squarings = max(0, int(math.ceil(math.log2(norm / 0.25)))) if norm > 0.25 else 0
+    m = aug / 2.0 ** squarings
+    term = np.eye(2 * n)
+    e = np.eye(2 * n)
+    for k in range(1, 9):
+        term = term @ m / k
+        e = e + term
+    for _ in range(squarings):
+        e = e @ e
+    return e[:n, :n], e[:n, n:]
+
+
 class ClutchEkf:
     """EKF of the production TCU.
 
@@ -191,10 +209,10 @@ class ClutchEkf:
         self.net, self.e, self.table, self.p = net, e, table, p
         self.model = ThermalNetwork(net, theta_a, theta0)
         self.theta_a = theta_a
-        self.s = np.array([theta0] * 5 + [0.0, 1.0, 1.0, 1.0])
-        self.P = np.diag([e.theta0_sd_K ** 2] * 5 + [e.kiss_sd_m ** 2, e.mu_sd ** 2, e.loss_scale_sd ** 2,
+        self.s = np.array([theta0] * N_T + [0.0, 1.0, 1.0, 1.0])
+        self.P = np.diag([e.theta0_sd_K ** 2] * N_T + [e.kiss_sd_m ** 2, e.mu_sd ** 2, e.loss_scale_sd ** 2,
                                                       e.heat_scale_sd ** 2])
-        self.q_rw = np.array([e.theta_walk_K2_per_s] * 5 + [e.kiss_walk_m2_per_s, e.mu_walk_per_s,
+        self.q_rw = np.array([e.theta_walk_K2_per_s] * N_T + [e.kiss_walk_m2_per_s, e.mu_walk_per_s,
                                                             e.loss_walk_per_s if e.loss_scale_sd > 0 else 0.0,
                                                             e.heat_walk_per_s if e.heat_scale_sd > 0 else 0.0])
         self.energy_J = 0.0
@@ -213,7 +231,7 @@ class ClutchEkf:
     @property
     def theta_cm(self) -> float:
         """Estimated facing temperature (mean of both facings), K."""
-        return float(0.5 * (self.s[1] + self.s[2]))
+        return float(0.5 * (self.s[F1] + self.s[F2]))
 
     @property
     def dx_kiss(self) -> float:
@@ -254,13 +272,13 @@ class ClutchEkf:
         """
         s = self.s if s is None else s
         th = min(max(float(s[IX_CS]), self.table.theta_min_K), self.table.theta_max_K)
-        theta_cm = float(0.5 * (s[1] + s[2]))          # the stack's growth at the estimated facing temperature
+        theta_cm = float(0.5 * (s[F1] + s[F2]))          # the stack's growth at the estimated facing temperature
         return (float(s[IX_MU]) if mu is None else mu) * outputs(x_m - float(s[IX_DX]), th, self.table, self.p,
                                                                  theta_cm).torque
 
     # --- prediction ----------------------------------------------------------------------------
     def _parts(self, w_engine: float, w_disc: float, clamped: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """``(A_link, a_sink, b_sink)`` of the five temperatures: ``dtheta/dt = A_link theta + k_loss
+        """``(A_link, a_sink, b_sink)`` of the temperatures: ``dtheta/dt = A_link theta + k_loss
         (a_sink theta + b_sink) + k_heat q``; cached per ``SPEED_BAND`` (rad/s) band of the speeds.
 
         ``A_link`` (1/s): conduction between the nodes and the cushion-spring ODE (its ``H`` to the
@@ -273,19 +291,19 @@ class ClutchEkf:
         if hit is None:
             links, sink_g, sink_t = self.model.conductances(key[1] * SPEED_BAND, key[2] * SPEED_BAND, clamped)
             c = np.array(self.model.caps)
-            a = np.zeros((5, 5))
+            a = np.zeros((N_T, N_T))
             for i, gl in enumerate(links):
                 a[i, i + 1], a[i + 1, i] = gl / c[i], gl / c[i + 1]
                 a[i, i] -= gl / c[i]
                 a[i + 1, i + 1] -= gl / c[i + 1]
             n = self.net
             cs = n.spring_C_J_per_K
-            a[IX_CS, 1] = a[IX_CS, 2] = 0.5 * n.spring_U_W_per_K / cs
+            a[IX_CS, F1] = a[IX_CS, F2] = 0.5 * n.spring_U_W_per_K / cs
             a[IX_CS, IX_CS] = -(n.spring_U_W_per_K + n.spring_H_W_per_K) / cs
-            a_sink = np.zeros(5)
-            b_sink = np.zeros(5)
-            a_sink[:4] = -np.array(sink_g) / c
-            b_sink[:4] = np.array(sink_g) * np.array(sink_t) / c
+            a_sink = np.zeros(N_T)
+            b_sink = np.zeros(N_T)
+            a_sink[:N_NODES] = -np.array(sink_g) / c
+            b_sink[:N_NODES] = np.array(sink_g) * np.array(sink_t) / c
             b_sink_cs = n.spring_H_W_per_K * self.theta_a / cs
             hit = self._cache[key] = (a, a_sink, b_sink, b_sink_cs)
         return hit
@@ -301,22 +319,20 @@ class ClutchEkf:
 
     def _discrete(self, w_engine: float, w_disc: float, clamped: bool, dt: float,
                   k_loss: float) -> tuple[np.ndarray, np.ndarray, tuple]:
-        """``(Phi, Psi, parts)``: ``exp(A dt)`` and ``int_0^dt exp(A s) ds`` of the five temperatures with
-        the loss scale ``k_loss`` held, by their series to ``(A dt)^5`` (the EKF period is far below the
-        network's time constants; a test checks the prediction against the plant network). Cached per
-        speed band and period, recomputed when ``k_loss`` has changed (only measurement updates change it).
+        """``(Phi, Psi, parts)``: ``exp(A dt)`` and ``int_0^dt exp(A s) ds`` of the temperatures with
+        the loss scale ``k_loss`` held: the exponential of ``[[A, I], [0, 0]] dt`` by scaling and squaring
+        (Taylor series to order 8 of the matrix scaled to a norm below 1/4, then squared back; relative
+        error below 1e-10, a test compares it with scipy's ``expm``; the network's surface layers have time
+        constants near the EKF period, so a short series of ``A dt`` alone would not do). Cached per speed
+        band and period, recomputed when ``k_loss`` has changed (only measurement updates change it).
         """
         key = (clamped, round(w_engine / SPEED_BAND), round(w_disc / SPEED_BAND), round(dt * 1e4))
         hit = self._dcache.get(key)
         if hit is None or hit[0] != k_loss:
             parts = self._parts(w_engine, w_disc, clamped)
             a = parts[0].copy()
-            a[np.arange(5), np.arange(5)] += k_loss * parts[1]
-            ad, term, phi, psi = a * dt, np.eye(5), np.eye(5), np.eye(5) * dt
-            for k in range(1, 6):
-                term = term @ ad / k
-                phi = phi + term
-                psi = psi + term * dt / (k + 1)
+            a[np.arange(N_T), np.arange(N_T)] += k_loss * parts[1]
+            phi, psi = _exp_and_integral(a, dt)
             hit = self._dcache[key] = (k_loss, phi, psi, parts)
         return hit[1], hit[2], hit[3]
 
@@ -338,21 +354,21 @@ class ClutchEkf:
         s = self.s
         k_loss, k_heat = float(s[IX_LOSS]), float(s[IX_HEAT])
         phi, psi, (_, a_sink, b_sink, b_cs) = self._discrete(w_engine, w_disc, clamped, dt, k_loss)
-        th = s[:5]
-        q = np.zeros(5)
+        th = s[:N_T]
+        q = np.zeros(N_T)
         if p_mean != 0.0:
-            q[:4] = np.array(self.model.heat_inputs(p_mean)) / self.model.caps
+            q[:N_NODES] = np.array(self.model.heat_inputs(p_mean)) / self.model.caps
         b = k_loss * b_sink + k_heat * q
         b[IX_CS] += b_cs
         s_new = s.copy()
-        s_new[:5] = phi @ th + psi @ b
+        s_new[:N_T] = phi @ th + psi @ b
         f = np.eye(N_STATE)
-        f[:5, :5] = phi
-        f[:5, IX_LOSS] = psi @ (a_sink * th + b_sink)
-        f[:5, IX_HEAT] = psi @ q
+        f[:N_T, :N_T] = phi
+        f[:N_T, IX_LOSS] = psi @ (a_sink * th + b_sink)
+        f[:N_T, IX_HEAT] = psi @ q
         self.s = s_new
         qn = self.q_rw * dt
-        qn[:5] += (self.e.heat_share_sd * k_heat * q * dt) ** 2
+        qn[:N_T] += (self.e.heat_share_sd * k_heat * q * dt) ** 2
         self.P = f @ self.P @ f.T + np.diag(qn)
         self.energy_J = self.t_acc = 0.0
 
@@ -376,15 +392,15 @@ class ClutchEkf:
         if not mask.any():
             return False
         if e.temperature_update and h0 >= e.theta_torque_min_Nm:
-            mask[:5] = True
+            mask[:N_T] = True
             mask[IX_HEAT] = e.heat_scale_sd > 0.0
             mask[IX_LOSS] = e.loss_scale_sd > 0.0 and self.theta_cm - self.theta_a >= e.loss_excitation_K
         hrow = np.zeros(N_STATE)
-        for i, d in ((IX_CS, 1.0), (1, 1.0), (IX_DX, 1e-6)):
+        for i, d in ((IX_CS, 1.0), (F1, 1.0), (IX_DX, 1e-6)):
             sp = self.s.copy()
             sp[i] += d
             hrow[i] = (self.model_torque(x_meas_m, sp) - h0) / d
-        hrow[2] = hrow[1]                    # the stack grows with the facings' mean: both enter alike
+        hrow[F2] = hrow[F1]                   # the stack grows with the facings' mean: both enter alike
         hrow[IX_MU] = h0 / max(self.mu_scale, 1e-6)
         r = (e.torque_sd_Nm if torque_sd_Nm is None else torque_sd_Nm) ** 2
         s_inn = float(hrow @ self.P @ hrow) + r

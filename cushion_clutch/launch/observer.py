@@ -2,9 +2,9 @@
 
 The observer uses only what a TCU has: the engine and disc speeds (through
 :class:`SpeedSensors`), the clutch torque its own model expects at the
-measured bearing position, the ambient temperature and time. Its facing and
-cushion-spring models have their own parameters (scenario ``[observer]``),
-deliberately mismatched with the plant's in the shipped scenarios.
+measured bearing position, the ambient temperature and time. Its thermal network
+and cushion-spring model have their own parameters (scenario ``[observer]``):
+the plant's physical network with a stated mismatch (:class:`~.thermal_network.TcuNetworkBase`).
 """
 from __future__ import annotations
 
@@ -13,6 +13,7 @@ import random
 from ..model import ClutchParameters, thermal_step
 from .tcu_params import Observer, Sensors
 from .thermal import FacingModel
+from .thermal_network import ThermalNetwork
 
 
 class SpeedSensors:
@@ -39,23 +40,33 @@ class SpeedSensors:
 class FacingObserver:
     """Estimates theta_cm and theta_cs (K) from the slip power the TCU computes.
 
-    Call :meth:`update` once per TCU period with the slip power (W) sampled at
-    this cycle; it first advances both temperatures over the period that just
-    ended with the power sampled at the previous cycle (causal, held).
+    Its thermal model is its own copy of the physical network (:class:`~.thermal_network.ThermalNetwork`
+    with the ``[observer]`` parameters, mismatched with the plant's), or with ``network = false`` the
+    lumped facing. Call :meth:`update` once per TCU period with the slip power (W) sampled at this
+    cycle (and the measured speeds and clamp state); it first advances both temperatures over the period
+    that just ended with the power sampled at the previous cycle (causal, held).
     """
 
-    __slots__ = ("facing", "p", "dt", "theta_cm", "theta_cs", "p_prev")
+    __slots__ = ("facing", "net", "p", "dt", "theta_cm", "theta_cs", "p_prev", "prev")
 
     def __init__(self, obs: Observer, theta_a: float, theta0: float, dt: float):
-        self.facing = FacingModel(obs.capacity_J_per_K, obs.loss_W_per_K, obs.heat_share, theta_a, dt)
+        self.net = ThermalNetwork(obs, theta_a, theta0) if obs.network else None
+        self.facing = None if obs.network else FacingModel(obs.capacity_J_per_K, obs.loss_W_per_K, obs.heat_share,
+                                                           theta_a, dt)
         self.p = ClutchParameters(U=obs.spring_U_W_per_K, H=obs.spring_H_W_per_K, C=obs.spring_C_J_per_K,
                                   theta_a=theta_a, theta_cs_start=theta0)
         self.dt = dt
         self.theta_cm = self.theta_cs = theta0
         self.p_prev = 0.0
+        self.prev = (0.0, 0.0, False)
 
-    def update(self, p_slip_W: float) -> None:
-        """Advance over the last period; remember ``p_slip_W`` for the next one."""
+    def update(self, p_slip_W: float, w_engine: float = 0.0, w_disc: float = 0.0, clamped: bool = False) -> None:
+        """Advance over the last period; remember ``p_slip_W`` (W), the speeds (rad/s) and the clamp state."""
         self.theta_cs = thermal_step(self.theta_cs, self.theta_cm, self.dt, self.p)
-        self.theta_cm = self.facing.step(self.theta_cm, self.p_prev)
+        if self.net is not None:
+            self.net.step(self.dt, self.p_prev, *self.prev)
+            self.theta_cm = self.net.theta_cm
+        else:
+            self.theta_cm = self.facing.step(self.theta_cm, self.p_prev)
         self.p_prev = p_slip_W
+        self.prev = (w_engine, w_disc, clamped)

@@ -328,29 +328,111 @@ class Scenario(Checked):
         return path if path.is_absolute() else Path(self.folder or ".") / path
 
 
+def shipped_names() -> list[str]:
+    """Names of the shipped scenarios."""
+    return sorted(p.stem for p in DEFAULT_SCENARIO.parent.glob("*.toml"))
+
+
 def scenario_path(name: str | Path) -> Path:
-    """A scenario file: ``name`` itself, or the shipped ``<name>.toml`` (default, creep, cooldown, fade, wear, tolerance)."""
+    """A scenario file: ``name`` itself, or the shipped ``<name>.toml`` (default, creep, cooldown, fade, ...)."""
     path = Path(name)
     shipped = DEFAULT_SCENARIO.parent / f"{name}.toml"
     # a folder of that name (e.g. the output of an earlier `launch --scenario wear --out wear`) is no scenario
     return shipped if not path.is_file() and path.suffix == "" and shipped.is_file() else path
 
 
-def load_scenario(path: str | Path = DEFAULT_SCENARIO) -> Scenario:
-    """Load and check a scenario TOML file (unknown keys and bad ranges rejected)."""
-    if not Path(path).is_file():
-        raise ParameterError([f"scenario file {path} not found (shipped: default, creep, cooldown, fade, wear, tolerance)"])
+#: keys naming files relative to the scenario file that sets them
+_RELATIVE_FILES = (("clutch", "friction_csv"), ("clutch", "plant_tables"), ("clutch", "tcu_tables"))
+
+
+def _resolve_extends(value: object, child: Path) -> Path:
+    """The file an ``extends`` value names: a shipped scenario's name, or a path relative to ``child``'s folder."""
+    if not isinstance(value, str) or not value:
+        raise ParameterError([f"extends = {value!r}: must be a shipped scenario name "
+                              f"({', '.join(shipped_names())}) or a file name"], str(child))
+    path = Path(value)
+    if not path.is_absolute():
+        local = child.parent / path
+        if local.is_file():
+            return local.resolve()
+    if path.suffix == "" and (DEFAULT_SCENARIO.parent / f"{value}.toml").is_file():
+        return (DEFAULT_SCENARIO.parent / f"{value}.toml").resolve()
+    if path.is_absolute() and path.is_file():
+        return path.resolve()
+    raise ParameterError([f"extends = {value!r}: no such scenario (shipped: {', '.join(shipped_names())}; "
+                          f"or a file relative to {child.parent})"], str(child))
+
+
+def merged_data(path: str | Path, _chain: tuple[Path, ...] = ()) -> tuple[dict, dict]:
+    """The TOML tables of a scenario file deep-merged over those of the scenario it ``extends`` (recursively).
+
+    Returns ``(data, origin)``: ``origin[(section, key)]`` (``section`` "" for top-level keys) is the file
+    that set the value. Tables merge key by key; any other value (numbers, strings, lists) replaces the
+    parent's. File names of ``clutch.friction_csv``, ``plant_tables`` and ``tcu_tables`` set by a parent are
+    made absolute, relative to the parent's folder. ``name`` and ``description`` are not inherited
+    (``name`` defaults to the file's stem). A cycle of ``extends`` is refused.
+    """
+    path = Path(path).resolve()
+    if path in _chain:
+        raise ParameterError(["extends: cycle " + " -> ".join(str(p) for p in _chain + (path,))], str(path))
     data = load_toml(path)
     if "folder" in data:
         raise ParameterError(["folder: unknown key"], str(path))
-    data["folder"] = str(Path(path).resolve().parent)
-    sc = build_checked(Scenario, data, str(path))
+    for sec, key in _RELATIVE_FILES:
+        v = data.get(sec, {}).get(key) if isinstance(data.get(sec), dict) else None
+        if _chain and isinstance(v, str) and v and not Path(v).is_absolute():     # a parent: its own folder
+            data[sec][key] = str(path.parent / v)
+    if "extends" not in data:
+        origin = {(sec if isinstance(v, dict) else "", k): path
+                  for sec, v in data.items() for k in (v if isinstance(v, dict) else [sec])}
+        data.setdefault("name", path.stem)
+        return data, origin
+    parent = _resolve_extends(data.pop("extends"), path)
+    base, origin = merged_data(parent, _chain + (path,))
+    base.pop("name", None)
+    base.pop("description", None)
+    for sec, value in data.items():
+        if isinstance(value, dict) and isinstance(base.get(sec), dict):
+            base[sec] = {**base[sec], **value}
+            origin.update({(sec, k): path for k in value})
+        else:
+            base[sec] = value
+            origin.update({(sec, k): path for k in (value if isinstance(value, dict) else [])})
+            origin[("", sec)] = path
+    base.setdefault("name", path.stem)
+    return base, origin
+
+
+def _blame(problem: str, origin: dict, top: Path) -> str:
+    """``problem`` with the file that set its key, when that is not ``top``."""
+    key = problem.split(" ", 1)[0].split("[", 1)[0].rstrip(":")
+    sec, _, name = key.partition(".")
+    src = origin.get((sec, name)) if name else origin.get(("", sec))
+    return f"{problem} (set in {src})" if src is not None and src != top else problem
+
+
+def load_scenario(path: str | Path = DEFAULT_SCENARIO) -> Scenario:
+    """Load and check a scenario TOML file (unknown keys and bad ranges rejected, naming the file that set them).
+
+    ``extends = "<shipped name>"`` or ``extends = "<file>"`` (relative to this file's folder) starts from that
+    scenario and applies this file's values over it (:func:`merged_data`).
+    """
+    if not Path(path).is_file():
+        raise ParameterError([f"scenario file {path} not found (shipped: {', '.join(shipped_names())})"])
+    top = Path(path).resolve()
+    data, origin = merged_data(top)
+    data["folder"] = str(top.parent)
+    try:
+        sc = build_checked(Scenario, data, str(path))
+    except ParameterError as exc:
+        raise ParameterError([_blame(p, origin, top) for p in exc.problems], str(path)) from None
     fr = sc.friction_path()
     if fr is not None and not fr.is_file():
-        raise ParameterError([f"clutch.friction_csv = {sc.clutch.friction_csv!r}: file {fr} not found"], str(path))
+        raise ParameterError([_blame(f"clutch.friction_csv = {sc.clutch.friction_csv!r}: file {fr} not found",
+                                     origin, top)], str(path))
     for which in ("plant", "tcu"):
         folder = sc.tables_path(which)
         if folder is not None and not folder.is_dir():
-            raise ParameterError([f"clutch.{which}_tables = {getattr(sc.clutch, which + '_tables')!r}: "
-                                  f"folder {folder} not found"], str(path))
+            raise ParameterError([_blame(f"clutch.{which}_tables = {getattr(sc.clutch, which + '_tables')!r}: "
+                                         f"folder {folder} not found", origin, top)], str(path))
     return sc

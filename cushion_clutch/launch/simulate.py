@@ -50,7 +50,9 @@ X_RETRACTED_M = 1e-6
 COLUMNS = ("time_s", "launch", "w_engine_rad_s", "w_disc_rad_s", "v_m_s", "accel_m_s2", "x_cmd_m",
            "x_to_m", "torque_demand_Nm", "torque_capacity_Nm", "torque_clutch_Nm", "theta_cm_K",
            "theta_cs_K", "theta_cs_tcu_K", "x_kiss_m", "x_kiss_tcu_m", "throttle", "locked", "theta_cm_tcu_K",
-           "torque_believed_Nm", "torque_shaft_Nm")
+           "torque_believed_Nm", "torque_shaft_Nm", "theta_surface_K", "theta_pressure_plate_K")
+#: theta_surface_K: the hotter metal friction surface (1 mm layer), theta_pressure_plate_K: the pressure plate's
+#: bulk node, both from the plant's thermal network (NaN with the lumped facing or a prescribed profile)
 
 
 @dataclass
@@ -103,7 +105,11 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
     else:
         ctl = TcuController(VARIANTS[name], sc, table, p, theta0, dl.j_d, dl.t_load_rest, dl.j_e, engine.w_idle)
         sense = None
-    net = ThermalNetwork(sc.plant_thermal, theta_a, theta0) if sc.plant_thermal.enabled else None
+    # the plant's thermal network (a prescribed profile_csv overrides it; disabled: the lumped facing)
+    net = ThermalNetwork(sc.plant_thermal, theta_a, theta0) if sc.plant_thermal.enabled and not fac.profile_csv \
+        else None
+    net_temps = ((lambda: (net.theta_surface, net.theta[-1])) if net is not None
+                 else (lambda: (math.nan, math.nan)))
     net_every = max(1, int(round(tc.period_s / h)))     # the network's time constants are seconds: 10 ms steps
     net_n, net_e = 0, 0.0
     sensors = SpeedSensors(sc.sensors)
@@ -204,7 +210,7 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
                         rec_countdown = record_every
                         rows.append((t + j * h, n + 1, dl.w_e, 0.0, 0.0, 0.0, 0.0, x_act, 0.0, 0.0, 0.0,
                                      theta_cm_step, theta_cs, ctl.theta_now, x_kiss, ctl.kiss_now, engine.throttle,
-                                     0.0, ctl.theta_cm_estimate(), math.nan, 0.0))
+                                     0.0, ctl.theta_cm_estimate(), math.nan, 0.0, *net_temps()))
                         if progress is not None and (k + j) % 10000 == 0:
                             progress(t + j * h)
                     rec_countdown -= 1
@@ -265,7 +271,7 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
                              ctl.t_dem + ctl.t_rate * (tcu_every - countdown) * h, t_cap, dl.t_c, theta_cm_step,
                              theta_cs, ctl.theta_now, x_kiss, ctl.kiss_now, engine.throttle, float(dl.locked),
                              ctl.theta_cm_estimate(), believed if sampling else math.nan,
-                             dl.k * dl.phi + dl.c * (dl.w_d - dl.v * dl.i_tot / dl.r)))
+                             dl.k * dl.phi + dl.c * (dl.w_d - dl.v * dl.i_tot / dl.r), *net_temps()))
                 if progress is not None and k % 10000 == 0:
                     progress(t)
             rec_countdown -= 1

@@ -242,7 +242,8 @@ class TcuController:
             self.theta_cm_ideal = theta_cm_true
         elif self.observer is not None:
             slip = abs(w_e - w_d)
-            self.observer.update(self.model_torque(x_meas) * slip if self.phase == LAUNCH else 0.0)
+            self.observer.update(self.model_torque(x_meas) * slip if self.phase == LAUNCH else 0.0, w_e, w_d,
+                                 self.phase == LAUNCH or self.phase == CLOSE)
         if launch != self.launch:
             self.launch = launch
             self.sync, self.integral, self.t_dem, self.w_ref = False, 0.0, 0.0, w_e

@@ -8,21 +8,28 @@ from dataclasses import dataclass
 from typing import Iterable
 
 from ..config import Checked
+from .thermal_network import TcuNetworkBase
 
 
 @dataclass(frozen=True)
-class Observer(Checked):
-    """The TCU's facing-temperature observer: its own (mismatched) lumped models.
+class Observer(TcuNetworkBase):
+    """The TCU's temperature observer: its own copy of the physical network (mismatched) or a lumped facing.
 
-    ``C_f dtheta_cm/dt = share T_est w_slip - G_f (theta_cm - theta_a)`` with
-    the slip speed from the speed sensors and ``T_est`` its model's torque at
-    the measured bearing position; then the cushion-spring model
+    ``network = true`` (default): the chain of :mod:`.thermal_network` with this section's parameters (by
+    default the plant's with the mismatch of :class:`~.thermal_network.TcuNetworkBase`), heated by
+    ``T_est w_slip`` with the slip speed from the speed sensors and ``T_est`` its model's torque at the
+    measured bearing position. ``network = false``: the lumped facing
+    ``C_f dtheta_cm/dt = share T_est w_slip - G_f (theta_cm - theta_a)``. Then the cushion-spring model
     ``C dtheta_cs/dt = U (theta_cm - theta_cs) + H (theta_a - theta_cs)``.
     """
 
+    network: bool = True
     capacity_J_per_K: float = 517.5
+    """lumped facing only"""
     loss_W_per_K: float = 1.08
+    """lumped facing only"""
     heat_share: float = 1.0
+    """lumped facing only"""
     spring_U_W_per_K: float = 0.1
     spring_H_W_per_K: float = 0.04
     spring_C_J_per_K: float = 1.0
@@ -30,6 +37,7 @@ class Observer(Checked):
     _section = "observer"
 
     def _problems(self) -> Iterable[str]:
+        yield from super()._problems()
         yield from self._ranges({
             "capacity_J_per_K": (1.0, 1e6), "loss_W_per_K": (0.0, 1e4), "heat_share": (0.0, 1.0),
             "spring_U_W_per_K": (0.0, 1e4), "spring_H_W_per_K": (0.0, 1e4), "spring_C_J_per_K": (0.0, 1e6, True)})

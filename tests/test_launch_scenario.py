@@ -1,0 +1,87 @@
+"""Scenario files: ``extends`` (deep merge, provenance of bad values, cycles), the shipped scenarios' size."""
+import tomllib
+
+import pytest
+
+from cushion_clutch.data import DEFAULT_SCENARIO
+from cushion_clutch.errors import ParameterError
+from cushion_clutch.launch.scenario import load_scenario, merged_data, scenario_path, shipped_names
+
+SHIPPED = DEFAULT_SCENARIO.parent
+
+
+def test_shipped_scenarios_load_and_state_only_differences():
+    names = shipped_names()
+    assert {"default", "trailer", "creep", "cooldown", "fade", "wear", "tolerance"} <= set(names)
+    default = tomllib.loads(DEFAULT_SCENARIO.read_text())
+    assert default["plant_thermal"]["enabled"] is True
+    for name in names:
+        sc = load_scenario(scenario_path(name))
+        assert sc.name == name and sc.plant_thermal.enabled
+        if name != "default":
+            text = (SHIPPED / f"{name}.toml").read_text()
+            assert len(text.splitlines()) <= 60, name
+            assert "extends" in tomllib.loads(text), name
+
+
+def test_extends_merges_tables_key_by_key(tmp_path):
+    child = tmp_path / "heavy.toml"
+    child.write_text('extends = "default"\n[vehicle]\nmass_kg = 2500.0\n[run]\nlaunches = 3\n')
+    sc, base = load_scenario(child), load_scenario()
+    assert sc.vehicle.mass_kg == 2500.0 and sc.run.launches == 3
+    assert sc.vehicle.slope_percent == base.vehicle.slope_percent            # the rest of [vehicle] inherited
+    assert sc.run.period_s == base.run.period_s and sc.engine == base.engine and sc.tcu_sensors == base.tcu_sensors
+    assert sc.name == "heavy" and sc.description == ""                       # not inherited
+    # two levels, a path relative to the child's folder
+    grand = tmp_path / "sub" / "g.toml"
+    grand.parent.mkdir()
+    grand.write_text('extends = "../heavy.toml"\nname = "g"\n[run]\nperiod_s = 30.0\n')
+    g = load_scenario(grand)
+    assert (g.vehicle.mass_kg, g.run.launches, g.run.period_s, g.name) == (2500.0, 3, 30.0, "g")
+    data, origin = merged_data(grand)
+    assert origin[("vehicle", "mass_kg")] == child.resolve() and origin[("run", "period_s")] == grand.resolve()
+    assert origin[("engine", "inertia_kg_m2")] == DEFAULT_SCENARIO.resolve()
+
+
+def test_relative_files_stay_relative_to_the_file_that_names_them(tmp_path):
+    child = tmp_path / "myfade.toml"
+    child.write_text('extends = "fade"\n[run]\nlaunches = 2\n')
+    sc = load_scenario(child)
+    assert sc.friction_path() == SHIPPED / "organic_facing_friction.csv"
+    tol = tmp_path / "mytol.toml"
+    tol.write_text('extends = "tolerance"\n')
+    assert load_scenario(tol).tables_path("plant") == SHIPPED / "tables" / "default_p95_2mm"
+
+
+def test_bad_values_name_the_file_that_set_them(tmp_path):
+    parent = tmp_path / "parent.toml"
+    parent.write_text('extends = "default"\n[vehicle]\nmass_kg = -5.0\n')
+    child = tmp_path / "child.toml"
+    child.write_text('extends = "parent.toml"\n[vehicle]\nmass_lb = 3.0\n[adaptation]\ngain = 1.5\n')
+    with pytest.raises(ParameterError) as info:
+        load_scenario(child)
+    problems = info.value.problems
+    assert any("vehicle.mass_kg = -5.0" in p and f"set in {parent.resolve()}" in p for p in problems)
+    assert any("vehicle.mass_lb: unknown key" in p and "set in" not in p for p in problems)   # the child's own
+    assert any("adaptation.gain = 1.5" in p for p in problems)
+    assert str(child) in str(info.value)
+
+
+def test_cycles_and_unknown_parents_are_refused(tmp_path):
+    a, b = tmp_path / "a.toml", tmp_path / "b.toml"
+    a.write_text('extends = "b.toml"\n')
+    b.write_text('extends = "a.toml"\n')
+    with pytest.raises(ParameterError, match="extends: cycle"):
+        load_scenario(a)
+    own = tmp_path / "own.toml"
+    own.write_text('extends = "own.toml"\n')
+    with pytest.raises(ParameterError, match="extends: cycle"):
+        load_scenario(own)
+    nowhere = tmp_path / "n.toml"
+    nowhere.write_text('extends = "nonesuch"\n')
+    with pytest.raises(ParameterError, match="no such scenario.*default"):
+        load_scenario(nowhere)
+    bad = tmp_path / "bad.toml"
+    bad.write_text('extends = 3\n')
+    with pytest.raises(ParameterError, match="extends = 3"):
+        load_scenario(bad)

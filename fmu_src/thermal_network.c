@@ -1,0 +1,61 @@
+/*
+ * The chain of lumped thermal nodes (thermal_network.h): conductances, the exact-exponential
+ * Gauss-Seidel step (Co-Simulation) and the derivative (Model Exchange).
+ */
+#include "thermal_network.h"
+
+#include <math.h>
+
+void tn_conductances(const TnParams *p, double w_engine, double w_disc, int clamped, double *link, double *sink_g,
+                     double *sink_t) {
+    int i;
+    /* the speed factor of the convection, per speed source (Nu ~ Re^0.8) */
+    double f[2];
+    f[TN_ENGINE] = 1.0 + (p->gain - 1.0) * pow(fabs(w_engine) / p->w_ref, 0.8);
+    f[TN_DISC] = 1.0 + (p->gain - 1.0) * pow(fabs(w_disc) / p->w_ref, 0.8);
+    for (i = 0; i + 1 < p->n; ++i) link[i] = clamped ? p->g_clamped[i] : p->g_open[i];
+    for (i = 0; i < p->n; ++i) {
+        double g = p->g_conv[i] * f[p->speed[i]] + p->g_fix[i];
+        sink_g[i] = g;
+        sink_t[i] = p->g_fix[i] != 0.0 && g > 0.0 ? (p->g_fix[i] * p->theta_fix + (g - p->g_fix[i]) * p->theta_a) / g
+                                                  : p->theta_a;
+    }
+}
+
+void tn_step(const TnParams *p, double *th, double dt, double power, double w_engine, double w_disc, int clamped) {
+    double link[TN_MAX], sg[TN_MAX], st[TN_MAX];
+    int i, n = p->n;
+    tn_conductances(p, w_engine, w_disc, clamped, link, sg, st);
+    for (i = 0; i < n; ++i) {
+        double gl = i > 0 ? link[i - 1] : 0.0, gr = i < n - 1 ? link[i] : 0.0;
+        double gs = gl + gr + sg[i];
+        double flow = p->share[i] * power + sg[i] * st[i] + (i > 0 ? gl * th[i - 1] : 0.0) +
+                      (i < n - 1 ? gr * th[i + 1] : 0.0);
+        if (gs > 0.0) {
+            double inf = flow / gs;
+            th[i] = inf + (th[i] - inf) * exp(-dt * gs / p->cap[i]);
+        } else {
+            th[i] += flow * dt / p->cap[i];
+        }
+    }
+}
+
+void tn_derivative(const TnParams *p, const double *th, double power, double w_engine, double w_disc, int clamped,
+                   double *der) {
+    double link[TN_MAX], sg[TN_MAX], st[TN_MAX];
+    int i, n = p->n;
+    tn_conductances(p, w_engine, w_disc, clamped, link, sg, st);
+    for (i = 0; i < n; ++i) {
+        double q = p->share[i] * power + sg[i] * (st[i] - th[i]);
+        if (i > 0) q += link[i - 1] * (th[i - 1] - th[i]);
+        if (i < n - 1) q += link[i] * (th[i + 1] - th[i]);
+        der[i] = q / p->cap[i];
+    }
+}
+
+double tn_mean(const TnParams *p, const double *th) {
+    double s = 0.0;
+    int i;
+    for (i = 0; i < p->n; ++i) s += p->weight[i] * th[i];
+    return s;
+}

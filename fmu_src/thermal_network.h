@@ -1,0 +1,41 @@
+/*
+ * A chain of lumped thermal nodes (the clutch's thermal network in the CushionClutchThermal FMU).
+ *
+ * Nodes 0 .. n-1 in a chain, temperatures theta_i (K), heat capacities C_i (J/K):
+ *   link i -- i+1:   conductance g_open[i] or g_clamped[i] (W/K), by the clutch's clamp state;
+ *   sink of node i:  G_i = g_conv[i] * (1 + (gain - 1) (|w_i| / w_ref)^0.8) + g_fix[i]   (W/K)
+ *                    towards the mean of ambient theta_a (convection) and theta_fix (g_fix, e.g. the engine
+ *                    block), with w_i the engine or the disc speed (speed[i]);
+ *   heat input:      q_i = share[i] * P  (P the slip power, W).
+ * Co-Simulation: tn_step advances node by node (0 first) with the exact exponential solution for the node's
+ * neighbours held, the same Gauss-Seidel exponential splitting as the Python plant
+ * (cushion_clutch.launch.thermal_network.ThermalNetwork.step); Model Exchange: tn_derivative.
+ * The structure (n, speed sources, mean weights) and the parameters' value references are generated from
+ * Python into cushion_variables.h (cushion_clutch.fmu.thermal_chain); this file knows no node by name.
+ */
+#ifndef THERMAL_NETWORK_H
+#define THERMAL_NETWORK_H
+
+#define TN_MAX 32
+enum { TN_ENGINE = 0, TN_DISC = 1 };
+
+typedef struct {
+    int n;
+    double cap[TN_MAX], share[TN_MAX], g_conv[TN_MAX], g_fix[TN_MAX], weight[TN_MAX];
+    int speed[TN_MAX];                    /* TN_ENGINE or TN_DISC */
+    double g_open[TN_MAX], g_clamped[TN_MAX]; /* link i -- i+1, W/K */
+    double theta_fix, theta_a, gain, w_ref;   /* K, K, 1, rad/s */
+} TnParams;
+
+/* links (n-1), sink conductances and sink temperatures (n) at the given speeds and clamp state */
+void tn_conductances(const TnParams *p, double w_engine, double w_disc, int clamped, double *link, double *sink_g,
+                     double *sink_t);
+/* advance theta (K) by dt (s) with the slip power (W), speeds (rad/s) and clamp state held */
+void tn_step(const TnParams *p, double *theta, double dt, double power, double w_engine, double w_disc, int clamped);
+/* dtheta/dt (K/s) */
+void tn_derivative(const TnParams *p, const double *theta, double power, double w_engine, double w_disc, int clamped,
+                   double *der);
+/* the weighted mean (the facing temperature theta_cm), K */
+double tn_mean(const TnParams *p, const double *theta);
+
+#endif

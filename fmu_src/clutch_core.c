@@ -206,18 +206,19 @@ static void net_params(const double *r, TnParams *p) {
     for (i = 0; i < TN_N; ++i) {
         p->cap[i] = r[TN_VR_CAP[i]];
         p->share[i] = r[TN_VR_SHARE[i]];
-        p->g_conv[i] = r[TN_VR_CONV[i]];
-        p->g_fix[i] = r[TN_VR_FIX[i]];
+        p->area[i] = r[TN_VR_AREA[i]];
+        p->g_engine[i] = r[TN_VR_ENGINE[i]];
         p->speed[i] = TN_SPEED[i];
         p->weight[i] = TN_WEIGHT[i];
     }
     for (i = 0; i + 1 < TN_N; ++i) {
-        p->g_open[i] = r[TN_VR_OPEN[i]];
+        p->g_always[i] = r[TN_VR_ALWAYS[i]];
         p->g_clamped[i] = r[TN_VR_CLAMPED[i]];
     }
-    p->theta_fix = r[TN_VR_THETA_ENGINE];
+    p->theta_engine = r[TN_VR_THETA_ENGINE];
     p->theta_a = r[VR_THETA_A];
-    p->gain = r[TN_VR_GAIN];
+    p->h_still = r[TN_VR_H_STILL];
+    p->h_rot = r[TN_VR_H_ROT];
     p->w_ref = r[TN_VR_WREF];
 }
 

@@ -9,16 +9,16 @@
 void tn_conductances(const TnParams *p, double w_engine, double w_disc, int clamped, double *link, double *sink_g,
                      double *sink_t) {
     int i;
-    /* the speed factor of the convection, per speed source (Nu ~ Re^0.8) */
-    double f[2];
-    f[TN_ENGINE] = 1.0 + (p->gain - 1.0) * pow(fabs(w_engine) / p->w_ref, 0.8);
-    f[TN_DISC] = 1.0 + (p->gain - 1.0) * pow(fabs(w_disc) / p->w_ref, 0.8);
-    for (i = 0; i + 1 < p->n; ++i) link[i] = clamped ? p->g_clamped[i] : p->g_open[i];
+    /* (|w| / w_ref)^0.8 per speed source (turbulent forced convection, Nu ~ Re^0.8) */
+    double x[2];
+    x[TN_ENGINE] = pow(fabs(w_engine) / p->w_ref, 0.8);
+    x[TN_DISC] = pow(fabs(w_disc) / p->w_ref, 0.8);
+    for (i = 0; i + 1 < p->n; ++i) link[i] = clamped ? p->g_always[i] + p->g_clamped[i] : p->g_always[i];
     for (i = 0; i < p->n; ++i) {
-        double g = p->g_conv[i] * f[p->speed[i]] + p->g_fix[i];
+        double conv = p->area[i] > 0.0 ? p->area[i] * (p->h_still + p->h_rot * x[p->speed[i]]) : 0.0;
+        double g = conv + p->g_engine[i];
         sink_g[i] = g;
-        sink_t[i] = p->g_fix[i] != 0.0 && g > 0.0 ? (p->g_fix[i] * p->theta_fix + (g - p->g_fix[i]) * p->theta_a) / g
-                                                  : p->theta_a;
+        sink_t[i] = g > 0.0 ? (p->g_engine[i] * p->theta_engine + conv * p->theta_a) / g : p->theta_a;
     }
 }
 

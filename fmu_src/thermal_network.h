@@ -2,10 +2,10 @@
  * A chain of lumped thermal nodes (the clutch's thermal network in the CushionClutchThermal FMU).
  *
  * Nodes 0 .. n-1 in a chain, temperatures theta_i (K), heat capacities C_i (J/K):
- *   link i -- i+1:   conductance g_open[i] or g_clamped[i] (W/K), by the clutch's clamp state;
- *   sink of node i:  G_i = g_conv[i] * (1 + (gain - 1) (|w_i| / w_ref)^0.8) + g_fix[i]   (W/K)
- *                    towards the mean of ambient theta_a (convection) and theta_fix (g_fix, e.g. the engine
- *                    block), with w_i the engine or the disc speed (speed[i]);
+ *   link i -- i+1:   conductance g_always[i], plus g_clamped[i] while the clutch is clamped (W/K);
+ *   sink of node i:  convection G_c = area[i] (h_still + h_rot (|w_i| / w_ref)^0.8) to the air at theta_a,
+ *                    with w_i the engine or the disc speed (speed[i]), plus g_engine[i] to the engine
+ *                    block at theta_engine (W/K);
  *   heat input:      q_i = share[i] * P  (P the slip power, W).
  * Co-Simulation: tn_step advances node by node (0 first) with the exact exponential solution for the node's
  * neighbours held, the same Gauss-Seidel exponential splitting as the Python plant
@@ -21,10 +21,10 @@ enum { TN_ENGINE = 0, TN_DISC = 1 };
 
 typedef struct {
     int n;
-    double cap[TN_MAX], share[TN_MAX], g_conv[TN_MAX], g_fix[TN_MAX], weight[TN_MAX];
-    int speed[TN_MAX];                    /* TN_ENGINE or TN_DISC */
-    double g_open[TN_MAX], g_clamped[TN_MAX]; /* link i -- i+1, W/K */
-    double theta_fix, theta_a, gain, w_ref;   /* K, K, 1, rad/s */
+    double cap[TN_MAX], share[TN_MAX], area[TN_MAX], g_engine[TN_MAX], weight[TN_MAX]; /* J/K, 1, m2, W/K, 1 */
+    int speed[TN_MAX];                          /* TN_ENGINE or TN_DISC */
+    double g_always[TN_MAX], g_clamped[TN_MAX]; /* link i -- i+1, W/K */
+    double theta_engine, theta_a, h_still, h_rot, w_ref; /* K, K, W/(m2 K), W/(m2 K), rad/s */
 } TnParams;
 
 /* links (n-1), sink conductances and sink temperatures (n) at the given speeds and clamp state */

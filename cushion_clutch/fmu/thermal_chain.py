@@ -5,7 +5,7 @@ variant compiles it with ``thermal_network.c`` (a chain of N lumped nodes that k
 name) and a second generated variable table. Everything the C chain needs comes from here:
 
 * :class:`Chain`: the network as arrays (nodes, capacities, heat shares, convection and fixed
-  sinks with their speed source, link conductances open and clamped, the weights of the facing
+  sinks with their speed source, link conductances (always, and added while clamped), the weights of the facing
   temperature ``theta_cm``). :func:`chain_of` maps the plant's
   :class:`~cushion_clutch.launch.thermal_network.NetworkParams` onto it; a new node list is a
   new :class:`Chain`, and the C table, the FMU variables and the descriptions follow.
@@ -48,31 +48,34 @@ TN_MAX = 32
 class Chain:
     """A chain of lumped thermal nodes (SI), node ``i`` linked to ``i + 1``.
 
-    Sink of node i: ``convection_W_per_K[i] (1 + (gain - 1) (|w| / w_ref)^0.8)`` to ambient, ``w``
-    the speed of ``speed[i]`` ("engine" or "disc"), plus ``fixed_W_per_K[i]`` to ``fixed_K``.
-    Slip power P puts ``heat_share[i] P`` into node i. ``theta_cm`` = sum of ``theta_cm_weights[i] theta_i``.
+    Link i conducts ``link_always_W_per_K[i]``, plus ``link_clamped_W_per_K[i]`` while the clutch is
+    clamped. Sink of node i: convection ``cooled_area_m2[i] (h_still + h_rot (|w| / w_ref)^0.8)`` to the air,
+    ``w`` the speed of ``speed[i]`` ("engine" or "disc"), plus ``engine_W_per_K[i]`` to the engine block at
+    ``engine_K``. Slip power P puts ``heat_share[i] P`` into node i.
+    ``theta_cm`` = sum of ``theta_cm_weights[i] theta_i``.
     """
 
     nodes: tuple[str, ...]
     capacity_J_per_K: tuple[float, ...]
     heat_share: tuple[float, ...]
-    convection_W_per_K: tuple[float, ...]
+    cooled_area_m2: tuple[float, ...]
     speed: tuple[str, ...]
-    fixed_W_per_K: tuple[float, ...]
-    link_open_W_per_K: tuple[float, ...]
+    engine_W_per_K: tuple[float, ...]
+    link_always_W_per_K: tuple[float, ...]
     link_clamped_W_per_K: tuple[float, ...]
     theta_cm_weights: tuple[float, ...]
-    fixed_K: float
-    convection_gain_at_reference: float
+    engine_K: float
+    still_air_W_per_m2_K: float
+    rotating_W_per_m2_K: float
     convection_reference_rad_s: float
 
     def __post_init__(self) -> None:
         n = len(self.nodes)
         problems = [f"{k}: {len(getattr(self, k))} entries for {n} nodes" for k in
-                    ("capacity_J_per_K", "heat_share", "convection_W_per_K", "speed", "fixed_W_per_K",
+                    ("capacity_J_per_K", "heat_share", "cooled_area_m2", "speed", "engine_W_per_K",
                      "theta_cm_weights") if len(getattr(self, k)) != n]
         problems += [f"{k}: {len(getattr(self, k))} entries for {n - 1} links" for k in
-                     ("link_open_W_per_K", "link_clamped_W_per_K") if len(getattr(self, k)) != n - 1]
+                     ("link_always_W_per_K", "link_clamped_W_per_K") if len(getattr(self, k)) != n - 1]
         problems += [f"speed {s!r} (allowed {', '.join(SPEEDS)})" for s in self.speed if s not in SPEEDS]
         if not 1 <= n <= TN_MAX:
             problems.append(f"{n} nodes (allowed 1 to {TN_MAX})")
@@ -90,22 +93,38 @@ class Chain:
 
 def chain_of(p=None) -> Chain:
     """The plant's network (:class:`~cushion_clutch.launch.thermal_network.NetworkParams`, default: its
-    defaults) as a :class:`Chain`, in the plant's node order and with its conductance laws."""
-    from ..launch.thermal_network import NODES, NetworkParams, ThermalNetwork
+    defaults) as a :class:`Chain`, in the plant's node order and with its conductance laws.
+
+    Network v2 exposes its chain as arrays (``thermal_network.coefficients``): they are taken as they are.
+    The four-node network before it (no ``coefficients``) is mapped here: its convection
+    ``G0 (1 + (gain - 1) x)`` is ``area (h_still + h_rot x)`` with area = G0, h_still = 1, h_rot = gain - 1.
+    """
+    from ..launch import thermal_network as tn
     from ..model import KELVIN
-    p = p or NetworkParams()
-    net = ThermalNetwork(p, 293.15, 293.15)
-    shares = [q for q in net.heat_inputs(1.0)]              # the effusivity partition, per watt
+    p = p or tn.NetworkParams()
+    if hasattr(tn, "coefficients"):
+        c = tn.coefficients(p)
+        n = len(tn.NODES)
+        return Chain(nodes=tuple(tn.NODES), capacity_J_per_K=tuple(c["caps"]), heat_share=tuple(c["shares"]),
+                     cooled_area_m2=tuple(c["area_cooled"]),
+                     speed=tuple(("engine", "disc")[s] for s in tn.SPEED_OF_NODE),
+                     engine_W_per_K=tuple(c["engine"]), link_always_W_per_K=tuple(c["link_always"]),
+                     link_clamped_W_per_K=tuple(c["link_clamped"]),
+                     theta_cm_weights=tuple(0.5 if i in tn.FACINGS else 0.0 for i in range(n)),
+                     engine_K=p.engine_degC + KELVIN, still_air_W_per_m2_K=p.still_air_W_per_m2_K,
+                     rotating_W_per_m2_K=p.rotating_W_per_m2_K,
+                     convection_reference_rad_s=p.convection_reference_rad_s)
+    net = tn.ThermalNetwork(p, 293.15, 293.15)                 # v1: four nodes
     open_links, _, _ = net.conductances(0.0, 0.0, False)
     clamped_links, _, _ = net.conductances(0.0, 0.0, True)
-    return Chain(nodes=NODES, capacity_J_per_K=tuple(net.caps), heat_share=tuple(shares),
-                 convection_W_per_K=(p.flywheel_convection_W_per_K, p.facing_convection_W_per_K,
-                                     p.facing_convection_W_per_K, p.pressure_plate_convection_W_per_K),
-                 speed=("engine", "disc", "disc", "engine"),
-                 fixed_W_per_K=(p.engine_W_per_K, 0.0, 0.0, 0.0),
-                 link_open_W_per_K=tuple(open_links), link_clamped_W_per_K=tuple(clamped_links),
-                 theta_cm_weights=(0.0, 0.5, 0.5, 0.0), fixed_K=p.engine_degC + KELVIN,
-                 convection_gain_at_reference=p.convection_gain_at_reference,
+    return Chain(nodes=tuple(tn.NODES), capacity_J_per_K=tuple(net.caps), heat_share=tuple(net.heat_inputs(1.0)),
+                 cooled_area_m2=(p.flywheel_convection_W_per_K, p.facing_convection_W_per_K,
+                                 p.facing_convection_W_per_K, p.pressure_plate_convection_W_per_K),
+                 speed=("engine", "disc", "disc", "engine"), engine_W_per_K=(p.engine_W_per_K, 0.0, 0.0, 0.0),
+                 link_always_W_per_K=tuple(open_links),
+                 link_clamped_W_per_K=tuple(c - o for c, o in zip(clamped_links, open_links)),
+                 theta_cm_weights=(0.0, 0.5, 0.5, 0.0), engine_K=p.engine_degC + KELVIN, still_air_W_per_m2_K=1.0,
+                 rotating_W_per_m2_K=p.convection_gain_at_reference - 1.0,
                  convection_reference_rad_s=p.convection_reference_rad_s)
 
 
@@ -116,19 +135,22 @@ def node_output(node: str) -> str:
 
 
 def _node_params(node: str) -> dict[str, str]:
-    return {"cap": f"C_{node}", "share": f"heat_share_{node}", "conv": f"G_convection_{node}",
-            "fix": f"G_engine_{node}"}
+    return {"cap": f"C_{node}", "share": f"heat_share_{node}", "area": f"A_cooled_{node}",
+            "engine": f"G_engine_{node}"}
 
 
 def _link_params(a: str, b: str) -> dict[str, str]:
-    return {"open": f"G_{a}__{b}_open", "clamped": f"G_{a}__{b}_clamped"}
+    return {"always": f"G_{a}__{b}", "clamped": f"G_{a}__{b}_clamped"}
 
 
 #: the network's global parameters: name -> (unit, description, range)
 GLOBALS = {
-    "theta_engine": ("K", "engine block temperature (the fixed sink of G_engine_*)", (223.15, 423.15, False, False)),
-    "convection_gain_at_reference": ("1", "G(w_ref) / G(0) of every node's convection", (1.0, 100.0, False, False)),
-    "convection_reference_omega": ("rad/s", "speed w_ref of the convection law G(w) = G0 (1 + (gain - 1) "
+    "theta_engine": ("K", "engine block temperature (the sink of G_engine_*)", (223.15, 423.15, False, False)),
+    "h_still_air": ("W/(m2.K)", "heat-transfer coefficient to the air at rest (convection and radiation)",
+                    (0.0, 1e4, False, False)),
+    "h_rotating": ("W/(m2.K)", "added heat-transfer coefficient of a part turning at convection_reference_omega",
+                   (0.0, 1e4, False, False)),
+    "convection_reference_omega": ("rad/s", "speed w_ref of the convection law A (h_still_air + h_rotating "
                                             "(|w| / w_ref)^0.8)", (1.0, 2000.0, False, False)),
     "theta_network_start": ("K", "initial temperature of every network node", (0.0, 2000.0, True, True)),
 }
@@ -147,12 +169,12 @@ def thermal_variables(chain: Chain) -> tuple[tuple, tuple]:
         q = _node_params(k)
         extra += [(q["cap"], "parameter", "J/K", f"heat capacity of {k}"),
                   (q["share"], "parameter", "1", f"share of the slip power into {k}"),
-                  (q["conv"], "parameter", "W/K", f"convection of {k} to ambient at rest (turns with the {s})"),
-                  (q["fix"], "parameter", "W/K", f"conduction of {k} to the engine block at theta_engine")]
+                  (q["area"], "parameter", "m2", f"area of {k} cooled by the air (turns with the {s})"),
+                  (q["engine"], "parameter", "W/K", f"conduction of {k} to the engine block at theta_engine")]
     for a, b in chain.links():
         q = _link_params(a, b)
-        extra += [(q["open"], "parameter", "W/K", f"conductance {a} -- {b} with the clutch open"),
-                  (q["clamped"], "parameter", "W/K", f"conductance {a} -- {b} with the clutch clamped "
+        extra += [(q["always"], "parameter", "W/K", f"conductance {a} -- {b}"),
+                  (q["clamped"], "parameter", "W/K", f"added conductance {a} -- {b} while the clutch is clamped "
                                                      "(clamp force > 0)")]
     extra += [(n, "parameter", u, d) for n, (u, d, _) in GLOBALS.items()]
     extra += [(f"der({node_output(k)})", "local", "K/s", f"rate of change of {node_output(k)}") for k in chain.nodes]
@@ -169,13 +191,14 @@ def thermal_starts(chain: Chain, p: "clutch_model.ClutchParameters | None" = Non
     for i, k in enumerate(chain.nodes):
         q = _node_params(k)
         starts.update({node_output(k): theta0, f"der({node_output(k)})": 0.0, q["cap"]: chain.capacity_J_per_K[i],
-                       q["share"]: chain.heat_share[i], q["conv"]: chain.convection_W_per_K[i],
-                       q["fix"]: chain.fixed_W_per_K[i]})
+                       q["share"]: chain.heat_share[i], q["area"]: chain.cooled_area_m2[i],
+                       q["engine"]: chain.engine_W_per_K[i]})
     for i, (a, b) in enumerate(chain.links()):
         q = _link_params(a, b)
-        starts.update({q["open"]: chain.link_open_W_per_K[i], q["clamped"]: chain.link_clamped_W_per_K[i]})
-    starts.update({"theta_engine": chain.fixed_K, "convection_gain_at_reference": chain.convection_gain_at_reference,
-                   "convection_reference_omega": chain.convection_reference_rad_s, "theta_network_start": theta0})
+        starts.update({q["always"]: chain.link_always_W_per_K[i], q["clamped"]: chain.link_clamped_W_per_K[i]})
+    starts.update({"theta_engine": chain.engine_K, "h_still_air": chain.still_air_W_per_m2_K,
+                   "h_rotating": chain.rotating_W_per_m2_K, "convection_reference_omega":
+                   chain.convection_reference_rad_s, "theta_network_start": theta0})
     return {k: float(v) for k, v in starts.items()}
 
 
@@ -185,9 +208,9 @@ def thermal_ranges(chain: Chain) -> dict[str, tuple]:
     for k in chain.nodes:
         q = _node_params(k)
         ranges.update({q["cap"]: (0.0, 1e6, True, False), q["share"]: (0.0, 1.0, False, False),
-                       q["conv"]: (0.0, 1e4, False, False), q["fix"]: (0.0, 1e4, False, False)})
+                       q["area"]: (0.0, 10.0, False, False), q["engine"]: (0.0, 1e4, False, False)})
     for a, b in chain.links():
-        ranges.update({v: (0.0, 1e4, False, False) for v in _link_params(a, b).values()})
+        ranges.update({v: (0.0, 1e6, False, False) for v in _link_params(a, b).values()})
     ranges.update({n: r for n, (_, _, r) in GLOBALS.items()})
     return ranges
 
@@ -200,16 +223,16 @@ def _block(chain: Chain) -> str:
     """The C block of the variant: chain size, state count, value-reference arrays, structure."""
     n = len(chain.nodes)
     nodes = [_node_params(k) for k in chain.nodes]
-    links = [_link_params(a, b) for a, b in chain.links()] or [{"open": None, "clamped": None}]
+    links = [_link_params(a, b) for a, b in chain.links()] or [{"always": None, "clamped": None}]
     vr = lambda name: enum_name(name) if name else "-1"  # noqa: E731
     arrays = [
         _c_array("int", "TN_VR_THETA", [vr(node_output(k)) for k in chain.nodes]),
         _c_array("int", "TN_VR_DER", [vr(f"der({node_output(k)})") for k in chain.nodes]),
         _c_array("int", "TN_VR_CAP", [vr(q["cap"]) for q in nodes]),
         _c_array("int", "TN_VR_SHARE", [vr(q["share"]) for q in nodes]),
-        _c_array("int", "TN_VR_CONV", [vr(q["conv"]) for q in nodes]),
-        _c_array("int", "TN_VR_FIX", [vr(q["fix"]) for q in nodes]),
-        _c_array("int", "TN_VR_OPEN", [vr(q["open"]) for q in links]),
+        _c_array("int", "TN_VR_AREA", [vr(q["area"]) for q in nodes]),
+        _c_array("int", "TN_VR_ENGINE", [vr(q["engine"]) for q in nodes]),
+        _c_array("int", "TN_VR_ALWAYS", [vr(q["always"]) for q in links]),
         _c_array("int", "TN_VR_CLAMPED", [vr(q["clamped"]) for q in links]),
         _c_array("int", "TN_SPEED", [SPEEDS[s] for s in chain.speed]),
         _c_array("double", "TN_WEIGHT", [repr(float(w)) for w in chain.theta_cm_weights]),
@@ -223,7 +246,8 @@ def _block(chain: Chain) -> str:
 #define TN_N {n}
 #define CC_NSTATES (1 + TN_N)
 #define TN_VR_THETA_ENGINE {enum_name("theta_engine")}
-#define TN_VR_GAIN {enum_name("convection_gain_at_reference")}
+#define TN_VR_H_STILL {enum_name("h_still_air")}
+#define TN_VR_H_ROT {enum_name("h_rotating")}
 #define TN_VR_WREF {enum_name("convection_reference_omega")}
 #define TN_VR_THETA0 {enum_name("theta_network_start")}
 #ifdef CC_DEFINE_VARIABLE_TABLE

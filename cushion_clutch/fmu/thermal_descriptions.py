@@ -22,7 +22,7 @@ DESCRIPTION = ("Dry-clutch torque (the CushionClutch model) with the clutch's th
                "convection; theta_cm is the facing nodes' mean and drives the cushion-spring ODE "
                "(native C; Co-Simulation and Model Exchange)")
 #: units the variant adds to the clutch FMU's
-UNITS = {"W": {"kg": "1", "m": "2", "s": "-3"}}
+UNITS = {"W": {"kg": "1", "m": "2", "s": "-3"}, "m2": {"m": "2"}, "W/(m2.K)": {"kg": "1", "s": "-3", "K": "-1"}}
 
 
 def thermal_sources(fmi_version: int) -> tuple[str, ...]:

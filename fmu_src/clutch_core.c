@@ -239,32 +239,23 @@ static void net_start(double *r) {
     net_store(r, th);
 }
 
-/* slip power (W), clamp state and speeds of the current outputs and inputs */
+/* slip power (W) of the current outputs and inputs */
 static double slip_power(const double *r) { return r[VR_TORQUE] * fabs(r[VR_OMEGA_SLIP]); }
 
-/* slip_power and the nodes' derivatives of the current outputs */
-static void net_outputs(double *r) {
-    TnParams p;
-    double th[TN_N], der[TN_N];
-    int i;
-    net_params(r, &p);
-    for (i = 0; i < TN_N; ++i) th[i] = r[TN_VR_THETA[i]];
-    r[VR_SLIP_POWER] = slip_power(r);
-    tn_derivative(&p, th, r[VR_SLIP_POWER], r[VR_OMEGA_ENGINE], r[VR_OMEGA_ENGINE] - r[VR_OMEGA_SLIP],
-                  r[VR_CLAMP_FORCE] > 0.0, der);
-    for (i = 0; i < TN_N; ++i) r[TN_VR_DER[i]] = der[i];
+/* the network's parameters and operating point at the current inputs and clamp state (clamp force > 0) */
+static void net_operating(const double *r, TnParams *p, TnOperating *op) {
+    net_params(r, p);
+    tn_operating(p, r[VR_OMEGA_ENGINE], r[VR_OMEGA_ENGINE] - r[VR_OMEGA_SLIP], r[VR_CLAMP_FORCE] > 0.0, op);
 }
 
-/* Co-Simulation: advance the network h s with the slip power of the current torque held (launch plant's order) */
-static void net_step(double *r, double h) {
-    TnParams p;
-    double th[TN_N];
+/* slip_power and the nodes' derivatives of the current outputs, at the operating point op */
+static void net_derivatives(double *r, const TnParams *p, const TnOperating *op) {
+    double th[TN_N], der[TN_N];
     int i;
-    net_params(r, &p);
     for (i = 0; i < TN_N; ++i) th[i] = r[TN_VR_THETA[i]];
-    tn_step(&p, th, h, slip_power(r), r[VR_OMEGA_ENGINE], r[VR_OMEGA_ENGINE] - r[VR_OMEGA_SLIP],
-            r[VR_CLAMP_FORCE] > 0.0);
-    net_store(r, th);
+    r[VR_SLIP_POWER] = slip_power(r);
+    tn_derivative(p, op, th, r[VR_SLIP_POWER], der);
+    for (i = 0; i < TN_N; ++i) r[TN_VR_DER[i]] = der[i];
 }
 #endif
 
@@ -295,9 +286,6 @@ static int update_outputs(CcModel *m) {
     r[VR_X_KISS] = st.x_kiss;
     r[VR_CLAMP_FORCE] = st.clamp;
     r[VR_BEARING_FORCE] = st.bearing;
-#if CC_THERMAL
-    net_outputs(r);
-#endif
     m->dirty = 0;
     if (!(tb->theta[0] + KELVIN <= r[VR_THETA_CS] && r[VR_THETA_CS] <= tb->theta[tb->nt - 1] + KELVIN) &&
         !m->range_warned) {
@@ -307,6 +295,20 @@ static int update_outputs(CcModel *m) {
                tb->theta[0] + KELVIN, tb->theta[tb->nt - 1] + KELVIN);
     }
     return CC_OK;
+}
+
+/* update_outputs, and in the thermal variant slip_power and the nodes' derivatives */
+static int all_outputs(CcModel *m) {
+    int status = update_outputs(m);
+#if CC_THERMAL
+    if (status == CC_OK) {
+        TnParams p;
+        TnOperating op;
+        net_operating(m->r, &p, &op);
+        net_derivatives(m->r, &p, &op);
+    }
+#endif
+    return status;
 }
 
 /* outputs of the current inputs and state (in Initialization Mode: theta_cs = theta_cs_start).
@@ -331,7 +333,7 @@ static int refresh(CcModel *m, const char *fn) {
     } else if (!(m->phase & (PH_STEP | PH_EVENT | PH_CONT | PH_TERMINATED))) {
         return CC_OK;
     }
-    return update_outputs(m);
+    return all_outputs(m);
 }
 
 int cc_set_real(CcModel *m, const unsigned int vr[], size_t n, const double v[], const char *fn) {
@@ -406,7 +408,7 @@ int cc_exit_init(CcModel *m, const char *fn) {
     m->phase = m->me ? PH_EVENT : PH_STEP;
     m->dirty = 1;
     m->cover_ok = 0;
-    if (inputs_ok(m->r)) update_outputs(m);
+    if (inputs_ok(m->r)) all_outputs(m);
     return CC_OK;
 }
 
@@ -434,23 +436,39 @@ int cc_do_step(CcModel *m, double t, double h, const char *fn) {
     r[VR_THETA_CS] = theta_inf + (r[VR_THETA_CS] - theta_inf) * exp(-h * g / r[VR_C]);
     m->time = t + h;
 #if CC_THERMAL
-    /* the launch plant's order: the torque at the new theta_cs and the held theta_cm heats the network */
-    if (update_outputs(m) != CC_OK) {
-        m->terminated = 1;
-        return CC_DISCARD;
+    {   /* the launch plant's order: the torque at the new theta_cs and the held theta_cm heats the network */
+        TnParams p;
+        TnOperating op;
+        double th[TN_N];
+        int k;
+        if (update_outputs(m) != CC_OK) {
+            m->terminated = 1;
+            return CC_DISCARD;
+        }
+        net_operating(r, &p, &op);
+        for (k = 0; k < TN_N; ++k) th[k] = r[TN_VR_THETA[k]];
+        tn_step(&p, &op, th, h, slip_power(r));
+        for (k = 0; k < TN_N; ++k) r[TN_VR_THETA[k]] = th[k];
+        r[VR_THETA_CM] = tn_mean(&p, th);
+        if (!(r[VR_THETA_CM] > 0.0 && r[VR_THETA_CM] < THETA_CM_LIMIT)) {
+            cc_log(m, CC_DISCARD, "%s: t = %g s: the facing temperature theta_cm = %g K left (0, %g) K; step "
+                   "refused", fn, t + h, r[VR_THETA_CM], THETA_CM_LIMIT);
+            m->terminated = 1;
+            return CC_DISCARD;
+        }
+        if (update_outputs(m) != CC_OK) {        /* the outputs at the step's end */
+            m->terminated = 1;
+            return CC_DISCARD;
+        }
+        tn_links(&p, r[VR_CLAMP_FORCE] > 0.0, &op); /* same speeds; the clamp state of the new outputs */
+        net_derivatives(r, &p, &op);
     }
-    net_step(r, h);
-    if (!(r[VR_THETA_CM] > 0.0 && r[VR_THETA_CM] < THETA_CM_LIMIT)) {
-        cc_log(m, CC_DISCARD, "%s: t = %g s: the facing temperature theta_cm = %g K left (0, %g) K; step refused",
-               fn, t + h, r[VR_THETA_CM], THETA_CM_LIMIT);
+#else
+    if (update_outputs(m) != CC_OK) {
         m->terminated = 1;
         return CC_DISCARD;
     }
 #endif
-    if (update_outputs(m) != CC_OK) {
-        m->terminated = 1;
-        return CC_DISCARD;
-    }
     m->terminated = 0;
     return status;
 }

@@ -27,14 +27,19 @@ typedef struct {
     double theta_engine, theta_a, h_still, h_rot, w_ref; /* K, K, W/(m2 K), W/(m2 K), rad/s */
 } TnParams;
 
-/* links (n-1), sink conductances and sink temperatures (n) at the given speeds and clamp state */
-void tn_conductances(const TnParams *p, double w_engine, double w_disc, int clamped, double *link, double *sink_g,
-                     double *sink_t);
-/* advance theta (K) by dt (s) with the slip power (W), speeds (rad/s) and clamp state held */
-void tn_step(const TnParams *p, double *theta, double dt, double power, double w_engine, double w_disc, int clamped);
+/* the network at one operating point: links (n-1) and the nodes' sink conductances and temperatures */
+typedef struct {
+    double link[TN_MAX], sink_g[TN_MAX], sink_t[TN_MAX]; /* W/K, W/K, K */
+} TnOperating;
+
+/* the operating point at the given speeds (rad/s) and clamp state */
+void tn_operating(const TnParams *p, double w_engine, double w_disc, int clamped, TnOperating *op);
+/* the links alone for another clamp state (the sinks depend on the speeds only) */
+void tn_links(const TnParams *p, int clamped, TnOperating *op);
+/* advance theta (K) by dt (s) with the slip power (W) and the operating point held */
+void tn_step(const TnParams *p, const TnOperating *op, double *theta, double dt, double power);
 /* dtheta/dt (K/s) */
-void tn_derivative(const TnParams *p, const double *theta, double power, double w_engine, double w_disc, int clamped,
-                   double *der);
+void tn_derivative(const TnParams *p, const TnOperating *op, const double *theta, double power, double *der);
 /* the weighted mean (the facing temperature theta_cm), K */
 double tn_mean(const TnParams *p, const double *theta);
 

@@ -210,3 +210,22 @@ def test_parameters_from_the_chain_and_errors(fmus):
         s.close()
     with pytest.raises(Exception):                  # fmi2ExitInitializationMode: fmi2Error (logged)
         Slave(fmus[2], {"heat_share_flywheel": 0.9})
+
+
+def test_saved_state_holds_the_network(fmus):
+    """fmi2GetFMUstate / SetFMUstate restore the nodes and theta_cm: the same steps after a rollback give the
+    same temperatures, bit for bit."""
+    s = Slave(fmus[2])
+    names = ["theta_cm", "theta_cs", *NODE_OUTPUTS]
+    try:
+        for _ in range(50):
+            s.step(0.01, names, x_to=0.007, omega_slip=120.0, omega_engine=150.0)
+        saved, t_saved = s.s.getFMUstate(), s.t
+        first = [s.step(0.01, names, x_to=0.006, omega_slip=90.0, omega_engine=140.0) for _ in range(20)]
+        s.s.setFMUstate(saved)
+        s.t = t_saved
+        again = [s.step(0.01, names, x_to=0.006, omega_slip=90.0, omega_engine=140.0) for _ in range(20)]
+        s.s.freeFMUstate(saved)
+    finally:
+        s.close()
+    assert first == again and first[-1][0] > first[0][0]

@@ -230,7 +230,7 @@ fmi2Status fmi2SetContinuousStates(fmi2Component comp, const fmi2Real x[], size_
     COMP(fmi2Error)
     ME_ONLY("fmi2SetContinuousStates")
     if (nx != CC_NSTATES || !x) { cc_log(m, CC_ERROR, "fmi2SetContinuousStates: nx = %lu, expected %d", (unsigned long)nx, CC_NSTATES); return fmi2Error; }
-    return (fmi2Status)cc_set_state_value(m, x, "fmi2SetContinuousStates");
+    return (fmi2Status)cc_set_states(m, x, "fmi2SetContinuousStates");
 }
 
 fmi2Status fmi2GetDerivatives(fmi2Component comp, fmi2Real der[], size_t nx) {
@@ -251,7 +251,7 @@ fmi2Status fmi2GetContinuousStates(fmi2Component comp, fmi2Real x[], size_t nx) 
     COMP(fmi2Error)
     ME_ONLY("fmi2GetContinuousStates")
     if (nx != CC_NSTATES || !x) { cc_log(m, CC_ERROR, "fmi2GetContinuousStates: nx = %lu, expected %d", (unsigned long)nx, CC_NSTATES); return fmi2Error; }
-    return (fmi2Status)cc_get_state_value(m, x, "fmi2GetContinuousStates");
+    return (fmi2Status)cc_get_states(m, x, "fmi2GetContinuousStates");
 }
 
 fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component comp, fmi2Real nominal[], size_t nx) {

@@ -346,7 +346,7 @@ fmi3Status fmi3SetContinuousStates(fmi3Instance instance, const fmi3Float64 x[],
     INST(fmi3Error)
     ME_ONLY("fmi3SetContinuousStates")
     if (nx != CC_NSTATES || !x) { cc_log(m, CC_ERROR, "fmi3SetContinuousStates: nx = %lu, expected %d", (unsigned long)nx, CC_NSTATES); return fmi3Error; }
-    return (fmi3Status)cc_set_state_value(m, x, "fmi3SetContinuousStates");
+    return (fmi3Status)cc_set_states(m, x, "fmi3SetContinuousStates");
 }
 
 fmi3Status fmi3GetContinuousStateDerivatives(fmi3Instance instance, fmi3Float64 der[], size_t nx) {
@@ -367,7 +367,7 @@ fmi3Status fmi3GetContinuousStates(fmi3Instance instance, fmi3Float64 x[], size_
     INST(fmi3Error)
     ME_ONLY("fmi3GetContinuousStates")
     if (nx != CC_NSTATES || !x) { cc_log(m, CC_ERROR, "fmi3GetContinuousStates: nx = %lu, expected %d", (unsigned long)nx, CC_NSTATES); return fmi3Error; }
-    return (fmi3Status)cc_get_state_value(m, x, "fmi3GetContinuousStates");
+    return (fmi3Status)cc_get_states(m, x, "fmi3GetContinuousStates");
 }
 
 fmi3Status fmi3GetNominalsOfContinuousStates(fmi3Instance instance, fmi3Float64 nominals[], size_t nx) {

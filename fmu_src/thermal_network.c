@@ -53,10 +53,3 @@ void tn_derivative(const TnParams *p, const TnOperating *op, const double *th, d
         der[i] = q / p->cap[i];
     }
 }
-
-double tn_mean(const TnParams *p, const double *th) {
-    double s = 0.0;
-    int i;
-    for (i = 0; i < p->n; ++i) s += p->weight[i] * th[i];
-    return s;
-}

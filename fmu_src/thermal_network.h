@@ -21,7 +21,7 @@ enum { TN_ENGINE = 0, TN_DISC = 1 };
 
 typedef struct {
     int n;
-    double cap[TN_MAX], share[TN_MAX], area[TN_MAX], g_engine[TN_MAX], weight[TN_MAX]; /* J/K, 1, m2, W/K, 1 */
+    double cap[TN_MAX], share[TN_MAX], area[TN_MAX], g_engine[TN_MAX]; /* J/K, 1, m2, W/K */
     int speed[TN_MAX];                          /* TN_ENGINE or TN_DISC */
     double g_always[TN_MAX], g_clamped[TN_MAX]; /* link i -- i+1, W/K */
     double theta_engine, theta_a, h_still, h_rot, w_ref; /* K, K, W/(m2 K), W/(m2 K), rad/s */
@@ -40,7 +40,5 @@ void tn_links(const TnParams *p, int clamped, TnOperating *op);
 void tn_step(const TnParams *p, const TnOperating *op, double *theta, double dt, double power);
 /* dtheta/dt (K/s) */
 void tn_derivative(const TnParams *p, const TnOperating *op, const double *theta, double power, double *der);
-/* the weighted mean (the facing temperature theta_cm), K */
-double tn_mean(const TnParams *p, const double *theta);
 
 #endif

@@ -34,7 +34,7 @@ from .variable_table import enum_name, variable_header
 #: model identifier and modelName of the thermal variant
 THERMAL_SLAVE = "CushionClutchThermal"
 #: C sources of the network (compiled with the clutch core)
-NETWORK_SOURCES = ("thermal_network.c",)
+NETWORK_SOURCES = ("thermal_network.c", "clutch_thermal.c")
 NETWORK_HEADERS = ("thermal_network.h",)
 #: start value of the engine-speed input, rad/s (0: still-air convection on flywheel and pressure plate)
 OMEGA_ENGINE_START = 0.0
@@ -236,6 +236,7 @@ def _block(chain: Chain) -> str:
         _c_array("int", "TN_VR_CLAMPED", [vr(q["clamped"]) for q in links]),
         _c_array("int", "TN_SPEED", [SPEEDS[s] for s in chain.speed]),
         _c_array("double", "TN_WEIGHT", [repr(float(w)) for w in chain.theta_cm_weights]),
+        _c_array("char *const", "TN_NAME", [f'"{node_output(k)}"' for k in chain.nodes]),
     ]
     names = ", ".join(f'"{k}"' for k in chain.nodes)
     return f"""
@@ -250,7 +251,7 @@ def _block(chain: Chain) -> str:
 #define TN_VR_H_ROT {enum_name("h_rotating")}
 #define TN_VR_WREF {enum_name("convection_reference_omega")}
 #define TN_VR_THETA0 {enum_name("theta_network_start")}
-#ifdef CC_DEFINE_VARIABLE_TABLE
+#ifdef CC_DEFINE_THERMAL_TABLE /* clutch_thermal.c */
 {chr(10).join(arrays)}
 #endif
 """

@@ -159,10 +159,10 @@ def main(argv=None) -> None:
     from cushion_clutch.model import ClutchParameters, load_table, outputs, thermal_step
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--steps", type=int, default=200_000)
-    ap.add_argument("--cold", action="store_true", help="also time builds from an empty zig cache (minutes)")
     ap.add_argument("--thermal-only", action="store_true",
                     help="only the thermal FMU's step against the plain FMU's in the C host")
+    ap.add_argument("--steps", type=int, default=200_000)
+    ap.add_argument("--cold", action="store_true", help="also time builds from an empty zig cache (minutes)")
     args = ap.parse_args(argv)
     n = args.steps
     if args.thermal_only:

@@ -27,8 +27,7 @@ from .descriptions import fmi2_description, fmi3_build_description, fmi3_descrip
 from .variable_table import HEADER as VARIABLE_HEADER
 from .variable_table import variable_header
 from .thermal_chain import NETWORK_HEADERS, NETWORK_SOURCES, THERMAL_SLAVE, Chain, thermal_header  # noqa: F401
-from .thermal_descriptions import (thermal_fmi2_description, thermal_fmi3_build_description,
-                                   thermal_fmi3_description, thermal_sources)
+from .thermal_descriptions import thermal_descriptions_into, thermal_sources
 
 log = logging.getLogger(__name__)
 
@@ -91,26 +90,22 @@ def build_native_fmu(tables: Path, output: Path, fmi_version: int = 2,
         libs = build_binaries(src, thermal_sources(fmi_version) if thermal else sources(fmi_version), fmi_version,
                               Path(tmp) / "binaries", platforms, name=THERMAL_SLAVE if thermal else SLAVE)
         tmp_out = output.with_suffix(".fmu.tmp")
-        if thermal:
-            description = (thermal_fmi2_description(guid, has_friction, chain, x_kiss_ref) if fmi_version == 2
-                           else thermal_fmi3_description(guid, has_friction, chain, x_kiss_ref))
-        else:
-            description = (fmi2_description(guid, has_friction, x_kiss_ref)
-                           if fmi_version == 2 else fmi3_description(guid, has_friction, x_kiss_ref))
         with zipfile.ZipFile(tmp_out, "w", zipfile.ZIP_DEFLATED) as z:
-            z.writestr("modelDescription.xml", description)
+            z.writestr("modelDescription.xml", fmi2_description(guid, has_friction, x_kiss_ref)
+                       if fmi_version == 2 else fmi3_description(guid, has_friction, x_kiss_ref))
             for platform, lib in sorted(libs.items()):
                 z.write(lib, f"binaries/{platform}/{lib.name}")
             for name in staged:
                 z.write(src / name, f"sources/{name}")
             if fmi_version == 3:
-                z.writestr("sources/buildDescription.xml", thermal_fmi3_build_description() if thermal
-                           else fmi3_build_description())
+                z.writestr("sources/buildDescription.xml", fmi3_build_description())
             for name in FMU_FILES:
                 if (tables / name).exists():
                     z.write(tables / name, f"resources/tables/{name}")
         tmp_out.replace(output)
     log.info("built native FMI %d.0 %s (%s) from tables %s", fmi_version, output, ", ".join(sorted(libs)), tables)
+    if thermal:                         # the thermal variant's descriptions replace the clutch FMU's
+        thermal_descriptions_into(output, guid, has_friction, chain, x_kiss_ref, fmi_version)
     return output
 
 

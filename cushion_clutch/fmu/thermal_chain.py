@@ -2,17 +2,18 @@
 
 The clutch model is the native FMU's, unchanged (``clutch_core.c`` and friends); the thermal
 variant compiles it with ``thermal_network.c`` (a chain of N lumped nodes that knows no node by
-name) and a second generated variable table. Everything the C chain needs comes from here:
+name), ``clutch_thermal.c`` (the network inside the model: parameters, CS step, ME states) and a
+second generated variable table. Everything the C chain needs comes from here:
 
-* :class:`Chain`: the network as arrays (nodes, capacities, heat shares, convection and fixed
-  sinks with their speed source, link conductances (always, and added while clamped), the weights of the facing
-  temperature ``theta_cm``). :func:`chain_of` maps the plant's
+* :class:`Chain`: the network as arrays (nodes, capacities, heat shares, cooled areas with their
+  speed source, engine-block conductances, link conductances (always, and added while clamped),
+  the weights of the facing temperature ``theta_cm``). :func:`chain_of` maps the plant's
   :class:`~cushion_clutch.launch.thermal_network.NetworkParams` onto it; a new node list is a
   new :class:`Chain`, and the C table, the FMU variables and the descriptions follow.
 * :func:`thermal_variables`: the FMU interface. ``clutch_model.VARIABLES`` in their order with
-  ``theta_cm`` turned into an output (the network's facing mean), then after ``der(theta_cs)``
-  the input ``omega_engine``, the output ``slip_power``, the node temperatures (outputs, the
-  network's states), the network's parameters and the node derivatives.
+  ``theta_cm`` turned into an output (the network's facing mean), then the input ``omega_engine``,
+  the output ``slip_power``, the node temperatures (outputs, the network's states), the network's
+  parameters and the node derivatives; ``der(theta_cs)`` last.
 * :func:`thermal_header`: ``cushion_variables.h`` of the variant (:func:`.variable_table.variable_header`
   with the extra variables and a block of value-reference arrays for the chain).
 
@@ -157,7 +158,10 @@ GLOBALS = {
 
 
 def thermal_variables(chain: Chain) -> tuple[tuple, tuple]:
-    """(base, extra): ``clutch_model.VARIABLES`` with theta_cm an output, and the variables after der(theta_cs)."""
+    """(base, extra): ``clutch_model.VARIABLES`` with theta_cm an output, and the variant's own variables.
+
+    Value references: base, then extra, then ``der(theta_cs)`` (the last, ``CC_VR_DER_THETA_CS``).
+    """
     base = tuple((n, "output", u, "clutch facing temperature: the network's facing mean "
                   + " + ".join(f"{w:g} {node_output(k)}" for k, w in zip(chain.nodes, chain.theta_cm_weights) if w))
                  if n == "theta_cm" else (n, c, u, d) for n, c, u, d in clutch_model.VARIABLES)
@@ -203,7 +207,7 @@ def thermal_starts(chain: Chain, p: "clutch_model.ClutchParameters | None" = Non
 
 
 def thermal_ranges(chain: Chain) -> dict[str, tuple]:
-    """Allowed range (low, high, low open, high open) of every parameter of the variant."""
+    """Allowed range (low, high, low open, high open) of every parameter of the variant (and its input)."""
     ranges = dict(clutch_model.ClutchParameters.RANGES)
     for k in chain.nodes:
         q = _node_params(k)
@@ -212,6 +216,7 @@ def thermal_ranges(chain: Chain) -> dict[str, tuple]:
     for a, b in chain.links():
         ranges.update({v: (0.0, 1e6, False, False) for v in _link_params(a, b).values()})
     ranges.update({n: r for n, (_, _, r) in GLOBALS.items()})
+    ranges["omega_engine"] = (-clutch_model.OMEGA_SLIP_LIMIT, clutch_model.OMEGA_SLIP_LIMIT, False, False)
     return ranges
 
 
@@ -260,5 +265,5 @@ def _block(chain: Chain) -> str:
 def thermal_header(chain: Chain, p: "clutch_model.ClutchParameters | None" = None) -> str:
     """Text of the variant's ``cushion_variables.h``."""
     base, extra = thermal_variables(chain)
-    return variable_header(p, variables=base, starts=thermal_starts(chain, p), ranges=thermal_ranges(chain),
-                           extra=extra, block=_block(chain))
+    return variable_header(p, variant=((*base, *extra), thermal_starts(chain, p), thermal_ranges(chain)),
+                           block=_block(chain))

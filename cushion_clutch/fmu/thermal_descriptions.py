@@ -3,13 +3,15 @@
 Written from the clutch FMU's own descriptions (:mod:`.descriptions`: units, log categories and
 every clutch variable with its attributes, as they stand) and changed where the thermal variant
 differs: model name and identifier, source files, ``theta_cm`` an output (the network's facing
-mean, no start value), the variables of :func:`.thermal_chain.thermal_variables` after
-``der(theta_cs)`` (value reference = position, as in the C table), ``time`` (FMI 3.0) after them,
+mean, no start value), the variables of :func:`.thermal_chain.thermal_variables` after the
+clutch's, then ``der(theta_cs)`` (value reference = position, as in the C table), ``time`` (FMI 3.0) last,
 and the ModelStructure (outputs, the states theta_cs and the network's nodes in this order, and
 their dependencies).
 """
 from __future__ import annotations
 
+import zipfile
+from pathlib import Path
 from xml.etree import ElementTree as ET
 
 from ..model import clutch_model
@@ -33,10 +35,14 @@ def thermal_sources(fmi_version: int) -> tuple[str, ...]:
 def _all(chain: Chain) -> list[tuple[int, str, str, str, str]]:
     """(vr, name, causality, unit, description) of every variable but time, in value-reference order."""
     base, extra = thermal_variables(chain)
-    out = [(vr, *v) for vr, v in enumerate(base)]
-    out.append((vr_der(), "der(theta_cs)", "local", "K/s", "rate of change of theta_cs (paper eq. 3)"))
-    out += [(vr_der() + 1 + k, *v) for k, v in enumerate(extra)]
+    out = [(vr, *v) for vr, v in enumerate((*base, *extra))]
+    out.append((len(out), "der(theta_cs)", "local", "K/s", "rate of change of theta_cs (paper eq. 3)"))
     return out
+
+
+def thermal_vr_der(chain: Chain) -> int:
+    """Value reference of der(theta_cs) in the thermal FMU: the last (``CC_VR_DER_THETA_CS``)."""
+    return len(_all(chain)) - 1
 
 
 def thermal_dependencies(chain: Chain, has_friction: bool) -> tuple[dict[int, list[int]], list[int]]:
@@ -49,12 +55,13 @@ def thermal_dependencies(chain: Chain, has_friction: bool) -> tuple[dict[int, li
     theta_cm = vr["theta_cm"]
     deps = {}
     for out, d in plain.items():          # the clutch's outputs: theta_cm stands for the facing nodes
-        deps[out] = sorted({x for v in d for x in (facings if v == theta_cm else [v])})
+        deps[thermal_vr_der(chain) if out == vr_der() else out] = sorted(
+            {x for v in d for x in (facings if v == theta_cm else [v])})
     deps[theta_cm] = sorted(facings)
     deps[vr["slip_power"]] = sorted(set(deps[vr["torque"]]) | {vr["omega_slip"]})
     for k in nodes:
         deps[k] = [k]
-    ders = [vr_der()] + [vr[f"der({node_output(k)})"] for k in chain.nodes]
+    ders = [thermal_vr_der(chain)] + [vr[f"der({node_output(k)})"] for k in chain.nodes]
     for d in ders[1:]:
         deps[d] = sorted({vr["theta_cs"], *nodes, *inputs})
     return deps, ders
@@ -98,16 +105,21 @@ def thermal_fmi2_description(guid: str, has_friction: bool, chain: Chain, x_kiss
     p = None if x_kiss_ref_m is None else clutch_model.ClutchParameters(x_kiss_ref=x_kiss_ref_m)
     starts = thermal_starts(chain, p)
     variables = root.find("ModelVariables")
+    der_cs = None
     for sv in variables.findall("ScalarVariable"):
         if sv.get("name") == "theta_cm":
             sv.set("causality", "output")
             sv.set("description", _theta_cm_description(chain))
             real = sv.find("Real")
             real.attrib.pop("start", None)
+        elif sv.get("name") == "der(theta_cs)":       # moves to the end: the last value reference
+            der_cs = sv
+            variables.remove(sv)
+            sv.set("valueReference", str(thermal_vr_der(chain)))
     index = {}
     for vr, name, causality, unit, desc in _all(chain):
         index[name] = vr + 1
-        if vr <= vr_der():
+        if vr < len(clutch_model.VARIABLES) or name == "der(theta_cs)":
             continue
         attrs = dict(name=name, valueReference=str(vr), description=f"{desc} [{unit}]", causality=causality)
         attrs.update(variability="fixed", initial="exact") if causality == "parameter" else attrs.update(
@@ -119,6 +131,7 @@ def thermal_fmi2_description(guid: str, has_friction: bool, chain: Chain, x_kiss
             real.set("start", repr(starts[name]))
         if name.startswith("der("):
             real.set("derivative", str(index[name[4:-1]]))
+    variables.append(der_cs)
     deps, ders = thermal_dependencies(chain, has_friction)
     root.remove(root.find("ModelStructure"))
     structure = ET.SubElement(root, "ModelStructure")
@@ -143,16 +156,21 @@ def thermal_fmi3_description(token: str, has_friction: bool, chain: Chain, x_kis
     starts = thermal_starts(chain, p)
     all_ = _all(chain)
     variables = root.find("ModelVariables")
-    for v in variables:
+    der_cs = None
+    for v in list(variables):
         if v.get("name") == "theta_cm":
             v.set("causality", "output")
             v.set("description", _theta_cm_description(chain))
             v.attrib.pop("start", None)
         elif v.get("name") == "time":
             v.set("valueReference", str(len(all_)))
+        elif v.get("name") == "der(theta_cs)":        # moves to the end: the last value reference
+            der_cs = v
+            variables.remove(v)
+            v.set("valueReference", str(thermal_vr_der(chain)))
     vrs = {name: vr for vr, name, *_ in all_}
     for vr, name, causality, unit, desc in all_:
-        if vr <= vr_der():
+        if vr < len(clutch_model.VARIABLES) or name == "der(theta_cs)":
             continue
         attrs = dict(name=name, valueReference=str(vr), description=f"{desc} [{unit}]", causality=causality)
         attrs.update(variability="fixed", initial="exact") if causality == "parameter" else attrs.update(
@@ -165,6 +183,7 @@ def thermal_fmi3_description(token: str, has_friction: bool, chain: Chain, x_kis
         if causality in ("input", "parameter"):
             attrs["start"] = repr(starts[name])
         ET.SubElement(variables, "Float64", attrs)
+    variables.append(der_cs)
     deps, ders = thermal_dependencies(chain, has_friction)
     root.remove(root.find("ModelStructure"))
     structure = ET.SubElement(root, "ModelStructure")
@@ -186,3 +205,23 @@ def thermal_fmi3_build_description() -> str:
     for name in thermal_sources(3):
         ET.SubElement(files, "SourceFile", name=name)
     return _finish(root)
+
+
+def thermal_descriptions_into(fmu: Path, guid: str, has_friction: bool, chain: Chain, x_kiss_ref_m: float | None,
+                              fmi_version: int) -> None:
+    """Replace ``modelDescription.xml`` (and, FMI 3.0, ``sources/buildDescription.xml``) in the built ``fmu``
+    with the thermal variant's (the native build writes the clutch FMU's; binaries and sources are the variant's)."""
+    fmu = Path(fmu)
+    replace = {"modelDescription.xml": thermal_fmi2_description(guid, has_friction, chain, x_kiss_ref_m)
+               if fmi_version == 2 else thermal_fmi3_description(guid, has_friction, chain, x_kiss_ref_m)}
+    if fmi_version == 3:
+        replace["sources/buildDescription.xml"] = thermal_fmi3_build_description()
+    tmp = fmu.with_suffix(".fmu.tmp")
+    try:
+        with zipfile.ZipFile(fmu) as src, zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as dst:
+            for info in src.infolist():
+                dst.writestr(info.filename, replace.get(info.filename) or src.read(info.filename))
+        tmp.replace(fmu)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise

@@ -32,16 +32,14 @@ def _c_double(v: float) -> str:
     return repr(float(v))
 
 
-def variable_header(p: "clutch_model.ClutchParameters | None" = None, variables: tuple | None = None,
-                    starts: dict | None = None, ranges: dict | None = None, extra: tuple = (),
+def variable_header(p: "clutch_model.ClutchParameters | None" = None, variant: tuple | None = None,
                     block: str = "") -> str:
     """Text of ``cushion_variables.h`` for the model's ``VARIABLES`` as they stand (read at each call).
 
     Start values from ``p`` (default: the model's defaults); a tolerance P5/P95
     table set passes its own ``x_kiss_ref``. A variant of the model (the thermal FMU,
-    :mod:`.thermal_chain`) passes its own ``variables`` (same order as ``VARIABLES``,
-    causalities may differ), ``starts`` and ``ranges`` (covering ``extra`` too), the
-    ``extra`` variables that follow ``der(theta_cs)``, and a C ``block`` appended to the header.
+    :mod:`.thermal_chain`) passes ``variant`` = (its variables: ``VARIABLES`` in their order, then
+    its own; start values; ranges) and a C ``block`` appended to the header.
 
     Raises
     ------
@@ -50,10 +48,11 @@ def variable_header(p: "clutch_model.ClutchParameters | None" = None, variables:
         or a parameter has no range in ``ClutchParameters.RANGES``.
     """
     model = clutch_model
-    base = model.VARIABLES if variables is None else variables
-    starts = model.start_values(p) if starts is None else starts
-    ranges = model.ClutchParameters.RANGES if ranges is None else ranges
-    variables = (*base, *extra)
+    variables = model.VARIABLES
+    starts = model.start_values(p)
+    ranges = model.ClutchParameters.RANGES
+    if variant is not None:
+        variables, starts, ranges = variant
     names = [enum_name(n) for n, _, _, _ in variables]
     problems = [f"{n}: causality {c!r} (allowed {', '.join(CAUSALITIES)})"
                 for n, c, _, _ in variables if c not in CAUSALITIES]
@@ -62,10 +61,9 @@ def variable_header(p: "clutch_model.ClutchParameters | None" = None, variables:
                  for n, c, _, _ in variables if c == "parameter" and n not in ranges]
     if problems:
         raise ValueError("VARIABLES cannot be written as a C table: " + "; ".join(problems))
-    rows = [(n, CAUSALITIES[c], starts[n], ranges[n] if c == "parameter" else None)
-            for n, c, _, _ in variables]
-    rows.insert(len(base), ("der(theta_cs)", "CC_LOCAL", 0.0, None))
-    enum = ",\n    ".join([*names[:len(base)], "CC_VR_DER_THETA_CS", *names[len(base):], "CC_NVARS"])
+    rows = [(n, CAUSALITIES[c], starts[n], ranges[n] if c == "parameter" else None) for n, c, _, _ in variables]
+    rows.append(("der(theta_cs)", "CC_LOCAL", 0.0, None))
+    enum = ",\n    ".join([*names, "CC_VR_DER_THETA_CS", "CC_NVARS"])
     table = []
     for name, causality, start, rng in rows:
         r = "{0}" if rng is None else "{%s, %s, %d, %d}" % (_c_double(rng[0]), _c_double(rng[1]), rng[2], rng[3])

@@ -230,3 +230,24 @@ def test_saved_state_holds_the_network(fmus):
     finally:
         s.close()
     assert first == again and first[-1][0] > first[0][0]
+
+
+def test_every_binary_exports_exactly_the_fmi_api(fmus, tmp_path):
+    """The thermal FMU's binaries (every platform) export the FMI functions and nothing of the network's glue."""
+    import zipfile
+
+    import lief
+    from test_native_platforms import EXPECTED, _arch_and_exports, fmi_functions
+    seen = set()
+    for version, fmu in fmus.items():
+        with zipfile.ZipFile(fmu) as z:
+            libs = [n for n in z.namelist() if n.startswith("binaries/")]
+            z.extractall(tmp_path / f"fmi{version}", libs)
+        for name in libs:
+            assert name.endswith(("CushionClutchThermal.so", "CushionClutchThermal.dll", "CushionClutchThermal.dylib"))
+            binary = lief.parse(str(tmp_path / f"fmi{version}" / name))
+            arch, exports = _arch_and_exports(binary)
+            assert arch == EXPECTED[name.split("/")[1]][1], name
+            assert exports == fmi_functions(version), (name, exports ^ fmi_functions(version))
+            seen.add(name.split("/")[1])
+    assert seen == set(EXPECTED)

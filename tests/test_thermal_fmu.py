@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from fmpy import extract, read_model_description, simulate_fmu
+from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import FMU2Slave
 from fmpy.validation import validate_fmu
 
@@ -54,11 +55,16 @@ class Slave:
         self.s = FMU2Slave(guid=md.guid, unzipDirectory=self.unzip, modelIdentifier=md.coSimulation.modelIdentifier,
                            instanceName="thermal")
         self.s.instantiate()
-        self.s.setupExperiment(startTime=0.0)
-        if start:
-            self.s.setReal([self.vr[k] for k in start], list(start.values()))
-        self.s.enterInitializationMode()
-        self.s.exitInitializationMode()
+        try:
+            self.s.setupExperiment(startTime=0.0)
+            if start:
+                self.s.setReal([self.vr[k] for k in start], list(start.values()))
+            self.s.enterInitializationMode()
+            self.s.exitInitializationMode()
+        except FMICallException:
+            self.s.freeInstance()
+            shutil.rmtree(self.unzip, ignore_errors=True)
+            raise
         self.t = 0.0
 
     def step(self, h: float, names: list[str], **inputs: float) -> list[float]:
@@ -195,7 +201,7 @@ def test_fmi3_equals_fmi2(fmus):
         assert np.allclose(a[name], b[name], rtol=1e-12, atol=0.0), name
 
 
-def test_parameters_from_the_chain_and_errors(fmus):
+def test_parameters_from_the_chain_and_errors(fmus, capfd):
     """Start values are the plant's network; theta_cm cannot be set; shares not adding up to 1 are refused."""
     md = read_model_description(str(fmus[2]))
     start = {v.name: v.start for v in md.modelVariables}
@@ -205,12 +211,22 @@ def test_parameters_from_the_chain_and_errors(fmus):
     assert start["theta_cm"] is None
     s = Slave(fmus[2])
     try:
-        with pytest.raises(Exception):
+        with pytest.raises(FMICallException):
             s.s.setReal([s.vr["theta_cm"]], [400.0])
     finally:
         s.close()
-    with pytest.raises(Exception):                  # fmi2ExitInitializationMode: fmi2Error (logged)
-        Slave(fmus[2], {"heat_share_flywheel": 0.9})
+    capfd.readouterr()
+    with pytest.raises(FMICallException, match="fmi2ExitInitializationMode"):    # fmi2Error, logged
+        Slave(fmus[2], {f"heat_share_{NODES[0]}": 0.9})
+    assert "heat_share_* parameters add up to" in capfd.readouterr().out
+    bounds = {v.name: (v.min, v.max) for v in md.modelVariables}
+    assert bounds[f"heat_share_{NODES[0]}"] == ("0.0", "1.0") and bounds["omega_engine"] == ("-10000.0", "10000.0")
+
+
+def test_thermal_needs_the_native_backend(tmp_path, capsys):
+    assert main(["build-fmu", "--thermal", "--backend", "python", "-o", str(tmp_path / "x.fmu")]) == 2
+    assert "thermal = true needs backend 'native'" in capsys.readouterr().err
+    assert not (tmp_path / "x.fmu").exists()
 
 
 def test_saved_state_holds_the_network(fmus):

@@ -17,7 +17,8 @@ from xml.etree import ElementTree as ET
 from ..model import clutch_model
 from .constants import sources
 from .descriptions import _finish, dependencies, fmi2_description, fmi3_description, vr_der
-from .thermal_chain import NETWORK_SOURCES, THERMAL_SLAVE, Chain, node_output, thermal_starts, thermal_variables
+from .thermal_chain import (NETWORK_SOURCES, THERMAL_SLAVE, Chain, node_output, thermal_ranges, thermal_starts,
+                            thermal_variables)
 
 DESCRIPTION = ("Dry-clutch torque (the CushionClutch model) with the clutch's thermal network inside: a chain of "
                "lumped nodes heated by the slip power torque*|omega_slip| and cooled by speed-dependent "
@@ -65,6 +66,15 @@ def thermal_dependencies(chain: Chain, has_friction: bool) -> tuple[dict[int, li
     for d in ders[1:]:
         deps[d] = sorted({vr["theta_cs"], *nodes, *inputs})
     return deps, ders
+
+
+def _bounds(chain: Chain, name: str) -> dict[str, str]:
+    """FMI ``min``/``max`` of a variant's input or parameter: its closed range bounds (an open bound is left out)."""
+    rng = thermal_ranges(chain).get(name)
+    if rng is None:
+        return {}
+    lo, hi, lo_open, hi_open = rng
+    return {**({} if lo_open else {"min": repr(float(lo))}), **({} if hi_open else {"max": repr(float(hi))})}
 
 
 def _outputs(chain: Chain) -> list[int]:
@@ -129,6 +139,8 @@ def thermal_fmi2_description(guid: str, has_friction: bool, chain: Chain, x_kiss
             real.set("displayUnit", "degC")
         if causality in ("input", "parameter"):
             real.set("start", repr(starts[name]))
+            for k, v in _bounds(chain, name).items():
+                real.set(k, v)
         if name.startswith("der("):
             real.set("derivative", str(index[name[4:-1]]))
     variables.append(der_cs)
@@ -182,6 +194,7 @@ def thermal_fmi3_description(token: str, has_friction: bool, chain: Chain, x_kis
             attrs["derivative"] = str(vrs[name[4:-1]])
         if causality in ("input", "parameter"):
             attrs["start"] = repr(starts[name])
+            attrs.update(_bounds(chain, name))
         ET.SubElement(variables, "Float64", attrs)
     variables.append(der_cs)
     deps, ders = thermal_dependencies(chain, has_friction)

@@ -22,7 +22,7 @@ from cushion_clutch.fmu.thermal_chain import chain_of, node_output
 from cushion_clutch.data import DEFAULT_TABLES
 from cushion_clutch.launch.scenario import load_scenario
 from cushion_clutch.launch.thermal_network import NODES, ThermalNetwork
-from cushion_clutch.model import ClutchParameters, load_table, outputs, thermal_step
+from cushion_clutch.model import ClutchParameters, clutch_model, load_table, outputs, thermal_step
 
 pytestmark = pytest.mark.fmu
 
@@ -220,7 +220,9 @@ def test_parameters_from_the_chain_and_errors(fmus, capfd):
         Slave(fmus[2], {f"heat_share_{NODES[0]}": 0.9})
     assert "heat_share_* parameters add up to" in capfd.readouterr().out
     bounds = {v.name: (v.min, v.max) for v in md.modelVariables}
-    assert bounds[f"heat_share_{NODES[0]}"] == ("0.0", "1.0") and bounds["omega_engine"] == ("-10000.0", "10000.0")
+    limit = clutch_model.OMEGA_SLIP_LIMIT
+    assert bounds[f"heat_share_{NODES[0]}"] == ("0.0", "1.0")
+    assert tuple(map(float, bounds["omega_engine"])) == (-limit, limit)
 
 
 def test_thermal_needs_the_native_backend(tmp_path, capsys):

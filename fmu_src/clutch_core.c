@@ -163,6 +163,9 @@ static int check_parameters(CcModel *m, const double *r, const char *fn) {
         cc_log(m, CC_ERROR, "%s: parameter n_surfaces = %g must be a whole number in [1, 16]", fn, r[VR_N_SURFACES]);
         ok = 0;
     }
+#if CC_THERMAL
+    if (!cc_net_parameters_ok(m, r, fn)) ok = 0; /* the network's own rules (clutch_thermal.c) */
+#endif
     if (ok && !cover_consistent(m, r, fn)) ok = 0;
     if (ok && !(r[VR_U] + r[VR_H] > 0.0)) {
         cc_log(m, CC_ERROR, "%s: U + H must be > 0 (the cushion spring needs a heat path)", fn);
@@ -254,6 +257,9 @@ static int update_outputs(CcModel *m) {
     r[VR_X_KISS] = st.x_kiss;
     r[VR_CLAMP_FORCE] = st.clamp;
     r[VR_BEARING_FORCE] = st.bearing;
+#if CC_THERMAL
+    if (cc_net_outputs(m) != CC_OK) return CC_DISCARD; /* slip_power, the nodes' derivatives (clutch_thermal.c) */
+#endif
     m->dirty = 0;
     {
         int v = validity(m);
@@ -318,6 +324,9 @@ int cc_set_real(CcModel *m, const unsigned int vr[], size_t n, const double v[],
         m->r[vr[k]] = v[k];
         if (is_parameter(vr[k])) m->cover_ok = 0;
     }
+#if CC_THERMAL
+    if (!after_init) cc_net_start(m->r); /* the nodes at theta_network_start until initialisation ends */
+#endif
     if (n) m->dirty = 1;
     return CC_OK;
 }
@@ -382,6 +391,12 @@ int cc_do_step(CcModel *m, double t, double h, const char *fn) {
         m->terminated = 1;
         return CC_DISCARD;
     }
+#if CC_THERMAL
+    if (!cc_net_begin_step(m, t, "step refused")) {
+        m->terminated = 1;
+        return CC_DISCARD;
+    }
+#endif
     if (fabs(t - m->time) > 1e-9 * (1.0 + fabs(t))) {
         cc_log(m, CC_WARNING, "%s: currentCommunicationPoint = %.17g s does not follow the previous step "
                "(expected %.17g s); accepted", fn, t, m->time);
@@ -399,6 +414,14 @@ int cc_do_step(CcModel *m, double t, double h, const char *fn) {
     }
     m->time = t + h;
     m->terminated = 0;
+#if CC_THERMAL
+    /* the launch plant's order: the torque just computed (new theta_cs, held theta_cm) heats the network, then
+       the outputs at the step's end (clutch_thermal.c) */
+    if (cc_net_step(m, h, fn, update_outputs) != CC_OK) {
+        m->terminated = 1;
+        return CC_DISCARD;
+    }
+#endif
     return status;
 }
 
@@ -413,6 +436,14 @@ int cc_derivative(CcModel *m, double *der, const char *fn) {
         return CC_DISCARD;
     }
     theta = m->phase == PH_INIT ? r[VR_THETA_CS_START] : r[VR_THETA_CS];
+#if CC_THERMAL
+    {   /* the slip power needs the torque: the outputs of the current states and inputs */
+        int status = m->dirty ? refresh(m, fn) : CC_OK;
+        if (status != CC_OK) return status;
+        theta = r[VR_THETA_CS];
+        cc_net_get_derivatives(m, der + 1);
+    }
+#endif
     *der = (r[VR_U] * r[VR_THETA_CM] + r[VR_H] * r[VR_THETA_A] - (r[VR_U] + r[VR_H]) * theta) / r[VR_C];
     return CC_OK;
 }
@@ -443,6 +474,26 @@ int cc_get_state_value(CcModel *m, double *theta_cs, const char *fn) {
     if (!cc_allowed(m, PH_INIT | PH_EVENT | PH_CONT | PH_TERMINATED | PH_ERROR, fn)) return CC_ERROR;
     *theta_cs = m->phase == PH_INIT ? m->r[VR_THETA_CS_START] : m->r[VR_THETA_CS];
     return CC_OK;
+}
+
+int cc_set_states(CcModel *m, const double *x, const char *fn) {
+    int status;
+#if CC_THERMAL
+    if (!cc_allowed(m, PH_CONT, fn) || !cc_net_states_ok(m, x + 1, fn)) return CC_ERROR;
+#endif
+    status = cc_set_state_value(m, x[0], fn);
+#if CC_THERMAL
+    if (status == CC_OK) cc_net_set_states(m, x + 1);
+#endif
+    return status;
+}
+
+int cc_get_states(CcModel *m, double *x, const char *fn) {
+    int status = cc_get_state_value(m, x, fn);
+#if CC_THERMAL
+    if (status == CC_OK) cc_net_get_states(m, x + 1);
+#endif
+    return status;
 }
 
 /* -------------------------------------------------------------- saved state */

@@ -27,6 +27,14 @@
 #include "resource_uri.h"
 
 #define CC_VR_TIME CC_NVARS
+/* the thermal variant (CushionClutchThermal, cushion_clutch.fmu.thermal_chain) defines CC_THERMAL, the chain
+   (thermal_network.h) and CC_NSTATES (theta_cs, then the network's nodes) in its cushion_variables.h */
+#ifndef CC_THERMAL
+#define CC_THERMAL 0
+#endif
+#ifndef CC_NSTATES
+#define CC_NSTATES 1
+#endif
 
 /* statuses: the same numbers as fmi2Status and fmi3Status */
 enum { CC_OK = 0, CC_WARNING = 1, CC_DISCARD = 2, CC_ERROR = 3, CC_FATAL = 4 };
@@ -110,6 +118,9 @@ typedef struct {
     char table_error[600];
     CcLogger logger;
     void *log_ctx;
+#if CC_THERMAL
+    int net_skip;     /* the next output update skips the nodes' derivatives (a CS step computes them at its end) */
+#endif
 } CcModel;
 
 /* the serialized (and saved) FMU state: versioned, checksummed, validated before use */
@@ -163,14 +174,31 @@ int cc_get_real(CcModel *m, const unsigned int vr[], size_t n, double v[], const
 int cc_enter_init(CcModel *m, double start_time, const char *fn);
 int cc_exit_init(CcModel *m, const char *fn);
 int cc_do_step(CcModel *m, double t, double h, const char *fn);
+/* the CC_NSTATES state derivatives, K/s */
 int cc_derivative(CcModel *m, double *der, const char *fn);
 /* ME SetTime: refuses a non-finite time */
 int cc_set_time(CcModel *m, double t, const char *fn);
 int cc_set_state_value(CcModel *m, double theta_cs, const char *fn);
 /* the continuous state theta_cs, K (its start value during initialisation) */
 int cc_get_state_value(CcModel *m, double *theta_cs, const char *fn);
+/* the CC_NSTATES continuous states, K: theta_cs, then (thermal variant) the network's nodes; the front ends' */
+int cc_set_states(CcModel *m, const double *x, const char *fn);
+int cc_get_states(CcModel *m, double *x, const char *fn);
 void cc_state_save(const CcModel *m, CcState *s);
 int cc_state_check(CcModel *m, const void *bytes, size_t size, const char *fn);
 void cc_state_load(CcModel *m, const CcState *s);
+
+#if CC_THERMAL
+/* ---- the thermal variant's network in the model (clutch_thermal.c, over thermal_network.c) */
+void cc_net_start(double *r);
+int cc_net_parameters_ok(CcModel *m, const double *r, const char *fn);
+int cc_net_begin_step(CcModel *m, double t, const char *what);
+int cc_net_outputs(CcModel *m);
+int cc_net_step(CcModel *m, double h, const char *fn, int (*outputs)(CcModel *));
+int cc_net_states_ok(CcModel *m, const double *x, const char *fn);
+void cc_net_set_states(CcModel *m, const double *x);
+void cc_net_get_states(CcModel *m, double *x);
+void cc_net_get_derivatives(CcModel *m, double *der);
+#endif
 
 #endif

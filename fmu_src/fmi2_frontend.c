@@ -229,14 +229,14 @@ fmi2Status fmi2SetTime(fmi2Component comp, fmi2Real time) {
 fmi2Status fmi2SetContinuousStates(fmi2Component comp, const fmi2Real x[], size_t nx) {
     COMP(fmi2Error)
     ME_ONLY("fmi2SetContinuousStates")
-    if (nx != 1 || !x) { cc_log(m, CC_ERROR, "fmi2SetContinuousStates: nx = %lu, expected 1", (unsigned long)nx); return fmi2Error; }
-    return (fmi2Status)cc_set_state_value(m, x[0], "fmi2SetContinuousStates");
+    if (nx != CC_NSTATES || !x) { cc_log(m, CC_ERROR, "fmi2SetContinuousStates: nx = %lu, expected %d", (unsigned long)nx, CC_NSTATES); return fmi2Error; }
+    return (fmi2Status)cc_set_states(m, x, "fmi2SetContinuousStates");
 }
 
 fmi2Status fmi2GetDerivatives(fmi2Component comp, fmi2Real der[], size_t nx) {
     COMP(fmi2Error)
     ME_ONLY("fmi2GetDerivatives")
-    if (nx != 1 || !der) { cc_log(m, CC_ERROR, "fmi2GetDerivatives: nx = %lu, expected 1", (unsigned long)nx); return fmi2Error; }
+    if (nx != CC_NSTATES || !der) { cc_log(m, CC_ERROR, "fmi2GetDerivatives: nx = %lu, expected %d", (unsigned long)nx, CC_NSTATES); return fmi2Error; }
     return (fmi2Status)cc_derivative(m, der, "fmi2GetDerivatives");
 }
 
@@ -250,15 +250,15 @@ fmi2Status fmi2GetEventIndicators(fmi2Component comp, fmi2Real ind[], size_t ni)
 fmi2Status fmi2GetContinuousStates(fmi2Component comp, fmi2Real x[], size_t nx) {
     COMP(fmi2Error)
     ME_ONLY("fmi2GetContinuousStates")
-    if (nx != 1 || !x) { cc_log(m, CC_ERROR, "fmi2GetContinuousStates: nx = %lu, expected 1", (unsigned long)nx); return fmi2Error; }
-    return (fmi2Status)cc_get_state_value(m, x, "fmi2GetContinuousStates");
+    if (nx != CC_NSTATES || !x) { cc_log(m, CC_ERROR, "fmi2GetContinuousStates: nx = %lu, expected %d", (unsigned long)nx, CC_NSTATES); return fmi2Error; }
+    return (fmi2Status)cc_get_states(m, x, "fmi2GetContinuousStates");
 }
 
 fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component comp, fmi2Real nominal[], size_t nx) {
     COMP(fmi2Error)
     ME_ONLY("fmi2GetNominalsOfContinuousStates")
-    if (nx != 1 || !nominal) return fmi2Error;
-    nominal[0] = 300.0; /* K */
+    if (nx != CC_NSTATES || !nominal) return fmi2Error;
+    for (nx = 0; nx < CC_NSTATES; ++nx) nominal[nx] = 300.0; /* K */
     return fmi2OK;
 }
 

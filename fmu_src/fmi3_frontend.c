@@ -345,14 +345,14 @@ fmi3Status fmi3SetTime(fmi3Instance instance, fmi3Float64 time) {
 fmi3Status fmi3SetContinuousStates(fmi3Instance instance, const fmi3Float64 x[], size_t nx) {
     INST(fmi3Error)
     ME_ONLY("fmi3SetContinuousStates")
-    if (nx != 1 || !x) { cc_log(m, CC_ERROR, "fmi3SetContinuousStates: nx = %lu, expected 1", (unsigned long)nx); return fmi3Error; }
-    return (fmi3Status)cc_set_state_value(m, x[0], "fmi3SetContinuousStates");
+    if (nx != CC_NSTATES || !x) { cc_log(m, CC_ERROR, "fmi3SetContinuousStates: nx = %lu, expected %d", (unsigned long)nx, CC_NSTATES); return fmi3Error; }
+    return (fmi3Status)cc_set_states(m, x, "fmi3SetContinuousStates");
 }
 
 fmi3Status fmi3GetContinuousStateDerivatives(fmi3Instance instance, fmi3Float64 der[], size_t nx) {
     INST(fmi3Error)
     ME_ONLY("fmi3GetContinuousStateDerivatives")
-    if (nx != 1 || !der) { cc_log(m, CC_ERROR, "fmi3GetContinuousStateDerivatives: nx = %lu, expected 1", (unsigned long)nx); return fmi3Error; }
+    if (nx != CC_NSTATES || !der) { cc_log(m, CC_ERROR, "fmi3GetContinuousStateDerivatives: nx = %lu, expected %d", (unsigned long)nx, CC_NSTATES); return fmi3Error; }
     return (fmi3Status)cc_derivative(m, der, "fmi3GetContinuousStateDerivatives");
 }
 
@@ -366,15 +366,15 @@ fmi3Status fmi3GetEventIndicators(fmi3Instance instance, fmi3Float64 ind[], size
 fmi3Status fmi3GetContinuousStates(fmi3Instance instance, fmi3Float64 x[], size_t nx) {
     INST(fmi3Error)
     ME_ONLY("fmi3GetContinuousStates")
-    if (nx != 1 || !x) { cc_log(m, CC_ERROR, "fmi3GetContinuousStates: nx = %lu, expected 1", (unsigned long)nx); return fmi3Error; }
-    return (fmi3Status)cc_get_state_value(m, x, "fmi3GetContinuousStates");
+    if (nx != CC_NSTATES || !x) { cc_log(m, CC_ERROR, "fmi3GetContinuousStates: nx = %lu, expected %d", (unsigned long)nx, CC_NSTATES); return fmi3Error; }
+    return (fmi3Status)cc_get_states(m, x, "fmi3GetContinuousStates");
 }
 
 fmi3Status fmi3GetNominalsOfContinuousStates(fmi3Instance instance, fmi3Float64 nominals[], size_t nx) {
     INST(fmi3Error)
     ME_ONLY("fmi3GetNominalsOfContinuousStates")
-    if (nx != 1 || !nominals) return fmi3Error;
-    nominals[0] = 300.0; /* K */
+    if (nx != CC_NSTATES || !nominals) return fmi3Error;
+    for (nx = 0; nx < CC_NSTATES; ++nx) nominals[nx] = 300.0; /* K */
     return fmi3OK;
 }
 
@@ -386,7 +386,7 @@ fmi3Status fmi3GetNumberOfEventIndicators(fmi3Instance instance, size_t *n) {
 
 fmi3Status fmi3GetNumberOfContinuousStates(fmi3Instance instance, size_t *n) {
     INST(fmi3Error)
-    *n = m->me ? 1 : 0;
+    *n = m->me ? CC_NSTATES : 0;
     return fmi3OK;
 }
 

@@ -5,7 +5,12 @@ host (fmu_src/hosts/fmi2_host.c, dlopen), and the Python model alone; the time
 to build the native FMU with the binaries of every platform (FMI 2.0: 3, FMI 3.0: 5),
 with zig's cache warm, and with ``--cold`` also from an empty zig cache.
 
-    python -m cushion_clutch.benchmarks.fmu [--steps 200000] [--cold]
+    python -m cushion_clutch.benchmarks.fmu [--steps 200000] [--cold] [--thermal-only]
+
+The thermal FMU (``build-fmu --thermal``) against the plain one, both native in the C host
+``fmu_src/hosts/fmi2_duty_host.c`` on the same bearing sweep with 100 rad/s of slip (the plain FMU
+also gets a theta_cm sweep, the thermal one an engine speed): median of 5 alternating runs and the ratio
+(target: at most 3x). ``--thermal-only`` runs only this comparison.
 """
 from __future__ import annotations
 
@@ -82,6 +87,43 @@ def time_c_host(host: Path, fmu: Path, n: int, python: bool, workdir: Path) -> t
     return us, res.returncode, res.stderr.strip()[-200:]
 
 
+def time_thermal(tmp: Path, n: int, repeats: int = 5) -> tuple[float, float]:
+    """(plain, thermal) native FMI 2.0 FMU: median us per set+doStep+get in the C duty host; prints the ratio."""
+    import statistics
+
+    from fmpy import read_model_description
+
+    from cushion_clutch.data import DEFAULT_TABLES, fmu_sources
+    from cushion_clutch.fmu.build import build_fmu
+    from cushion_clutch.fmu.native import fmi2_header_dir
+
+    host = tmp / "duty_host"
+    subprocess.run([shutil.which("gcc") or "cc", "-std=c99", "-D_POSIX_C_SOURCE=199309L", "-O2",
+                    f"-I{fmi2_header_dir()}", str(fmu_sources() / "hosts" / "fmi2_duty_host.c"), "-o", str(host),
+                    "-ldl"], check=True)
+    runs = {}
+    for label, thermal in (("plain", False), ("thermal", True)):
+        fmu = build_fmu(DEFAULT_TABLES, tmp / f"duty_{label}.fmu", thermal=thermal)
+        md = read_model_description(str(fmu))
+        vr = {v.name: v.valueReference for v in md.modelVariables}
+        unzip = tmp / f"duty_{label}"
+        zipfile.ZipFile(fmu).extractall(unzip)
+        ins = ("x_to", "omega_slip", "omega_engine") if thermal else ("x_to", "theta_cm", "omega_slip")
+        lib = unzip / "binaries" / "linux64" / f"{md.coSimulation.modelIdentifier}.so"
+        runs[label] = [str(host), str(lib), (unzip / "resources").as_uri(), md.guid, str(n), "0.001",
+                       *(str(vr[k]) for k in ins), "1" if thermal else "0"]
+    times: dict[str, list[float]] = {"plain": [], "thermal": []}
+    for _ in range(repeats):
+        for label, cmd in runs.items():
+            res = subprocess.run(cmd, capture_output=True, text=True, check=True)
+            times[label].append(next(float(x.split()[1]) for x in res.stdout.splitlines()
+                                     if x.startswith("us_per_step")))
+    plain, thermal = statistics.median(times["plain"]), statistics.median(times["thermal"])
+    print(f"C duty host, {n} steps of 1 ms, median of {repeats}: plain FMU {plain:.3f} us/step, "
+          f"thermal FMU {thermal:.3f} us/step, ratio {thermal / plain:.2f} (target <= 3)")
+    return plain, thermal
+
+
 def time_builds(tmp: Path, cold: bool) -> None:
     """Print the time to build the native FMU for all platforms, per FMI version (warm, optionally cold)."""
     from cushion_clutch.fmu.build import build_fmu
@@ -126,6 +168,8 @@ def main(argv=None) -> None:
     from .page import results_page
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--thermal-only", action="store_true",
+                    help="only the thermal FMU's step against the plain FMU's in the C host")
     ap.add_argument("--steps", type=int, default=200_000)
     ap.add_argument("--cold", action="store_true", help="also time builds from an empty zig cache (minutes)")
     ap.add_argument("--markdown", action="store_true", help="with --out: the results page")
@@ -137,6 +181,10 @@ def main(argv=None) -> None:
 
 def _run(args, build_fmu, DEFAULT_TABLES, ClutchParameters, load_table, outputs, thermal_step) -> None:
     n = args.steps
+    if args.thermal_only:
+        with tempfile.TemporaryDirectory() as tmp:
+            time_thermal(Path(tmp), n)
+        return
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
         time_builds(tmp, args.cold)
@@ -154,6 +202,7 @@ def _run(args, build_fmu, DEFAULT_TABLES, ClutchParameters, load_table, outputs,
             print(f"C host, {b:>6} FMU: set+doStep+get {ch[b][0]:8.3f} us/step{note}")
         print(f"native speed-up: {ch['python'][0] / ch['native'][0]:.0f}x in the C host, "
               f"{fm['python'][0] / fm['native'][0]:.1f}x through fmpy")
+        time_thermal(tmp, n * 10)
     table, p = load_table(), ClutchParameters()
     theta = 293.15
     t0 = time.perf_counter()

@@ -16,13 +16,16 @@ from ..model.table_format import REQUIRED_FILES
 log = logging.getLogger(__name__)
 
 
-def build_fmu(tables: Path, output: Path, backend: str = "native", fmi_version: int = 2) -> Path:
+def build_fmu(tables: Path, output: Path, backend: str = "native", fmi_version: int = 2,
+              thermal: bool = False) -> Path:
     """Build ``output`` (.fmu) carrying the table set in ``tables``.
 
     ``backend`` is ``"native"`` (C; loads in any FMI host; binaries for Windows,
     Linux and macOS; Co-Simulation and Model Exchange) or ``"python"``
     (pythonfmu; FMI 2.0 Co-Simulation; needs Python and numpy where it runs).
-    ``fmi_version`` is 2 (FMI 2.0) or 3 (FMI 3.0, native only).
+    ``fmi_version`` is 2 (FMI 2.0) or 3 (FMI 3.0, native only). ``thermal`` (native only)
+    builds ``CushionClutchThermal``: the clutch with the plant's thermal network inside
+    (:mod:`.thermal_chain`; inputs x_to, omega_slip, omega_engine; theta_cm an output).
 
     Raises
     ------
@@ -37,10 +40,13 @@ def build_fmu(tables: Path, output: Path, backend: str = "native", fmi_version: 
             raise TableError(f"{tables / name} is missing")
     if fmi_version not in (2, 3):
         raise ParameterError([f"fmi_version = {fmi_version!r}: allowed 2 or 3"])
+    if thermal and backend != "native":
+        raise ParameterError([f"thermal = true needs backend 'native' (got {backend!r})"])
     output.parent.mkdir(parents=True, exist_ok=True)
     if backend == "native":
         from .native import build_native_fmu
-        return build_native_fmu(tables, output, fmi_version=fmi_version)
+        from .thermal_chain import chain_of
+        return build_native_fmu(tables, output, fmi_version=fmi_version, chain=chain_of() if thermal else None)
     if backend != "python":
         raise ValueError(f"backend = {backend!r}: allowed 'python' or 'native'")
     if fmi_version != 2:
@@ -86,6 +92,10 @@ def add_build_arguments(parser) -> None:
     parser.add_argument("--fmi-version", type=int, choices=(2, 3), default=2,
                         help="FMI 2.0 (default) or 3.0 (native backend only); both carry Co-Simulation "
                              "and Model Exchange")
+    parser.add_argument("--thermal", action="store_true",
+                        help="CushionClutchThermal: the clutch with the plant's thermal network inside (native "
+                             "only): inputs x_to, omega_slip, omega_engine; theta_cm and the nodes' "
+                             "temperatures are outputs")
 
 
 def build_from_args(args) -> str:
@@ -93,8 +103,10 @@ def build_from_args(args) -> str:
     from ..model.clutch_model import ClutchParameters
     from ..model.table_format import table_set_x_kiss_ref
     version = getattr(args, "fmi_version", 2)
-    out = build_fmu(args.tables, args.output, backend=args.backend, fmi_version=version)
+    thermal = getattr(args, "thermal", False)
+    out = build_fmu(args.tables, args.output, backend=args.backend, fmi_version=version, thermal=thermal)
     own = table_set_x_kiss_ref(args.tables)
     kiss = (f"x_kiss_ref = {own * 1e3:.4f} mm (the table set's own kiss point, metadata.json tolerance_study)"
             if own is not None else f"x_kiss_ref = {ClutchParameters().x_kiss_ref * 1e3:.4f} mm (default)")
-    return f"built {out} ({args.backend}, FMI {version}.0) from {args.tables}; {kiss}"
+    what = f"{args.backend}, FMI {version}.0" + (", thermal network inside" if thermal else "")
+    return f"built {out} ({what}) from {args.tables}; {kiss}"

@@ -56,9 +56,11 @@ def compile_command(platform: str, fmi_version: int, src: Path, files: tuple[str
 
 
 def build_binaries(src: Path, files: tuple[str, ...], fmi_version: int, out_dir: Path,
-                   platforms: tuple[str, ...] | None = None, linux_libs: tuple[str, ...] = ()) -> dict[str, Path]:
+                   platforms: tuple[str, ...] | None = None, linux_libs: tuple[str, ...] = (),
+                   name: str = "CushionClutch") -> dict[str, Path]:
     """Compile ``files`` (in ``src``, with the headers) for ``platforms`` (default: all, or the host
-    without ziglang) in parallel, linking ``linux_libs`` too on Linux; return platform -> library path."""
+    without ziglang) in parallel, linking ``linux_libs`` too on Linux; return platform -> library path.
+    ``name``: the library's name, the FMU's model identifier."""
     if platforms is None:
         platforms = tuple(TARGETS[fmi_version]) if zig_available() else (HOST[fmi_version],)
         if not zig_available():
@@ -67,7 +69,7 @@ def build_binaries(src: Path, files: tuple[str, ...], fmi_version: int, out_dir:
     jobs = {}
     for platform in platforms:
         _, suffix = TARGETS[fmi_version][platform]
-        out = out_dir / platform / f"CushionClutch{suffix}"
+        out = out_dir / platform / f"{name}{suffix}"
         out.parent.mkdir(parents=True, exist_ok=True)
         cmd = compile_command(platform, fmi_version, src, files, out, linux_libs)
         jobs[platform] = (cmd, out, subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE,

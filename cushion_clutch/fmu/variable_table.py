@@ -32,11 +32,14 @@ def _c_double(v: float) -> str:
     return repr(float(v))
 
 
-def variable_header(p: "clutch_model.ClutchParameters | None" = None) -> str:
+def variable_header(p: "clutch_model.ClutchParameters | None" = None, variant: tuple | None = None,
+                    block: str = "") -> str:
     """Text of ``cushion_variables.h`` for the model's ``VARIABLES`` as they stand (read at each call).
 
     Start values from ``p`` (default: the model's defaults); a tolerance P5/P95
-    table set passes its own ``x_kiss_ref``.
+    table set passes its own ``x_kiss_ref``. A variant of the model (the thermal FMU,
+    :mod:`.thermal_chain`) passes ``variant`` = (its variables: ``VARIABLES`` in their order, then
+    its own; start values; ranges) and a C ``block`` appended to the header.
 
     Raises
     ------
@@ -48,6 +51,8 @@ def variable_header(p: "clutch_model.ClutchParameters | None" = None) -> str:
     variables = model.VARIABLES
     starts = model.start_values(p)
     ranges = model.ClutchParameters.RANGES
+    if variant is not None:
+        variables, starts, ranges = variant
     names = [enum_name(n) for n, _, _, _ in variables]
     problems = [f"{n}: causality {c!r} (allowed {', '.join(CAUSALITIES)})"
                 for n, c, _, _ in variables if c not in CAUSALITIES]
@@ -95,6 +100,6 @@ static const CcVariable CC_VARIABLES[CC_NVARS] = {{
 {chr(10).join(table)}
 }};
 #endif
-
+{block}
 #endif
 """

@@ -1,0 +1,55 @@
+/*
+ * The chain of lumped thermal nodes (thermal_network.h): conductances, the exact-exponential
+ * Gauss-Seidel step (Co-Simulation) and the derivative (Model Exchange).
+ */
+#include "thermal_network.h"
+
+#include <math.h>
+
+void tn_links(const TnParams *p, int clamped, TnOperating *op) {
+    int i;
+    for (i = 0; i + 1 < p->n; ++i) op->link[i] = clamped ? p->g_always[i] + p->g_clamped[i] : p->g_always[i];
+}
+
+void tn_operating(const TnParams *p, double w_engine, double w_disc, int clamped, TnOperating *op) {
+    int i;
+    /* (|w| / w_ref)^0.8 per speed source (turbulent forced convection, Nu ~ Re^0.8) */
+    double x[2];
+    x[TN_ENGINE] = pow(fabs(w_engine) / p->w_ref, 0.8);
+    x[TN_DISC] = pow(fabs(w_disc) / p->w_ref, 0.8);
+    tn_links(p, clamped, op);
+    for (i = 0; i < p->n; ++i) {
+        double conv = p->area[i] > 0.0 ? p->area[i] * (p->h_still + p->h_rot * x[p->speed[i]]) : 0.0;
+        double g = conv + p->g_engine[i];
+        op->sink_g[i] = g;
+        op->sink_t[i] = g > 0.0 ? (p->g_engine[i] * p->theta_engine + conv * p->theta_a) / g : p->theta_a;
+    }
+}
+
+void tn_step(const TnParams *p, const TnOperating *op, double *th, double dt, double power) {
+    const double *link = op->link, *sg = op->sink_g, *st = op->sink_t;
+    int i, n = p->n;
+    for (i = 0; i < n; ++i) {
+        double gl = i > 0 ? link[i - 1] : 0.0, gr = i < n - 1 ? link[i] : 0.0;
+        double gs = gl + gr + sg[i];
+        double flow = p->share[i] * power + sg[i] * st[i] + (i > 0 ? gl * th[i - 1] : 0.0) +
+                      (i < n - 1 ? gr * th[i + 1] : 0.0);
+        if (gs > 0.0) {
+            double inf = flow / gs;
+            th[i] = inf + (th[i] - inf) * exp(-dt * gs / p->cap[i]);
+        } else {
+            th[i] += flow * dt / p->cap[i];
+        }
+    }
+}
+
+void tn_derivative(const TnParams *p, const TnOperating *op, const double *th, double power, double *der) {
+    const double *link = op->link, *sg = op->sink_g, *st = op->sink_t;
+    int i, n = p->n;
+    for (i = 0; i < n; ++i) {
+        double q = p->share[i] * power + sg[i] * (st[i] - th[i]);
+        if (i > 0) q += link[i - 1] * (th[i - 1] - th[i]);
+        if (i < n - 1) q += link[i] * (th[i + 1] - th[i]);
+        der[i] = q / p->cap[i];
+    }
+}

@@ -1,0 +1,271 @@
+"""The thermal clutch FMU (``build-fmu --thermal``, CushionClutchThermal) through fmpy: interface, the bar's
+twelve slips, a launch replayed in lock-step against the Python plant's network and clutch model, ME vs CS,
+FMI 3.0 vs 2.0, and the errors it reports."""
+from __future__ import annotations
+
+import dataclasses
+import functools
+import shutil
+import tempfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+from fmpy import extract, read_model_description, simulate_fmu
+from fmpy.fmi1 import FMICallException
+from fmpy.fmi2 import FMU2Slave
+from fmpy.validation import validate_fmu
+
+from cushion_clutch.cli import main
+from cushion_clutch.fmu.build import build_fmu
+from cushion_clutch.fmu.thermal_chain import chain_of, node_output
+from cushion_clutch.data import DEFAULT_TABLES
+from cushion_clutch.launch.scenario import load_scenario
+from cushion_clutch.launch.thermal_network import NODES, ThermalNetwork
+from cushion_clutch.model import ClutchParameters, clutch_model, load_table, outputs, thermal_step
+
+pytestmark = pytest.mark.fmu
+
+NODE_OUTPUTS = [node_output(k) for k in NODES]
+
+
+@functools.cache
+def thermal_fmus() -> dict[int, Path]:
+    """{2: FMI 2.0, 3: FMI 3.0} thermal FMUs, built once per session (FMI 2.0 through the CLI)."""
+    tmp = Path(tempfile.mkdtemp(prefix="cushion_thermal_tests_"))
+    assert main(["build-fmu", "--thermal", "-o", str(tmp / "T2.fmu")]) == 0
+    return {2: tmp / "T2.fmu", 3: build_fmu(DEFAULT_TABLES, tmp / "T3.fmu", fmi_version=3, thermal=True)}
+
+
+@pytest.fixture(scope="module")
+def fmus():
+    out = thermal_fmus()
+    yield out
+    shutil.rmtree(out[2].parent, ignore_errors=True)
+    thermal_fmus.cache_clear()
+
+
+class Slave:
+    """An FMI 2.0 Co-Simulation instance of the thermal FMU, stepped with held inputs."""
+
+    def __init__(self, fmu: Path, start: dict[str, float] | None = None):
+        md = read_model_description(str(fmu))
+        self.vr = {v.name: v.valueReference for v in md.modelVariables}
+        self.unzip = extract(str(fmu))
+        self.s = FMU2Slave(guid=md.guid, unzipDirectory=self.unzip, modelIdentifier=md.coSimulation.modelIdentifier,
+                           instanceName="thermal")
+        self.s.instantiate()
+        try:
+            self.s.setupExperiment(startTime=0.0)
+            if start:
+                self.s.setReal([self.vr[k] for k in start], list(start.values()))
+            self.s.enterInitializationMode()
+            self.s.exitInitializationMode()
+        except FMICallException:
+            self.s.freeInstance()
+            shutil.rmtree(self.unzip, ignore_errors=True)
+            raise
+        self.t = 0.0
+
+    def step(self, h: float, names: list[str], **inputs: float) -> list[float]:
+        self.s.setReal([self.vr[k] for k in inputs], list(inputs.values()))
+        self.s.doStep(self.t, h)
+        self.t += h
+        return self.s.getReal([self.vr[k] for k in names])
+
+    def close(self):
+        self.s.terminate()
+        self.s.freeInstance()
+        shutil.rmtree(self.unzip, ignore_errors=True)
+
+
+def test_interface_and_validation(fmus):
+    for version, fmu in fmus.items():
+        md = read_model_description(str(fmu))
+        causality = {v.name: v.causality for v in md.modelVariables}
+        assert causality["omega_slip"] == "input" and causality["x_to"] == "input"
+        assert causality["omega_engine"] == "input"
+        assert causality["theta_cm"] == "output"
+        assert not [v for v in md.modelVariables if v.name == "theta_cm" and v.causality == "input"]
+        assert all(causality[n] == "output" for n in ["torque", "theta_cs", *NODE_OUTPUTS])
+        assert md.coSimulation.modelIdentifier == md.modelExchange.modelIdentifier == "CushionClutchThermal"
+        assert len(md.derivatives) == 1 + len(NODES)            # theta_cs and the nodes are the ME states
+        assert validate_fmu(str(fmu)) == [], version
+
+
+def test_twelve_slips_heat_the_facings_by_a_physical_amount(fmus):
+    """The bar: twelve 3 s slips at x_to = 7 mm and 100 rad/s, 60 s apart: theta_cm rises 0.05-0.5 K per kJ
+    of slip energy, and falls while the clutch is open."""
+    s = Slave(fmus[2])
+    h, energy, open_cm = 0.01, 0.0, []
+    theta0 = s.step(0.0, ["theta_cm"], x_to=0.0, omega_slip=0.0, omega_engine=100.0)[0]
+    try:
+        for k in range(int(round(12 * 60.0 / h))):
+            slipping = (k * h) % 60.0 < 3.0 - 1e-9
+            th, torque, power = s.step(h, ["theta_cm", "torque", "slip_power"], x_to=0.007 if slipping else 0.0,
+                                       omega_slip=100.0 if slipping else 0.0, omega_engine=100.0)
+            energy += power * h
+            if slipping:
+                assert torque > 50.0 and power == pytest.approx(torque * 100.0, rel=1e-12)
+            else:
+                open_cm.append(th)
+                assert power == 0.0
+            if not slipping and (k * h) % 60.0 > 3.0 + h:   # open: the facings cool, step by step
+                assert th < open_cm[-2]
+    finally:
+        s.close()
+    rise_per_kJ = (th - theta0) / (energy / 1e3)
+    assert 200e3 < energy < 300e3                          # 12 x 3 s x ~70 N.m x 100 rad/s
+    assert 0.05 <= rise_per_kJ <= 0.5, rise_per_kJ
+
+
+@pytest.fixture(scope="module")
+def launch_inputs():
+    """Per-step x_to (m), slip and engine speeds (rad/s) of one launch of the default scenario with the plant's
+    thermal network on (the plain clutch FMU in the loop), from ``simulate_launches`` recording every step."""
+    from cushion_clutch.fmu.native import build_native_fmu
+    from cushion_clutch.fmu.crossbuild import HOST
+    from cushion_clutch.launch.simulate import simulate_launches
+    sc = load_scenario()
+    tcu = dataclasses.replace(sc.tcu, drive_time_s=4.0)
+    sc = dataclasses.replace(sc, tcu=tcu, run=dataclasses.replace(sc.run, launches=1, quiet_steps=False,
+                                                                  period_s=tcu.prefill_s + tcu.drive_time_s + 5.5),
+                             plant_thermal=dataclasses.replace(sc.plant_thermal, enabled=True))
+    with tempfile.TemporaryDirectory() as tmp:
+        plain = build_native_fmu(DEFAULT_TABLES, Path(tmp) / "plain.fmu", platforms=(HOST[2],))
+        res = simulate_launches(plain, sc, load_table(), "naive", record_every=1)
+    s = res.series
+    return sc, s["x_to_m"], s["w_engine_rad_s"] - s["w_disc_rad_s"], s["w_engine_rad_s"], s["theta_cm_K"]
+
+
+def test_launch_replay_matches_the_python_plant_in_lock_step(fmus, launch_inputs):
+    """A launch's inputs through the thermal FMU (CS, the plant's 1 ms step) and through the Python plant's
+    own ThermalNetwork and clutch model in the FMU's order: theta_cm, the nodes, theta_cs and the torque
+    agree to 1e-9 relative at every step."""
+    sc, x_to, w_slip, w_engine, _ = launch_inputs
+    h = sc.run.step_s
+    theta_a = sc.facing.ambient_degC + 273.15
+    theta0 = sc.facing.initial_degC + 273.15
+    p = ClutchParameters(theta_a=theta_a, theta_cs_start=theta0)
+    table = load_table()
+    net = ThermalNetwork(sc.plant_thermal, theta_a, theta0)
+    s = Slave(fmus[2], {"theta_a": theta_a, "theta_cs_start": theta0, "theta_network_start": theta0})
+    names = ["theta_cm", "theta_cs", "torque", *NODE_OUTPUTS]
+    theta_cs, theta_cm = theta0, net.theta_cm
+    worst, heat = dict.fromkeys(names, 0.0), 0.0
+    try:
+        for x, w, we in zip(x_to.tolist(), w_slip.tolist(), w_engine.tolist()):
+            got = s.step(h, names, x_to=x, omega_slip=w, omega_engine=we)
+            theta_cs = thermal_step(theta_cs, theta_cm, h, p)                  # the plant's order
+            o = outputs(x, theta_cs, table, p, theta_cm=theta_cm, omega_slip=w)
+            net.step(h, o.torque * abs(w), we, we - w, o.clamp_force > 0.0)
+            heat += o.torque * abs(w) * h
+            theta_cm = net.theta_cm
+            want = [theta_cm, theta_cs, outputs(x, theta_cs, table, p, theta_cm=theta_cm, omega_slip=w).torque,
+                    *net.theta]
+            for name, g, e in zip(names, got, want):
+                worst[name] = max(worst[name], abs(g - e) / max(abs(e), 1.0))
+    finally:
+        s.close()
+    assert heat > 5e3                                         # a real launch: kilojoules of slip
+    assert theta_cm > theta0 + 1.0
+    print(f"lock-step replay of {len(x_to)} steps: worst relative difference",
+          ", ".join(f"{k} {v:.2g}" for k, v in worst.items()))
+    assert max(worst.values()) <= 1e-9, worst
+
+
+def test_model_exchange_follows_co_simulation(fmus):
+    """ME (fmpy's CVode on the states theta_cs and the nodes) and CS (exact-exponential steps of 1 ms) on a
+    3 s slip and 7 s open: theta_cm and the nodes agree within the CS splitting's first-order error."""
+    rows = [(0.0, 0.007, 100.0, 150.0), (3.0, 0.007, 100.0, 150.0), (3.0, 0.0, 0.0, 80.0), (10.0, 0.0, 0.0, 80.0)]
+    signals = np.array(rows, dtype=[("time", float), ("x_to", float), ("omega_slip", float), ("omega_engine", float)])
+    out = ["theta_cm", "theta_cs", *NODE_OUTPUTS]
+    for version, fmu in fmus.items():
+        me = simulate_fmu(str(fmu), fmi_type="ModelExchange", input=signals, stop_time=10.0, output_interval=0.5,
+                          relative_tolerance=1e-9, output=out)
+        cs = simulate_fmu(str(fmu), fmi_type="CoSimulation", input=signals, stop_time=10.0, output_interval=1e-3,
+                          output=out)
+        for name in out:
+            ref = np.interp(me["time"], cs["time"], cs[name])
+            assert np.max(np.abs(me[name] - ref)) < 2e-3 * max(1.0, np.ptp(cs[name])), (version, name)
+        assert cs["theta_cm"][np.searchsorted(cs["time"], 3.0)] > cs["theta_cm"][0] + 2.0
+
+
+def test_fmi3_equals_fmi2(fmus):
+    rows = [(0.0, 0.006, 80.0, 120.0), (2.0, 0.006, 80.0, 120.0), (2.0, 0.0, 0.0, 90.0), (4.0, 0.0, 0.0, 90.0)]
+    signals = np.array(rows, dtype=[("time", float), ("x_to", float), ("omega_slip", float), ("omega_engine", float)])
+    out = ["theta_cm", "theta_cs", "torque", "slip_power", *NODE_OUTPUTS]
+    a, b = (simulate_fmu(str(fmus[v]), fmi_type="CoSimulation", input=signals, stop_time=4.0, output_interval=0.01,
+                         output=out) for v in (2, 3))
+    for name in out:
+        assert np.allclose(a[name], b[name], rtol=1e-12, atol=0.0), name
+
+
+def test_parameters_from_the_chain_and_errors(fmus, capfd):
+    """Start values are the plant's network; theta_cm cannot be set; shares not adding up to 1 are refused."""
+    md = read_model_description(str(fmus[2]))
+    start = {v.name: v.start for v in md.modelVariables}
+    chain = chain_of()
+    for k, c, q in zip(chain.nodes, chain.capacity_J_per_K, chain.heat_share):
+        assert float(start[f"C_{k}"]) == c and float(start[f"heat_share_{k}"]) == q
+    assert start["theta_cm"] is None
+    s = Slave(fmus[2])
+    try:
+        with pytest.raises(FMICallException):
+            s.s.setReal([s.vr["theta_cm"]], [400.0])
+    finally:
+        s.close()
+    capfd.readouterr()
+    with pytest.raises(FMICallException, match="fmi2ExitInitializationMode"):    # fmi2Error, logged
+        Slave(fmus[2], {f"heat_share_{NODES[0]}": 0.9})
+    assert "heat_share_* parameters add up to" in capfd.readouterr().out
+    bounds = {v.name: (v.min, v.max) for v in md.modelVariables}
+    limit = clutch_model.OMEGA_SLIP_LIMIT
+    assert bounds[f"heat_share_{NODES[0]}"] == ("0.0", "1.0")
+    assert tuple(map(float, bounds["omega_engine"])) == (-limit, limit)
+
+
+def test_thermal_needs_the_native_backend(tmp_path, capsys):
+    assert main(["build-fmu", "--thermal", "--backend", "python", "-o", str(tmp_path / "x.fmu")]) == 2
+    assert "thermal = true needs backend 'native'" in capsys.readouterr().err
+    assert not (tmp_path / "x.fmu").exists()
+
+
+def test_saved_state_holds_the_network(fmus):
+    """fmi2GetFMUstate / SetFMUstate restore the nodes and theta_cm: the same steps after a rollback give the
+    same temperatures, bit for bit."""
+    s = Slave(fmus[2])
+    names = ["theta_cm", "theta_cs", *NODE_OUTPUTS]
+    try:
+        for _ in range(50):
+            s.step(0.01, names, x_to=0.007, omega_slip=120.0, omega_engine=150.0)
+        saved, t_saved = s.s.getFMUstate(), s.t
+        first = [s.step(0.01, names, x_to=0.006, omega_slip=90.0, omega_engine=140.0) for _ in range(20)]
+        s.s.setFMUstate(saved)
+        s.t = t_saved
+        again = [s.step(0.01, names, x_to=0.006, omega_slip=90.0, omega_engine=140.0) for _ in range(20)]
+        s.s.freeFMUstate(saved)
+    finally:
+        s.close()
+    assert first == again and first[-1][0] > first[0][0]
+
+
+def test_every_binary_exports_exactly_the_fmi_api(fmus, tmp_path):
+    """The thermal FMU's binaries (every platform) export the FMI functions and nothing of the network's glue."""
+    import zipfile
+
+    import lief
+    from test_native_platforms import EXPECTED, _arch_and_exports, fmi_functions
+    seen = set()
+    for version, fmu in fmus.items():
+        with zipfile.ZipFile(fmu) as z:
+            libs = [n for n in z.namelist() if n.startswith("binaries/")]
+            z.extractall(tmp_path / f"fmi{version}", libs)
+        for name in libs:
+            assert name.endswith(("CushionClutchThermal.so", "CushionClutchThermal.dll", "CushionClutchThermal.dylib"))
+            binary = lief.parse(str(tmp_path / f"fmi{version}" / name))
+            arch, exports = _arch_and_exports(binary)
+            assert arch == EXPECTED[name.split("/")[1]][1], name
+            assert exports == fmi_functions(version), (name, exports ^ fmi_functions(version))
+            seen.add(name.split("/")[1])
+    assert seen == set(EXPECTED)

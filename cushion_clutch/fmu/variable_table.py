@@ -59,11 +59,11 @@ def variable_header(p: "clutch_model.ClutchParameters | None" = None, variant: t
     problems += [f"{n}: C name {e} is taken" for (n, _, _, _), e in zip(variables, names) if names.count(e) > 1]
     problems += [f"parameter {n}: no range in ClutchParameters.RANGES"
                  for n, c, _, _ in variables if c == "parameter" and n not in ranges]
+    ranges = {**ranges, **model.INPUT_RANGES}      # a variant's own inputs (omega_engine) come with its ranges
     problems += [f"input {n}: no range in clutch_model.INPUT_RANGES"
-                 for n, c, _, _ in variables if c == "input" and n not in model.INPUT_RANGES]
+                 for n, c, _, _ in variables if c == "input" and n not in ranges]
     if problems:
         raise ValueError("VARIABLES cannot be written as a C table: " + "; ".join(problems))
-    ranges = {**ranges, **model.INPUT_RANGES}
     rows = [(n, CAUSALITIES[c], starts[n], ranges[n] if c in ("parameter", "input") else None, u)
             for n, c, u, _ in variables]
     rows.append(("der(theta_cs)", "CC_LOCAL", 0.0, None, "K/s"))

@@ -37,6 +37,7 @@ from pathlib import Path
 import numpy as np
 
 from ..model import KELVIN, ClutchParameters, SpringTable, kiss_point, outputs
+from ..model.clutch_model import INPUT_RANGES
 from ..model.cover import CoverMap
 
 #: largest step of the force table's temperature axis between table temperatures, K
@@ -176,11 +177,12 @@ def _errors(ex: Export, table: SpringTable) -> dict:
                for i, j, k in cells)
     # theta_cs != theta_cm: the model against the 2-D table's assumption, read at theta_cs or at theta_cm
     xs, ts = np.linspace(*X_TO_RANGE_M, 101), np.arange(-40.0, 400.0 + 1e-9, 20.0)
+    lo_K, hi_K = INPUT_RANGES["theta_cm"][:2]
     cost = {}
     for d in THETA_DIFFERENCES_K:
         worst_cs = worst_cm = 0.0
         for t in ts:
-            for t_cm in (t - d, t + d):
+            for t_cm in [v for v in (t - d, t + d) if lo_K <= v + KELVIN <= hi_K]:    # what the model accepts
                 for x in xs:
                     f = clamp(x, t, t_cm)
                     worst_cs = max(worst_cs, abs(f - clamp(x, t, t)))

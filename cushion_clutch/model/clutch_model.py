@@ -256,6 +256,8 @@ ARGUMENT_UNITS = {"x_to": "m", "theta_cs": "K", "theta_cm": "K", "omega_slip": "
 def range_message(name: str, value, unit: str, rng: tuple) -> str:
     """``name = value unit is outside [lo, hi] unit``, plus the kelvin hint for a temperature below its range."""
     lo, hi, lo_open, hi_open = rng[:4]
+    if isinstance(value, float):
+        value = float(value)                # numpy's float64 repr would name its type
     text = f"{name} = {value!r} {unit} is outside {_range_text(lo, hi, lo_open, hi_open)} {unit}"
     if unit == "K" and isinstance(value, (int, float)) and value < lo:
         text += f" (the input is in kelvin: {value!r} degC would be {value + KELVIN:g} K)"

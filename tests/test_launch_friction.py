@@ -33,15 +33,20 @@ def test_constant_mu_table_gives_todays_results(tmp_path):
     for f in a.series.dtype.names:
         # accel_m_s2 is a finite difference (v_next - v) / h over the step h (not the rows' spacing): one ulp
         # of v becomes eps |v| / h there
-        atol = 1e-9 if f != "accel_m_s2" else max(1e-9, 64 * np.finfo(float).eps * np.abs(a.series["v_m_s"]).max()
-                                                  / sc.run.step_s)
+        # the others: round-off amplified by the closed loop, relative to the column's scale (measured on the
+        # physical network with issue 28's cover: 2.7e-8 N.m on a 311 N.m capacity column, 1e-10 of its scale)
+        scale = np.nanmax(np.abs(a.series[f])) if a.series[f].dtype.kind == "f" and a.series[f].size else 0.0
+        atol = max(1e-9, 1e-9 * scale) if f != "accel_m_s2" else max(
+            1e-9, 64 * np.finfo(float).eps * np.abs(a.series["v_m_s"]).max() / sc.run.step_s)
         np.testing.assert_allclose(b.series[f], a.series[f], rtol=1e-9, atol=atol, equal_nan=True)
     assert len(a.metrics) == len(b.metrics) > 0
     for ma, mb in zip(a.metrics, b.metrics):
         assert mb.keys() == ma.keys()
         for key, va in ma.items():          # numbers to round-off; strings and flags exactly
             if isinstance(va, float):
-                assert mb[key] == pytest.approx(va, rel=1e-9, abs=1e-9, nan_ok=True), key
+                # peak_jerk_m_s3 is a second difference over the 1 ms step: the series' 1e-10 becomes 1.4e-9
+                rel = 1e-8 if key.startswith("peak_jerk") else 1e-9
+                assert mb[key] == pytest.approx(va, rel=rel, abs=1e-9, nan_ok=True), key
             else:
                 assert mb[key] == va, key
 

@@ -71,6 +71,24 @@ State (K, K, K, K, K, m, 1, 1, 1)::
     whose length the TCU knows: repeated launches and a cool-down.
 
 A torque residual larger than ``gate_sd`` standard deviations is rejected.
+
+**The nominal calibration as the prior** (what the TCU *applies*). The torque
+the EKF learns against is the engine control unit's estimate, whose stated
+accuracy is ``mu_deadband`` in gain and ``torque_offset_accuracy_Nm`` in offset,
+and the bearing position reads within ``position_accuracy_m``. Through the touch
+band such biases are indistinguishable from a touch-point offset: on the default
+clutch at 20 degC the ECU's +4 % and +3 N.m move ``dx_kiss`` to about -0.11 mm
+within 0.2 s of the first launch, and the characteristic the TCU then believes
+is 5.3 N.m above the true one at 90 N.m (the naive TCU: 2.1). The learned
+state therefore moves the characteristic the TCU applies only on *evidence*: the
+learned characteristic differs from the nominal one (same temperatures) at one of
+the torques :data:`EVIDENCE_TORQUES_NM` by more than the envelope the known biases
+can produce there, ``g T + o + (dT/dx) x_acc``. The evidence is kept until the
+difference falls below ``evidence_release`` times the envelope (hysteresis).
+Without evidence the TCU applies the prior (``dx = 0`` and ``mu = 1``, or a
+stored or standstill-learned touch point, :meth:`ClutchEkf.set_prior`, whose
+accuracy is then ``x_acc``); the filter's own state keeps learning (its
+residuals stay consistent with the biased torque).
 """
 from __future__ import annotations
 
@@ -81,11 +99,13 @@ from typing import Iterable
 import numpy as np
 
 from ..config import Checked
-from ..model import ClutchParameters, SpringTable, outputs
+from ..model import ClutchParameters, SpringTable, outputs, x_to_for_torque
 from .thermal_network import NetworkParams, ThermalNetwork
 
 IX_CS, IX_DX, IX_MU, IX_LOSS, IX_HEAT = 4, 5, 6, 7, 8   #: state indices
 N_STATE = 9
+#: nominal torques at which the learned characteristic is compared with the nominal one, N.m
+EVIDENCE_TORQUES_NM = (10.0, 20.0, 40.0, 80.0, 120.0)
 #: speed band of the cached discretisation (convection), rad/s
 SPEED_BAND = 10.0
 
@@ -136,6 +156,13 @@ class EkfParams(Checked):
     gate_sd: float = 4.0
     mu_deadband: float = 0.05
     """the engine torque estimate's stated gain accuracy: a learned mu_scale within 1 +- this is not applied"""
+    torque_offset_accuracy_Nm: float = 3.0
+    """the engine torque estimate's stated offset accuracy, N.m (the evidence envelope)"""
+    position_accuracy_m: float = 20e-6
+    """the position sensor's stated offset accuracy, m (the evidence envelope)"""
+    evidence_release: float = 0.7
+    """the learned characteristic stays applied until its difference from the nominal falls below this
+    fraction of the bias envelope"""
     temperature_update: bool = True
     loss_scale_sd: float = 0.5
     """prior sd of the heat-loss scale (every node's sink conductance: convection and engine block), 1;
@@ -164,7 +191,8 @@ class EkfParams(Checked):
             "mu_sd": (0.0, 1.0), "mu_walk_per_s": (0.0, 1.0), "torque_sd_Nm": (1e-3, 1e3),
             "slip_min_rad_s": (0.0, 1e3), "touch_torque_min_Nm": (0.0, 1e4), "touch_torque_max_Nm": (0.0, 1e4),
             "mu_torque_min_Nm": (0.0, 1e4), "gate_sd": (1.0, 100.0, True),
-            "mu_deadband": (0.0, 0.5), "loss_scale_sd": (0.0, 2.0), "loss_walk_per_s": (0.0, 1.0),
+            "mu_deadband": (0.0, 0.5), "torque_offset_accuracy_Nm": (0.0, 100.0),
+            "position_accuracy_m": (0.0, 1e-3), "evidence_release": (0.0, 1.0), "loss_scale_sd": (0.0, 2.0), "loss_walk_per_s": (0.0, 1.0),
             "heat_scale_sd": (0.0, 2.0), "heat_walk_per_s": (0.0, 1.0), "loss_excitation_K": (0.0, 500.0), "theta_torque_min_Nm": (0.0, 1e4),
             "scale_min": (0.0, 1.0, True), "scale_max": (1.0, 100.0)})
         if self.touch_torque_max_Nm <= self.touch_torque_min_Nm:
@@ -201,8 +229,16 @@ class ClutchEkf:
         self.t_acc = 0.0
         self._cache: dict = {}
         self._dcache: dict = {}
+        self._ev_cache: dict = {}
         #: count of accepted measurement updates, and of rejected ones (gate)
         self.accepted = self.rejected = 0
+        #: the prior characteristic: touch-point offset (m), friction scale and the offset's accuracy (m)
+        #: (the nominal calibration; a stored or standstill-learned one after :meth:`set_prior`)
+        self.dx_prior, self.mu_prior, self.x_accuracy = 0.0, 1.0, e.position_accuracy_m
+        #: the learned characteristic differs from the prior by more than the known biases (applied)
+        self.evidence = False
+        #: the last ratio of that difference to the bias envelope (max over EVIDENCE_TORQUES_NM), 1
+        self.evidence_ratio = 0.0
 
     # --- estimates -----------------------------------------------------------------------------
     @property
@@ -235,28 +271,100 @@ class ClutchEkf:
         """Learned scale of the slip heat that reaches the network, 1."""
         return float(self.s[IX_HEAT])
 
+    def set_prior(self, dx_m: float, dx_sd_m: float, mu_scale: float = 1.0, loss_scale: float = 1.0,
+                  heat_scale: float = 1.0) -> None:
+        """Start from a stored or standstill-learned characteristic: it becomes the prior (and the state).
+
+        ``dx_m`` touch-point offset (position sensor's frame) with its accuracy ``dx_sd_m`` (m; the
+        state's sd and the evidence envelope's position term), the friction and thermal scales.
+        The touch point's covariance with the rest is reset.
+        """
+        s, pm = self.s, self.P
+        s[IX_DX], s[IX_MU] = dx_m, mu_scale
+        s[IX_LOSS], s[IX_HEAT] = loss_scale, heat_scale
+        pm[IX_DX, :] = pm[:, IX_DX] = 0.0
+        pm[IX_DX, IX_DX] = dx_sd_m ** 2
+        self.dx_prior, self.mu_prior, self.x_accuracy = dx_m, mu_scale, dx_sd_m
+        self.evidence, self.evidence_ratio = False, 0.0
+
+    @property
+    def dx_used(self) -> float:
+        """The touch-point offset the TCU applies: ``dx_kiss`` on evidence (module docstring), else the
+        prior's, m."""
+        return float(self.s[IX_DX]) if self.evidence else self.dx_prior
+
     @property
     def mu_used(self) -> float:
-        """The friction scale the TCU applies: ``mu_scale`` outside a dead band of ``mu_deadband`` around 1.
+        """The friction scale the TCU applies: without evidence 1; with it ``mu_scale`` outside a dead band
+        of ``mu_deadband`` around 1.
 
         ``mu_scale`` is learned against the engine control unit's torque
         estimate, so it carries that estimate's gain error; a deviation within
         the estimate's stated accuracy is not attributed to the clutch.
         """
-        d = self.s[IX_MU] - 1.0
+        d = (self.s[IX_MU] if self.evidence else self.mu_prior) - 1.0
         band = self.e.mu_deadband
         return 1.0 + (d - band if d > band else (d + band if d < -band else 0.0))
 
-    def model_torque(self, x_m: float, s: np.ndarray | None = None, mu: float | None = None) -> float:
+    def model_torque(self, x_m: float, s: np.ndarray | None = None, mu: float | None = None,
+                     dx: float | None = None) -> float:
         """The TCU's torque at bearing position ``x_m`` (m) with state ``s`` (default: the estimate), N.m.
 
-        ``mu`` replaces the state's friction scale (e.g. :attr:`mu_used`).
+        ``mu`` and ``dx`` replace the state's friction scale and touch-point offset (e.g. :attr:`mu_used`,
+        :attr:`dx_used`).
         """
         s = self.s if s is None else s
         th = min(max(float(s[IX_CS]), self.table.theta_min_K), self.table.theta_max_K)
         theta_cm = float(0.5 * (s[1] + s[2]))          # the stack's growth at the estimated facing temperature
-        return (float(s[IX_MU]) if mu is None else mu) * outputs(x_m - float(s[IX_DX]), th, self.table, self.p,
-                                                                 theta_cm).torque
+        return (float(s[IX_MU]) if mu is None else mu) * outputs(
+            x_m - (float(s[IX_DX]) if dx is None else dx), th, self.table, self.p, theta_cm).torque
+
+    def used_torque(self, x_m: float) -> float:
+        """The torque the TCU applies at the measured bearing position ``x_m`` (m): :attr:`dx_used`,
+        :attr:`mu_used`, N.m."""
+        return self.model_torque(x_m, mu=self.mu_used, dx=self.dx_used)
+
+    def update_evidence(self) -> bool:
+        """Compare the learned characteristic with the nominal one; set and return :attr:`evidence`.
+
+        At each nominal torque ``T`` of :data:`EVIDENCE_TORQUES_NM` the nominal
+        position ``x`` (the estimated temperatures) and its slope ``dT/dx`` give
+        the bias envelope ``g T + o + (dT/dx) x_acc`` (``g`` = ``mu_deadband``,
+        ``o`` = ``torque_offset_accuracy_Nm``, ``x_acc`` = ``position_accuracy_m``);
+        the learned characteristic's difference there, over the envelope, is the
+        ratio. Evidence once the largest ratio exceeds 1, kept until it falls below
+        ``evidence_release``.
+        """
+        e, s = self.e, self.s
+        th = min(max(float(s[IX_CS]), self.table.theta_min_K), self.table.theta_max_K)
+        theta_cm = float(0.5 * (s[1] + s[2]))
+        key = (round(th, 0), round(theta_cm, 0))
+        pts = self._ev_cache.get(key)
+        if pts is None:
+            pts = []
+            for t in EVIDENCE_TORQUES_NM:
+                try:
+                    x = x_to_for_torque(t, th, self.table, self.p, theta_cm=theta_cm)
+                except ValueError:
+                    continue
+                t0 = outputs(x, th, self.table, self.p, theta_cm).torque
+                if t0 < 0.9 * t:                    # beyond the closed capacity
+                    continue
+                slope = (outputs(x + 10e-6, th, self.table, self.p, theta_cm).torque - t0) / 10e-6
+                pts.append((x, t0, e.mu_deadband * t0 + e.torque_offset_accuracy_Nm, slope))
+            if len(self._ev_cache) > 4096:
+                self._ev_cache.clear()
+            self._ev_cache[key] = pts
+        mu, dx = float(s[IX_MU]), float(s[IX_DX])
+        ratio = 0.0
+        dx0, mu0 = self.dx_prior, self.mu_prior
+        for x, t0, env0, slope in pts:                  # the prior's position for each nominal torque
+            env = mu0 * (env0 + slope * self.x_accuracy)
+            d = abs(mu * outputs(x + dx0 - dx, th, self.table, self.p, theta_cm).torque - mu0 * t0)
+            ratio = max(ratio, d / env if env > 0.0 else math.inf)
+        self.evidence_ratio = ratio
+        self.evidence = ratio > 1.0 or (self.evidence and ratio > e.evidence_release)
+        return self.evidence
 
     # --- prediction ----------------------------------------------------------------------------
     def _parts(self, w_engine: float, w_disc: float, clamped: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -399,4 +507,6 @@ class ClutchEkf:
         ikh = np.eye(N_STATE) - np.outer(k, hrow)
         self.P = ikh @ self.P @ ikh.T + r * np.outer(k, k)
         self.accepted += 1
+        if mask[IX_DX] or mask[IX_MU]:
+            self.update_evidence()
         return True

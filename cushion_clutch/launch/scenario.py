@@ -14,7 +14,7 @@ from ..errors import ParameterError
 from .ekf import EkfParams, TcuNetworkParams
 from .mass_grade import MassGrade
 from .sensors import ProductionSensors
-from .tcu_params import Adaptation, Observer, Sensors
+from .tcu_params import Adaptation, Observer, Sensors, Standstill, TcuStore
 from .thermal_network import PlantThermal
 
 
@@ -303,6 +303,8 @@ class Scenario(Checked):
     tcu_thermal: TcuNetworkParams = field(default_factory=TcuNetworkParams)
     ekf: EkfParams = field(default_factory=EkfParams)
     mass_grade: MassGrade = field(default_factory=MassGrade)
+    standstill: Standstill = field(default_factory=Standstill)
+    tcu_store: TcuStore = field(default_factory=TcuStore)
     folder: str = ""
     """folder of the scenario file (set by :func:`load_scenario`), for relative file names"""
 

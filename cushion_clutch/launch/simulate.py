@@ -36,7 +36,7 @@ from .metrics import LaunchRecord
 from .observer import SpeedSensors
 from .scenario import Scenario
 from .engine import RPM
-from .production import ProductionTcu
+from .production import KeyOn, ProductionTcu, key_off, key_on
 from .tcu import CLOSE, LAUNCH, OPEN, PREFILL, VARIANTS, TcuController
 from .thermal import FacingModel
 from .thermal_network import ThermalNetwork
@@ -69,6 +69,8 @@ class LaunchResult:
     kiss_estimates: list[tuple[int, float]]
     quiet_s: float = 0.0
     """simulated time advanced in quiet steps (``run.quiet_steps``), s"""
+    key_on: KeyOn | None = None
+    """production TCU: how it started (reset or learned) and its standstill touch-point learning"""
 
 
 def _facing_profile(path: str) -> Callable[[float], float]:
@@ -121,9 +123,11 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
     r_to_disc = dl.i_tot / dl.r
     prefill, drive_end = tc.prefill_s, tc.prefill_s + tc.drive_time_s
 
-    clutch = ClutchFmu(fmu, {"theta_a": theta_a, "theta_cs_start": theta0,
-                             "x_kiss_ref": p.x_kiss_ref + sc.clutch.x_kiss_offset_m,
-                             **({"facing_wear": sc.clutch.facing_wear_m} if sc.clutch.facing_wear_m else {})})
+    clutch_start = {"theta_a": theta_a, "theta_cs_start": theta0, "x_kiss_ref": p.x_kiss_ref + sc.clutch.x_kiss_offset_m,
+                    **({"facing_wear": sc.clutch.facing_wear_m} if sc.clutch.facing_wear_m else {})}
+    keyed = (key_on(ctl, sc, fmu, clutch_start, sc.driveline.disc_inertia_kg_m2, engine.w_idle)
+             if name == "production" else None)
+    clutch = ClutchFmu(fmu, clutch_start)
     theta_cm = theta0
     x_act = 0.0
     theta_cs, x_kiss = theta0, p.x_kiss_ref
@@ -278,4 +282,6 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
     series = np.array(rows, dtype=[(c, float) for c in COLUMNS])
     metrics = [r.metrics(run.hot_degC) for r in recs]
     learned = ctl.learner.estimates if ctl.learner is not None else []
-    return LaunchResult(name, series, metrics, dl.en, events, wall, total, cpu, learned, n_quiet * h_quiet)
+    if keyed is not None:
+        key_off(ctl, sc, keyed)
+    return LaunchResult(name, series, metrics, dl.en, events, wall, total, cpu, learned, n_quiet * h_quiet, keyed)

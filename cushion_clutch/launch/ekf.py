@@ -83,7 +83,8 @@ is 5.3 N.m above the true one at 90 N.m (the naive TCU: 2.1). The learned
 state therefore moves the characteristic the TCU applies only on *evidence*: the
 learned characteristic differs from the nominal one (same temperatures) at one of
 the torques :data:`EVIDENCE_TORQUES_NM` by more than the envelope the known biases
-can produce there, ``g T + o + (dT/dx) x_acc``. The evidence is kept until the
+can produce there, ``g T + o + (dT/dx) x_acc``, times ``evidence_threshold``, in
+``evidence_confirm`` consecutive updates. The evidence is kept until the
 difference falls below ``evidence_release`` times the envelope (hysteresis).
 Without evidence the TCU applies the prior (``dx = 0`` and ``mu = 1``, or a
 stored or standstill-learned touch point, :meth:`ClutchEkf.set_prior`, whose
@@ -160,9 +161,16 @@ class EkfParams(Checked):
     """the engine torque estimate's stated offset accuracy, N.m (the evidence envelope)"""
     position_accuracy_m: float = 20e-6
     """the position sensor's stated offset accuracy, m (the evidence envelope)"""
+    evidence_threshold: float = 1.25
+    """the learned characteristic is applied once its difference from the prior exceeds this multiple of the
+    bias envelope (the touch point and the friction scale fit a gain and offset error of the torque only
+    approximately: with a bias at the envelope the ratio overshot 1 by 4 % in a synthetic launch)"""
     evidence_release: float = 0.7
-    """the learned characteristic stays applied until its difference from the nominal falls below this
+    """the learned characteristic stays applied until its difference from the prior falls below this
     fraction of the bias envelope"""
+    evidence_confirm: int = 5
+    """... and is applied once the difference has exceeded the envelope in this many consecutive touch-point
+    or friction updates (a transient of the filter within a launch is no evidence)"""
     temperature_update: bool = True
     loss_scale_sd: float = 0.5
     """prior sd of the heat-loss scale (every node's sink conductance: convection and engine block), 1;
@@ -192,9 +200,11 @@ class EkfParams(Checked):
             "slip_min_rad_s": (0.0, 1e3), "touch_torque_min_Nm": (0.0, 1e4), "touch_torque_max_Nm": (0.0, 1e4),
             "mu_torque_min_Nm": (0.0, 1e4), "gate_sd": (1.0, 100.0, True),
             "mu_deadband": (0.0, 0.5), "torque_offset_accuracy_Nm": (0.0, 100.0),
-            "position_accuracy_m": (0.0, 1e-3), "evidence_release": (0.0, 1.0), "loss_scale_sd": (0.0, 2.0), "loss_walk_per_s": (0.0, 1.0),
+            "position_accuracy_m": (0.0, 1e-3), "evidence_release": (0.0, 1.0), "evidence_threshold": (1.0, 100.0),
+            "evidence_confirm": (1, 1000), "loss_scale_sd": (0.0, 2.0), "loss_walk_per_s": (0.0, 1.0),
             "heat_scale_sd": (0.0, 2.0), "heat_walk_per_s": (0.0, 1.0), "loss_excitation_K": (0.0, 500.0), "theta_torque_min_Nm": (0.0, 1e4),
             "scale_min": (0.0, 1.0, True), "scale_max": (1.0, 100.0)})
+        yield from self._integers("evidence_confirm")
         if self.touch_torque_max_Nm <= self.touch_torque_min_Nm:
             yield "ekf.touch_torque_max_Nm: must exceed ekf.touch_torque_min_Nm"
 
@@ -237,6 +247,7 @@ class ClutchEkf:
         self.dx_prior, self.mu_prior, self.x_accuracy = 0.0, 1.0, e.position_accuracy_m
         #: the learned characteristic differs from the prior by more than the known biases (applied)
         self.evidence = False
+        self._over = 0
         #: the last ratio of that difference to the bias envelope (max over EVIDENCE_TORQUES_NM), 1
         self.evidence_ratio = 0.0
 
@@ -285,7 +296,7 @@ class ClutchEkf:
         pm[IX_DX, :] = pm[:, IX_DX] = 0.0
         pm[IX_DX, IX_DX] = dx_sd_m ** 2
         self.dx_prior, self.mu_prior, self.x_accuracy = dx_m, mu_scale, dx_sd_m
-        self.evidence, self.evidence_ratio = False, 0.0
+        self.evidence, self.evidence_ratio, self._over = False, 0.0, 0
 
     @property
     def dx_used(self) -> float:
@@ -332,8 +343,8 @@ class ClutchEkf:
         the bias envelope ``g T + o + (dT/dx) x_acc`` (``g`` = ``mu_deadband``,
         ``o`` = ``torque_offset_accuracy_Nm``, ``x_acc`` = ``position_accuracy_m``);
         the learned characteristic's difference there, over the envelope, is the
-        ratio. Evidence once the largest ratio exceeds 1, kept until it falls below
-        ``evidence_release``.
+        ratio. Evidence once the largest ratio exceeds ``evidence_threshold`` in
+        ``evidence_confirm`` consecutive calls, kept until it falls below ``evidence_release``.
         """
         e, s = self.e, self.s
         th = min(max(float(s[IX_CS]), self.table.theta_min_K), self.table.theta_max_K)
@@ -363,7 +374,8 @@ class ClutchEkf:
             d = abs(mu * outputs(x + dx0 - dx, th, self.table, self.p, theta_cm).torque - mu0 * t0)
             ratio = max(ratio, d / env if env > 0.0 else math.inf)
         self.evidence_ratio = ratio
-        self.evidence = ratio > 1.0 or (self.evidence and ratio > e.evidence_release)
+        self._over = self._over + 1 if ratio > e.evidence_threshold else 0
+        self.evidence = self._over >= e.evidence_confirm or (self.evidence and ratio > e.evidence_release)
         return self.evidence
 
     # --- prediction ----------------------------------------------------------------------------

@@ -154,7 +154,7 @@ class ProductionTcu(TcuController):
             e.predict(w_e, w_d, True)
             if launching:
                 e.correct(t_c, x_mean, slip, True)
-                if self.rls.ready()[1] and h1[1] > 0.0 and h0[1] > 0.0:
+                if all(self.rls.ready()) and h1[1] > 0.0 and h0[1] > 0.0:    # mass and load both estimated
                     t_vehicle = self.rls.inertia_at_disc_kg_m2() * (h1[1] - h0[1]) / span \
                         + self.rls.holding_torque_Nm()
                     e.correct(t_vehicle, x_mean, slip, True, VEHICLE_TORQUE_SD_NM)

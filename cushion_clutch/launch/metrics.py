@@ -25,6 +25,10 @@ Each metric measures one cause (SI units unless a name says otherwise):
     Peak-to-peak vehicle acceleration in the :data:`SHUFFLE_WINDOW_S` after
     lock-up (driveline shuffle; it includes any acceleration trend there).
 
+``protection_level``
+    The highest level of the TCU's thermal protection in the launch (0 ok, 1 warn, 2 limit,
+    3 inhibited: no launch; :mod:`.protection`).
+
 Also: cushion-spring temperature at the start and the TCU's error in it,
 kiss-point error (believed minus true, at the start), engagement time, slip
 energy, peak jerk (acceleration low-passed at 20 ms), engine stall.
@@ -39,7 +43,7 @@ METRIC_COLUMNS = ("tcu", "launch", "demand_level", "theta_cs_start_degC", "chara
                   "characteristic_error_max_Nm", "tracking_error_rms_Nm", "tracking_error_max_Nm",
                   "creep_error_Nm", "lockup_accel_step_m_s2", "shuffle_amplitude_m_s2", "kiss_point_error_mm",
                   "engagement_time_s", "slip_energy_kJ", "peak_jerk_m_s3", "engine_stall", "theta_cs_error_K",
-                  "hot", "phase")
+                  "hot", "phase", "protection_level")
 #: demand up to which the creep error is taken, N.m
 CREEP_NM = 30.0
 #: windows before and after lock-up for the acceleration step, s
@@ -73,7 +77,7 @@ class LaunchRecord:
 
     __slots__ = ("launch", "cool", "lock_time", "stall", "slip_J", "n_err", "sq_err", "max_err", "jerk",
                  "n_ch", "sq_ch", "max_ch", "n_creep", "sum_creep", "kiss_err", "theta_cs", "theta_err",
-                 "a_filt", "alpha", "h", "started", "acc", "t_first", "window", "level")
+                 "a_filt", "alpha", "h", "started", "acc", "t_first", "window", "level", "protection")
 
     def __init__(self, launch: int, cool: bool, h: float, level: str = ""):
         self.launch, self.cool, self.h, self.level = launch, cool, h, level
@@ -91,6 +95,8 @@ class LaunchRecord:
         self.started = False
         self.acc: list[float] = []
         self.t_first = math.nan
+        #: the highest thermal-protection level of the TCU in this launch (0 ok ... 3 inhibited, .protection)
+        self.protection = 0
 
     def start(self, kiss_err_m: float, theta_cs_K: float, theta_err_K: float) -> None:
         """At the first engaged step: the TCU's kiss-point and temperature errors."""
@@ -165,6 +171,7 @@ class LaunchRecord:
             "theta_cs_error_K": self.theta_err if self.theta_err is not None else nan,
             "hot": bool(theta >= hot_degC),
             "phase": "cool-down" if self.cool else "repeated",
+            "protection_level": self.protection,
         }
 
 

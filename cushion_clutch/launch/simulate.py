@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable
 
@@ -50,7 +50,7 @@ X_RETRACTED_M = 1e-6
 COLUMNS = ("time_s", "launch", "w_engine_rad_s", "w_disc_rad_s", "v_m_s", "accel_m_s2", "x_cmd_m",
            "x_to_m", "torque_demand_Nm", "torque_capacity_Nm", "torque_clutch_Nm", "theta_cm_K",
            "theta_cs_K", "theta_cs_tcu_K", "x_kiss_m", "x_kiss_tcu_m", "throttle", "locked", "theta_cm_tcu_K",
-           "torque_believed_Nm", "torque_shaft_Nm")
+           "torque_believed_Nm", "torque_shaft_Nm", "protection_level")
 
 
 @dataclass
@@ -71,6 +71,8 @@ class LaunchResult:
     """simulated time advanced in quiet steps (``run.quiet_steps``), s"""
     key_on: KeyOn | None = None
     """production TCU: how it started (reset or learned) and its standstill touch-point learning"""
+    protection_events: list = field(default_factory=list)
+    """(s into the launch slot, launch, level, message): what the thermal protection told the driver"""
 
 
 def _facing_profile(path: str) -> Callable[[float], float]:
@@ -175,7 +177,11 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
                 engaged = phase == LAUNCH or phase == CLOSE
                 launching = phase == LAUNCH
                 sampling = (launching or phase == PREFILL) and rec.lock_time is None
-                braking = not engaged and tl >= drive_end
+                braking = not engaged and (tl >= drive_end or ctl.inhibited)   # inhibited: the driver brakes
+                if ctl.protection is not None and ctl.protection.level > rec.protection:
+                    rec.protection = ctl.protection.level
+                    if ctl.inhibited and not rec.started:          # an inhibited launch: its start state
+                        rec.start(ctl.kiss_now - x_kiss, theta_cs, ctl.theta_now - theta_cs)
             if (quiet and cycled and braking and ctl.phase == OPEN and ctl.x_cmd == 0.0 and t_cap == 0.0
                     and -X_RETRACTED_M < x_act < X_RETRACTED_M and not stalled and not dl.locked and dl.v == 0.0
                     and dl.w_d == 0.0 and dl.phi == 0.0 and k + tcu_every <= n_steps
@@ -208,7 +214,8 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
                         rec_countdown = record_every
                         rows.append((t + j * h, n + 1, dl.w_e, 0.0, 0.0, 0.0, 0.0, x_act, 0.0, 0.0, 0.0,
                                      theta_cm_step, theta_cs, ctl.theta_now, x_kiss, ctl.kiss_now, engine.throttle,
-                                     0.0, ctl.theta_cm_estimate(), math.nan, 0.0))
+                                     0.0, ctl.theta_cm_estimate(), math.nan, 0.0,
+                                     ctl.protection.level if ctl.protection is not None else 0.0))
                         if progress is not None and (k + j) % 10000 == 0:
                             progress(t + j * h)
                     rec_countdown -= 1
@@ -269,7 +276,8 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
                              ctl.t_dem + ctl.t_rate * (tcu_every - countdown) * h, t_cap, dl.t_c, theta_cm_step,
                              theta_cs, ctl.theta_now, x_kiss, ctl.kiss_now, engine.throttle, float(dl.locked),
                              ctl.theta_cm_estimate(), believed if sampling else math.nan,
-                             dl.k * dl.phi + dl.c * (dl.w_d - dl.v * dl.i_tot / dl.r)))
+                             dl.k * dl.phi + dl.c * (dl.w_d - dl.v * dl.i_tot / dl.r),
+                             ctl.protection.level if ctl.protection is not None else 0.0))
                 if progress is not None and k % 10000 == 0:
                     progress(t)
             rec_countdown -= 1
@@ -284,4 +292,5 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
     learned = ctl.learner.estimates if ctl.learner is not None else []
     if keyed is not None:
         key_off(ctl, sc, keyed)
-    return LaunchResult(name, series, metrics, dl.en, events, wall, total, cpu, learned, n_quiet * h_quiet, keyed)
+    return LaunchResult(name, series, metrics, dl.en, events, wall, total, cpu, learned, n_quiet * h_quiet, keyed,
+                        ctl.protection.events if ctl.protection is not None else [])

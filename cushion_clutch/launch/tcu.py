@@ -55,6 +55,7 @@ from dataclasses import dataclass
 from ..model import KELVIN, ClutchParameters, SpringTable, kiss_point, outputs, thermal_step, x_to_for_torque
 from .adaptation import KissLearner
 from .observer import FacingObserver
+from .protection import LIMIT, ThermalProtection
 from .scenario import Scenario
 
 
@@ -128,6 +129,10 @@ class TcuController:
         self.t_closed = math.inf
         self._kiss_key: tuple = ()
         self._kiss_value = math.nan
+        #: thermal protection by the facing-temperature estimate (:mod:`.protection`), TCUs that have one
+        self.protection = (ThermalProtection(sc.protection)
+                           if sc.protection.enabled and variant.temperature != "none" else None)
+        self.inhibited = False
         #: the assumed theta_cs (K) and believed kiss point (m) after the last cycle
         self.theta_now, self.kiss_now = self.theta_used(), self.kiss()
 
@@ -146,6 +151,10 @@ class TcuController:
     def theta_cm_estimate(self) -> float:
         """The observer's facing temperature, K (NaN without an observer)."""
         return self.observer.theta_cm if self.observer is not None else float("nan")
+
+    def theta_facing_protect(self) -> float:
+        """The facing temperature the thermal protection acts on (the TCU's estimate; ``aware``: the true), K."""
+        return self.theta_cm_ideal if self.v.temperature == "ideal" else self.theta_cm_estimate()
 
     def theta_cm_used(self) -> float | None:
         """The facing temperature the TCU's clutch model assumes (the stack's growth), K; None: theta_cs."""
@@ -216,7 +225,10 @@ class TcuController:
             return t_lock - ds / k + kp * e + self.integral
         if level == "creep":
             return drv.creep_torque_Nm
-        w_t = self.w_idle + drv.pedal(level) * (tc.engine_speed_full_pedal_rpm * math.pi / 30.0 - self.w_idle)
+        full = tc.engine_speed_full_pedal_rpm
+        if self.protection is not None and self.protection.level >= LIMIT:     # slip energy limited
+            full = min(full, self.protection.p.limit_engine_speed_rpm)
+        w_t = self.w_idle + drv.pedal(level) * (full * math.pi / 30.0 - self.w_idle)
         dw = (w_t - self.w_ref) / tc.engine_speed_time_constant_s
         self.w_ref += dw * dt
         e = w_e - self.w_ref
@@ -243,12 +255,22 @@ class TcuController:
         elif self.observer is not None:
             slip = abs(w_e - w_d)
             self.observer.update(self.model_torque(x_meas) * slip if self.phase == LAUNCH else 0.0)
+        prot = self.protection
         if launch != self.launch:
             self.launch = launch
             self.sync, self.integral, self.t_dem, self.w_ref = False, 0.0, 0.0, w_e
             self.t_closed = math.inf
             if self.learner is not None:
                 self.learner.start_launch()
+            if prot is not None:
+                self.inhibited = prot.launch_start(self.theta_facing_protect(), tl, launch)
+        if prot is not None:
+            prot.update(self.theta_facing_protect(), tl, launch)
+            if self.inhibited:                    # no launch in this slot: the clutch stays open
+                self.phase, self.t_dem, self.t_rate, self.x_cmd = OPEN, 0.0, 0.0, 0.0
+                self.theta_now, self.kiss_now = self.theta_used(), self.kiss()
+                return
+        was_launching = self.phase == LAUNCH
         t_launch = tl - tc.prefill_s
         t_prev = self.t_dem
         if 0.0 <= t_launch < tc.drive_time_s and not locked_once:
@@ -276,4 +298,6 @@ class TcuController:
             self.phase, self.t_dem, self.t_rate, self.x_cmd = OPEN, 0.0, 0.0, 0.0
         if self.phase != LAUNCH:
             self.t_rate = 0.0
+            if was_launching and prot is not None:
+                prot.launch_end(self.theta_facing_protect())
         self.theta_now, self.kiss_now = self.theta_used(), self.kiss()

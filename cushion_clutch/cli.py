@@ -161,7 +161,7 @@ def _launch(args: argparse.Namespace) -> int:
     from .fmu.check import check_fmu
     from .model import load_table
     from .launch.plant import build_plant_fmu
-    from .launch.report import metrics_table, ratio_line, run_all, summary_table, write_outputs
+    from .launch.report import metrics_table, peak_lines, ratio_line, run_all, summary_table, write_outputs
     from .launch.scenario import load_scenario, scenario_path
     from .launch.tcu import VARIANTS
     from .outputs import OutputSet
@@ -187,6 +187,7 @@ def _launch(args: argparse.Namespace) -> int:
     print(summary_table(results))
     print()
     print(ratio_line(results, "hot"))
+    print(peak_lines(results))
     for name, res in results.items():
         e = res.energy
         print(f"{name}: energy balance residual {e.residual():.3g} J of {e.engine_work / 1e3:.1f} kJ engine "

@@ -26,8 +26,8 @@ Each metric measures one cause (SI units unless a name says otherwise):
     lock-up (driveline shuffle; it includes any acceleration trend there).
 
 ``protection_level``
-    The highest level of the TCU's thermal protection in the launch (0 ok, 1 warn, 2 limit,
-    3 inhibited: no launch; :mod:`.protection`).
+    The level of the TCU's thermal protection the launch ran at, decided at its start (0 ok,
+    1 warn, 2 limit, 3 inhibited: no launch; :mod:`.protection`).
 
 Also: cushion-spring temperature at the start and the TCU's error in it,
 kiss-point error (believed minus true, at the start), engagement time, slip
@@ -95,7 +95,7 @@ class LaunchRecord:
         self.started = False
         self.acc: list[float] = []
         self.t_first = math.nan
-        #: the highest thermal-protection level of the TCU in this launch (0 ok ... 3 inhibited, .protection)
+        #: the thermal-protection level the launch ran at (0 ok ... 3 inhibited, .protection)
         self.protection = 0
 
     def start(self, kiss_err_m: float, theta_cs_K: float, theta_err_K: float) -> None:

@@ -15,9 +15,11 @@ level  name        when / what
 ====  ===========  =================================================================
 0      ok          ``theta < warn_degC``
 1      warn        ``theta >= warn_degC``: the driver is told (a message, the signal)
-2      limit       ``theta >= limit_degC``: slip energy limited: the launch's
-                   engine-speed target lowered to ``limit_engine_speed_rpm`` (the slip
-                   speed, and with it the slip power, falls with it)
+2      limit       ``theta >= limit_degC`` at a launch's start: slip energy limited, the
+                   launch's engine-speed target lowered to ``limit_engine_speed_rpm`` (the
+                   slip speed, and with it the slip power, falls with it); decided per
+                   launch (switched within a launch, the speed controller pulled the
+                   engine down: a 208 N.m torque spike)
 3      inhibit     at a launch's start, ``theta >= inhibit_degC`` or ``theta`` plus the
                    last launch's rise of the estimate reaches ``damage_degC``: no launch
                    (the driver holds the brake) until ``theta < resume_degC``

@@ -178,8 +178,8 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
                 launching = phase == LAUNCH
                 sampling = (launching or phase == PREFILL) and rec.lock_time is None
                 braking = not engaged and (tl >= drive_end or ctl.inhibited)   # inhibited: the driver brakes
-                if ctl.protection is not None and ctl.protection.level > rec.protection:
-                    rec.protection = ctl.protection.level
+                if ctl.launch_level != rec.protection:
+                    rec.protection = ctl.launch_level
                     if ctl.inhibited and not rec.started:          # an inhibited launch: its start state
                         rec.start(ctl.kiss_now - x_kiss, theta_cs, ctl.theta_now - theta_cs)
             if (quiet and cycled and braking and ctl.phase == OPEN and ctl.x_cmd == 0.0 and t_cap == 0.0

@@ -132,7 +132,9 @@ class TcuController:
         #: thermal protection by the facing-temperature estimate (:mod:`.protection`), TCUs that have one
         self.protection = (ThermalProtection(sc.protection)
                            if sc.protection.enabled and variant.temperature != "none" else None)
-        self.inhibited = False
+        self.inhibited = self.limited = False
+        #: the protection level the current launch runs at (decided at its start; 3: inhibited)
+        self.launch_level = 0
         #: the assumed theta_cs (K) and believed kiss point (m) after the last cycle
         self.theta_now, self.kiss_now = self.theta_used(), self.kiss()
 
@@ -226,7 +228,7 @@ class TcuController:
         if level == "creep":
             return drv.creep_torque_Nm
         full = tc.engine_speed_full_pedal_rpm
-        if self.protection is not None and self.protection.level >= LIMIT:     # slip energy limited
+        if self.limited:                                  # slip energy limited (decided at the launch's start)
             full = min(full, self.protection.p.limit_engine_speed_rpm)
         w_t = self.w_idle + drv.pedal(level) * (full * math.pi / 30.0 - self.w_idle)
         dw = (w_t - self.w_ref) / tc.engine_speed_time_constant_s
@@ -264,6 +266,10 @@ class TcuController:
                 self.learner.start_launch()
             if prot is not None:
                 self.inhibited = prot.launch_start(self.theta_facing_protect(), tl, launch)
+                # the launch's limit is set at its start: a mid-launch switch of the engine-speed target made the
+                # speed controller pull the engine down (a torque spike of 208 N.m, measured)
+                self.launch_level = prot.update(self.theta_facing_protect(), tl, launch)
+                self.limited = self.launch_level >= LIMIT
         if prot is not None:
             prot.update(self.theta_facing_protect(), tl, launch)
             if self.inhibited:                    # no launch in this slot: the clutch stays open

@@ -42,6 +42,7 @@ not shorten a load-limited slip.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Iterable
 
 from ..config import Checked
@@ -146,3 +147,61 @@ class ThermalProtection:
         if not self.inhibited:
             self._set(self._graded(theta_K - KELVIN), t, launch)
         return self.level
+
+
+def plot_protection(out: Path, png: Path, tcus: tuple[str, ...] = ("naive", "aware", "production")) -> Path:
+    """Plot a protected heavy-duty run from a ``cushion-clutch launch`` output folder ``out``: per TCU the
+    plant's facing temperature, the TCU's estimate and its protection level, and the slip energy per launch.
+    """
+    import csv
+
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    p = Protection()
+    fig, axes = plt.subplots(3, 1, figsize=(10, 9), sharex=False)
+    colours = {"naive": "tab:red", "production": "tab:blue", "aware": "tab:green"}
+    for name in tcus:
+        d = np.genfromtxt(out / f"launch_{name}.csv", delimiter=",", names=True)
+        c = colours.get(name, None)
+        axes[0].plot(d["time_s"] / 60, d["theta_cm_K"] - KELVIN, color=c, lw=1.0,
+                     label=f"{name}: plant facings" + ("" if name != "naive" else " (no protection)"))
+        if np.isfinite(d["theta_cm_tcu_K"]).any():
+            axes[0].plot(d["time_s"] / 60, d["theta_cm_tcu_K"] - KELVIN, color=c, lw=1.0, ls="--",
+                         label=f"{name}: its estimate")
+        if d["protection_level"].max() > 0:
+            axes[1].plot(d["time_s"] / 60, d["protection_level"], color=c, lw=1.2,
+                         label=name + (" (the true temperature)" if name == "aware" else " (its estimate)"))
+    for y, lab in ((p.warn_degC, "warn"), (p.limit_degC, "limit"), (p.inhibit_degC, "inhibit"),
+                   (p.damage_degC, "damage (seed paper)")):
+        axes[0].axhline(y, color="k", lw=0.6, ls=":")
+        axes[0].text(axes[0].get_xlim()[1], y, " " + lab, fontsize=8, va="center")
+    axes[0].set_ylabel("facing temperature [degC]")
+    axes[0].set_xlabel("time [min]")
+    axes[0].legend(fontsize=8, loc="lower right")
+    axes[1].set_yticks([0, 1, 2, 3], ["ok", "warn", "limit", "inhibit"])
+    axes[1].set_ylabel("protection level")
+    axes[1].set_xlabel("time [min]")
+    axes[1].legend(fontsize=8, loc="upper left")
+    rows = list(csv.DictReader(open(out / "launch_metrics.csv")))
+    width = 0.8 / len(tcus)
+    for k, name in enumerate(tcus):
+        r = [x for x in rows if x["tcu"] == name]
+        axes[2].bar(np.array([int(x["launch"]) for x in r]) + (k - 0.5 * (len(tcus) - 1)) * width,
+                    [float(x["slip_energy_kJ"]) for x in r], width, color=colours.get(name, None), label=name)
+    axes[2].set_xlabel("launch")
+    axes[2].set_ylabel("slip energy [kJ]")
+    axes[2].legend(fontsize=8)
+    fig.suptitle("Thermal protection, scenario 'protection' (3500 kg, 12 %, a hill start every 20 s)")
+    fig.tight_layout()
+    png.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(png, dpi=110)
+    plt.close(fig)
+    return png
+
+
+if __name__ == "__main__":      # python -m cushion_clutch.launch.protection <launch output folder> <png>
+    import sys
+    print(plot_protection(Path(sys.argv[1]), Path(sys.argv[2])))

@@ -81,6 +81,8 @@ class ProductionTcu(TcuController):
         self.w_prev = (0.0, 0.0)
         self.hist: deque = deque(maxlen=WINDOW + 1)     # (w_e, w_v, T_est, x_meas)
         self.x_offset = sensors.position_offset_m
+        self._closed_key: tuple = ()
+        self._closed_value = 0.0
         super().__init__(variant, sc, table, p, theta0, self.rls.inertia_at_disc_kg_m2(),
                          self.rls.holding_torque_Nm(), j_e_kg_m2, w_idle_rad_s)
 
@@ -106,8 +108,18 @@ class ProductionTcu(TcuController):
                                 theta_cm=self.theta_cm_used()) + self.ekf.dx_used)
 
     def model_torque(self, x_m: float) -> float:
-        """Torque the TCU believes at the true bearing position ``x_m`` (it sees it through its sensor), N.m."""
-        return self.ekf.used_torque(x_m + self.x_offset)
+        """Torque the TCU believes at the true bearing position ``x_m`` (it sees it through its sensor), N.m.
+
+        The value at the closed position (asked every launch cycle for the capacity limit) is kept
+        until the EKF's estimate changes (every ``ekf.period_s`` at most).
+        """
+        e = self.ekf
+        if x_m == self.sc.tcu.x_to_closed_m:
+            key = (e.s[4], e.theta_cm, e.dx_used, e.mu_used)
+            if key != self._closed_key:
+                self._closed_key, self._closed_value = key, e.used_torque(x_m + self.x_offset)
+            return self._closed_value
+        return e.used_torque(x_m + self.x_offset)
 
     # --- sensing -------------------------------------------------------------------------------------
     def sense(self, t: float, w_engine: float, w_disc: float, engine_torque_Nm: float) -> None:

@@ -169,10 +169,13 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
             cycled = countdown == 0
             if cycled:                                           # -- TCU cycle
                 countdown = tcu_every
-                if sense is not None:                             # production TCU: its own sensors
-                    sense(t, dl.w_e, dl.w_d, t_e)
-                ctl.cycle(n + 1, tl, rec.lock_time is not None, sensors.read(dl.w_e), sensors.read(dl.w_d),
-                          x_act, theta_cm, t_e, levels[n], sensors.read(dl.v * r_to_disc))
+                if sense is not None:         # production TCU: its own speed sensors, read from the truth given;
+                    sense(t, dl.w_e, dl.w_d, t_e)                 # the wheel speed as the others read it (ABS)
+                    ctl.cycle(n + 1, tl, rec.lock_time is not None, dl.w_e, dl.w_d, x_act, theta_cm, t_e, levels[n],
+                              sensors.read(dl.v * r_to_disc))
+                else:
+                    ctl.cycle(n + 1, tl, rec.lock_time is not None, sensors.read(dl.w_e), sensors.read(dl.w_d),
+                              x_act, theta_cm, t_e, levels[n], sensors.read(dl.v * r_to_disc))
                 phase = ctl.phase
                 engaged = phase == LAUNCH or phase == CLOSE
                 launching = phase == LAUNCH

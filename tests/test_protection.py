@@ -64,7 +64,7 @@ def test_protected_tcus_keep_their_estimate_below_the_damage_limit(tmp_path):
     sc = load_scenario(scenario_path("protection"))
     sc = dataclasses.replace(
         sc, run=dataclasses.replace(sc.run, launches=7),
-        protection=Protection(warn_degC=60.0, limit_degC=80.0, inhibit_degC=100.0, resume_degC=60.0,
+        protection=Protection(enabled=True, warn_degC=60.0, limit_degC=80.0, inhibit_degC=100.0, resume_degC=60.0,
                               damage_degC=130.0))
     naive = simulate_launches(fmu, sc, load_table(), "naive")
     assert naive.series["theta_cm_K"].max() - KELVIN > 130.0          # unprotected: past the (lowered) limit

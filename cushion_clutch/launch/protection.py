@@ -59,7 +59,9 @@ MESSAGES = ("clutch temperature normal", "clutch hot: avoid repeated starts",
 class Protection(Checked):
     """Section ``[protection]``: thresholds on the estimated facing temperature (degC) and the limit action."""
 
-    enabled: bool = True
+    enabled: bool = False
+    """off unless a scenario turns it on (the shipped comparisons of the TCUs' characteristics run without it;
+    the ``protection`` scenario turns it on)"""
     warn_degC: float = 250.0
     limit_degC: float = 280.0
     inhibit_degC: float = 310.0

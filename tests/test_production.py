@@ -67,3 +67,14 @@ def test_on_a_nominal_clutch_production_is_never_worse_than_naive(plant, section
     naive = simulate_launches(plant, sc, load_table(), "naive").metrics[0]["characteristic_error_max_Nm"]
     prod = simulate_launches(plant, sc, load_table(), "production")
     assert prod.metrics[0]["characteristic_error_max_Nm"] <= naive + 0.5
+
+
+def test_the_temperature_estimate_holds_on_heavy_duty(plant):
+    """3500 kg hill starts on the plant network (the protection duty, unprotected): before the ECU-offset
+    state and the RLS readiness fix the theta_cs estimate was 33-64 K high after twelve starts."""
+    sc = load_scenario(scenario_path("protection"))
+    sc = dataclasses.replace(sc, run=dataclasses.replace(sc.run, launches=12),
+                             protection=dataclasses.replace(sc.protection, enabled=False))
+    r = simulate_launches(plant, sc, load_table(), "production")
+    assert r.metrics[-1]["theta_cs_start_degC"] > 130.0                 # the clutch did heat up
+    assert max(abs(m["theta_cs_error_K"]) for m in r.metrics) < 10.0

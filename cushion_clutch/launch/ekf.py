@@ -31,15 +31,12 @@ State (K, K, K, K, K, m, 1, 1, 1)::
   Both scales are kept within ``[scale_min, scale_max]``.
 * **Measurement** (during slip): the clutch torque from the engine side,
   ``T_c = T_est - J_e dw_e/dt``, against the model
-  ``h(s) = mu_scale T_model(x_meas - dx_kiss, theta_cs, theta_cm) + b`` with ``b``
+  ``h(s) = mu_scale T_model(x_meas - dx_kiss, theta_cs, theta_cm) + b`` (the TCU's
+  characteristic, nominal mu; ``theta_cm`` sets the stack's thermal growth; ``b``
   the engine control unit's torque offset, a state of prior sd
-  ``torque_offset_accuracy_Nm`` (its stated accuracy) and a slow random walk
-  (``mu_scale`` carries the gain error). Without it the offset had nowhere to
-  go but into the temperatures and the thermal scales: on a 3500 kg hill-start
-  duty (plant network) ``k_loss`` ran to its bound 0.26, ``k_heat`` to 1.22, and
-  the theta_cs estimate was 64 K high after twelve starts and still climbing (the TCU's
-  characteristic
-  characteristic, nominal mu; ``theta_cm`` sets the stack's thermal growth);
+  ``torque_offset_accuracy_Nm``, its stated accuracy, and a slow random walk,
+  ``mu_scale`` carrying the gain error: without it the offset had nowhere to go
+  but into the touch point, the temperatures and the thermal scales);
   the Jacobian is taken numerically in ``theta_cs``, the facings and
   ``dx_kiss``. The facings' column matters: on the default characteristic
   ``dT/dtheta_cm`` is about +0.05 N.m/K at 60-150 N.m, where ``dT/dtheta_cs``
@@ -107,12 +104,17 @@ from typing import Iterable
 import numpy as np
 
 from ..config import Checked
-from ..model import ClutchParameters, SpringTable, outputs, x_to_for_torque
+from ..model import ClutchParameters, SpringTable, outputs
+from ..model import x_to_for_torque
 from .thermal_network import NetworkParams, ThermalNetwork
 
 IX_CS, IX_DX, IX_MU, IX_LOSS, IX_HEAT = 4, 5, 6, 7, 8   #: state indices
-IX_OFF = 9            #: the engine control unit's torque offset (the last state)
-N_STATE = 10
+N_STATE = 9
+
+#: the engine control unit's torque offset: the last state, after the temperatures, the touch point, mu and
+#: the two thermal scales
+IX_OFF = N_STATE
+N_STATE = IX_OFF + 1
 #: nominal torques at which the learned characteristic is compared with the nominal one, N.m
 EVIDENCE_TORQUES_NM = (10.0, 20.0, 40.0, 80.0, 120.0)
 #: speed band of the cached discretisation (convection), rad/s
@@ -241,13 +243,17 @@ class ClutchEkf:
         self.net, self.e, self.table, self.p = net, e, table, p
         self.model = ThermalNetwork(net, theta_a, theta0)
         self.theta_a = theta_a
-        self.s = np.array([theta0] * 5 + [0.0, 1.0, 1.0, 1.0, 0.0])
+        self.s = np.array([theta0] * 5 + [0.0, 1.0, 1.0, 1.0])
         self.P = np.diag([e.theta0_sd_K ** 2] * 5 + [e.kiss_sd_m ** 2, e.mu_sd ** 2, e.loss_scale_sd ** 2,
-                                                      e.heat_scale_sd ** 2, e.torque_offset_accuracy_Nm ** 2])
+                                                      e.heat_scale_sd ** 2])
         self.q_rw = np.array([e.theta_walk_K2_per_s] * 5 + [e.kiss_walk_m2_per_s, e.mu_walk_per_s,
                                                             e.loss_walk_per_s if e.loss_scale_sd > 0 else 0.0,
-                                                            e.heat_walk_per_s if e.heat_scale_sd > 0 else 0.0,
-                                                            e.offset_walk_Nm2_per_s])
+                                                            e.heat_walk_per_s if e.heat_scale_sd > 0 else 0.0])
+        # the ECU torque offset, appended: prior sd its stated accuracy, a slow random walk
+        self.s = np.append(self.s, 0.0)
+        self.P = np.pad(self.P, (0, 1))
+        self.P[IX_OFF, IX_OFF] = e.torque_offset_accuracy_Nm ** 2
+        self.q_rw = np.append(self.q_rw, e.offset_walk_Nm2_per_s)
         self.energy_J = 0.0
         self.t_acc = 0.0
         self._cache: dict = {}
@@ -335,23 +341,23 @@ class ClutchEkf:
         band = self.e.mu_deadband
         return 1.0 + (d - band if d > band else (d + band if d < -band else 0.0))
 
-    def model_torque(self, x_m: float, s: np.ndarray | None = None, mu: float | None = None,
-                     dx: float | None = None) -> float:
+    def model_torque(self, x_m: float, s: np.ndarray | None = None, mu: float | None = None) -> float:
         """The TCU's torque at bearing position ``x_m`` (m) with state ``s`` (default: the estimate), N.m.
 
-        ``mu`` and ``dx`` replace the state's friction scale and touch-point offset (e.g. :attr:`mu_used`,
-        :attr:`dx_used`).
+        ``mu`` replaces the state's friction scale (e.g. :attr:`mu_used`).
         """
         s = self.s if s is None else s
         th = min(max(float(s[IX_CS]), self.table.theta_min_K), self.table.theta_max_K)
         theta_cm = float(0.5 * (s[1] + s[2]))          # the stack's growth at the estimated facing temperature
-        return (float(s[IX_MU]) if mu is None else mu) * outputs(
-            x_m - (float(s[IX_DX]) if dx is None else dx), th, self.table, self.p, theta_cm).torque
+        return (float(s[IX_MU]) if mu is None else mu) * outputs(x_m - float(s[IX_DX]), th, self.table, self.p,
+                                                                 theta_cm).torque
 
     def used_torque(self, x_m: float) -> float:
         """The torque the TCU applies at the measured bearing position ``x_m`` (m): :attr:`dx_used`,
         :attr:`mu_used`, N.m."""
-        return self.model_torque(x_m, mu=self.mu_used, dx=self.dx_used)
+        s = self.s.copy()
+        s[IX_DX] = self.dx_used
+        return self.model_torque(x_m, s, mu=self.mu_used)
 
     def update_evidence(self) -> bool:
         """Compare the learned characteristic with the nominal one; set and return :attr:`evidence`.

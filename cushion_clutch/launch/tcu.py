@@ -251,13 +251,13 @@ class TcuController:
         measured wheel speed at the disc (rad/s, the kiss-point learner's input; default ``w_d``).
         """
         tc = self.sc.tcu
+        prot = self.protection
         if self.v.temperature == "ideal":
             self.theta_ideal = thermal_step(self.theta_ideal, theta_cm_true, self.period, self.p)
             self.theta_cm_ideal = theta_cm_true
         elif self.observer is not None:
             slip = abs(w_e - w_d)
             self.observer.update(self.model_torque(x_meas) * slip if self.phase == LAUNCH else 0.0)
-        prot = self.protection
         if launch != self.launch:
             self.launch = launch
             self.sync, self.integral, self.t_dem, self.w_ref = False, 0.0, 0.0, w_e

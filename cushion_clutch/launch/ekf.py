@@ -104,12 +104,14 @@ from typing import Iterable
 import numpy as np
 
 from ..config import Checked
-from ..model import ClutchParameters, SpringTable, outputs
 from ..model import x_to_for_torque
+from ..model import ClutchParameters, SpringTable, outputs
 from .thermal_network import NetworkParams, ThermalNetwork
 
 IX_CS, IX_DX, IX_MU, IX_LOSS, IX_HEAT = 4, 5, 6, 7, 8   #: state indices
 N_STATE = 9
+#: speed band of the cached discretisation (convection), rad/s
+SPEED_BAND = 10.0
 
 #: the engine control unit's torque offset: the last state, after the temperatures, the touch point, mu and
 #: the two thermal scales
@@ -117,8 +119,6 @@ IX_OFF = N_STATE
 N_STATE = IX_OFF + 1
 #: nominal torques at which the learned characteristic is compared with the nominal one, N.m
 EVIDENCE_TORQUES_NM = (10.0, 20.0, 40.0, 80.0, 120.0)
-#: speed band of the cached discretisation (convection), rad/s
-SPEED_BAND = 10.0
 
 
 @dataclass(frozen=True)

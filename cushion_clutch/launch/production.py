@@ -37,7 +37,7 @@ from collections import deque
 from pathlib import Path
 
 from ..model import ClutchParameters, SpringTable, x_to_for_torque
-from .ekf import ClutchEkf, EkfParams, TcuNetworkParams
+from .ekf import IX_DX, ClutchEkf, EkfParams, TcuNetworkParams
 from .mass_grade import MassGrade, MassGradeEstimator
 from .sensors import ProductionSensors, TcuSensors
 from .store import AdaptedState, load_state, save_state
@@ -115,7 +115,7 @@ class ProductionTcu(TcuController):
         """
         e = self.ekf
         if x_m == self.sc.tcu.x_to_closed_m:
-            key = (e.s[4], e.theta_cm, e.dx_used, e.mu_used)
+            key = (e.theta_cs, e.theta_cm, e.dx_used, e.mu_used)
             if key != self._closed_key:
                 self._closed_key, self._closed_value = key, e.used_torque(x_m + self.x_offset)
             return self._closed_value
@@ -191,7 +191,7 @@ class ProductionTcu(TcuController):
     def adapted_state(self, starts_since_standstill: int, touch_point_learned: bool) -> AdaptedState:
         """What the TCU stores at key-off: the characteristic it applies and its thermal scales."""
         e = self.ekf
-        sd = math.sqrt(max(float(e.P[5, 5]), 0.0)) if e.evidence else e.x_accuracy
+        sd = math.sqrt(max(float(e.P[IX_DX, IX_DX]), 0.0)) if e.evidence else e.x_accuracy
         return AdaptedState(e.dx_used, min(max(sd, 1e-6), 0.009), e.mu_scale if e.evidence else e.mu_prior,
                             e.loss_scale, e.heat_scale, touch_point_learned, starts_since_standstill)
 

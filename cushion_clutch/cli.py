@@ -167,7 +167,7 @@ def _launch(args: argparse.Namespace) -> int:
     from .fmu.check import check_fmu
     from .model import load_table
     from .launch.plant import build_plant_fmu
-    from .launch.report import ratio_line, run_all, summary_rows, write_outputs
+    from .launch.report import peak_lines, ratio_line, run_all, summary_rows, write_outputs
     from .launch.scenario import load_scenario, scenario_path
     from .launch.tcu import VARIANTS
     from .outputs import OutputSet
@@ -196,6 +196,7 @@ def _launch(args: argparse.Namespace) -> int:
     print(launch_terminal_table(summary_rows(results)))
     print()
     print(ratio_line(results, "hot"))
+    print(peak_lines(results))
     for name, res in results.items():
         e = res.energy
         print(f"{name}: energy residual {e.residual():.3g} J of {e.engine_work / 1e3:.1f} kJ; "

@@ -23,6 +23,7 @@ def plant(tmp_path_factory):
 
 def test_production_learns_a_late_kiss_point_and_tracks_the_temperature(plant):
     sc = short(load_scenario(scenario_path("wear")), launches=4)
+    sc = dataclasses.replace(sc, standstill=dataclasses.replace(sc.standstill, learn="never"))   # launches only
     r = simulate_launches(plant, sc, load_table(), "production")
     kiss = [m["kiss_point_error_mm"] for m in r.metrics]
     ch = [m["characteristic_error_max_Nm"] for m in r.metrics]
@@ -35,6 +36,14 @@ def test_production_learns_a_late_kiss_point_and_tracks_the_temperature(plant):
     assert r.series["theta_cs_K"].max() - r.series["theta_cs_K"][0] > 8.0
 
 
+def test_a_reset_production_tcu_knows_the_worn_touch_point_before_its_first_launch(plant):
+    sc = short(load_scenario(scenario_path("wear")), launches=2)
+    r = simulate_launches(plant, sc, load_table(), "production")
+    assert r.key_on.start == "reset" and r.key_on.standstill.ok
+    assert all(abs(m["kiss_point_error_mm"]) < 0.06 for m in r.metrics)
+    assert all(m["characteristic_error_max_Nm"] < 3.0 for m in r.metrics)
+
+
 def test_production_with_the_plant_network_runs_and_stays_deterministic(plant):
     sc = short(load_scenario(), launches=2)
     sc = dataclasses.replace(sc, plant_thermal=dataclasses.replace(sc.plant_thermal, enabled=True))
@@ -43,3 +52,30 @@ def test_production_with_the_plant_network_runs_and_stays_deterministic(plant):
     assert np.array_equal(a.series["theta_cs_tcu_K"], b.series["theta_cs_tcu_K"])
     rise = a.series["theta_cm_K"].max() - a.series["theta_cm_K"][0]
     assert 0.5 < rise < 20.0          # most slip heat goes into flywheel and pressure plate (effusivity split)
+
+
+@pytest.mark.parametrize("sections", [
+    {},                                                                        # default, 20 degC
+    {"vehicle": {"mass_kg": 1200.0, "slope_percent": 0.0},                     # light car, flat, -10 degC
+     "facing": {"ambient_degC": -10.0, "initial_degC": -10.0}}])
+@pytest.mark.parametrize("learn", ["never", "missing"])
+def test_on_a_nominal_clutch_production_is_never_worse_than_naive(plant, sections, learn):
+    """The ECU's torque bias (+4 %, +3 N.m) and the position offset (+20 um) are no evidence of a change."""
+    sc = short(load_scenario(), launches=1)
+    for sec, vals in sections.items():
+        sc = dataclasses.replace(sc, **{sec: dataclasses.replace(getattr(sc, sec), **vals)})
+    sc = dataclasses.replace(sc, standstill=dataclasses.replace(sc.standstill, learn=learn))
+    naive = simulate_launches(plant, sc, load_table(), "naive").metrics[0]["characteristic_error_max_Nm"]
+    prod = simulate_launches(plant, sc, load_table(), "production")
+    assert prod.metrics[0]["characteristic_error_max_Nm"] <= naive + 0.5
+
+
+def test_the_temperature_estimate_holds_on_heavy_duty(plant):
+    """3500 kg hill starts on the plant network (the protection duty, unprotected): before the ECU-offset
+    state and the RLS readiness fix the theta_cs estimate was 33-64 K high after twelve starts."""
+    sc = load_scenario(scenario_path("protection"))
+    sc = dataclasses.replace(sc, run=dataclasses.replace(sc.run, launches=12),
+                             protection=dataclasses.replace(sc.protection, enabled=False))
+    r = simulate_launches(plant, sc, load_table(), "production")
+    assert r.metrics[-1]["theta_cs_start_degC"] > 130.0                 # the clutch did heat up
+    assert max(abs(m["theta_cs_error_K"]) for m in r.metrics) < 10.0

@@ -31,8 +31,12 @@ State (K for each network node and the cushion spring, m, 1, 1, 1)::
   Both scales are kept within ``[scale_min, scale_max]``.
 * **Measurement** (during slip): the clutch torque from the engine side,
   ``T_c = T_est - J_e dw_e/dt``, against the model
-  ``h(s) = mu_scale T_model(x_meas - dx_kiss, theta_cs, theta_cm)`` (the TCU's
-  characteristic, nominal mu; ``theta_cm`` sets the stack's thermal growth);
+  ``h(s) = mu_scale T_model(x_meas - dx_kiss, theta_cs, theta_cm) + b`` (the TCU's
+  characteristic, nominal mu; ``theta_cm`` sets the stack's thermal growth; ``b``
+  the engine control unit's torque offset, a state of prior sd
+  ``torque_offset_accuracy_Nm``, its stated accuracy, and a slow random walk,
+  ``mu_scale`` carrying the gain error: without it the offset had nowhere to go
+  but into the touch point, the temperatures and the thermal scales);
   the Jacobian is taken numerically in ``theta_cs``, the facings and
   ``dx_kiss``. The facings' column matters: on the default characteristic
   ``dT/dtheta_cm`` is about +0.05 N.m/K at 60-150 N.m, where ``dT/dtheta_cs``
@@ -71,6 +75,25 @@ State (K for each network node and the cushion spring, m, 1, 1, 1)::
     whose length the TCU knows: repeated launches and a cool-down.
 
 A torque residual larger than ``gate_sd`` standard deviations is rejected.
+
+**The nominal calibration as the prior** (what the TCU *applies*). The torque
+the EKF learns against is the engine control unit's estimate, whose stated
+accuracy is ``mu_deadband`` in gain and ``torque_offset_accuracy_Nm`` in offset,
+and the bearing position reads within ``position_accuracy_m``. Through the touch
+band such biases are indistinguishable from a touch-point offset: on the default
+clutch at 20 degC the ECU's +4 % and +3 N.m move ``dx_kiss`` to about -0.11 mm
+within 0.2 s of the first launch, and the characteristic the TCU then believes
+is 5.3 N.m above the true one at 90 N.m (the naive TCU: 2.1). The learned
+state therefore moves the characteristic the TCU applies only on *evidence*: the
+learned characteristic differs from the nominal one (same temperatures) at one of
+the torques :data:`EVIDENCE_TORQUES_NM` by more than the envelope the known biases
+can produce there, ``g T + o + (dT/dx) x_acc``, times ``evidence_threshold``, in
+``evidence_confirm`` consecutive updates. The evidence is kept until the
+difference falls below ``evidence_release`` times the envelope (hysteresis).
+Without evidence the TCU applies the prior (``dx = 0`` and ``mu = 1``, or a
+stored or standstill-learned touch point, :meth:`ClutchEkf.set_prior`, whose
+accuracy is then ``x_acc``); the filter's own state keeps learning (its
+residuals stay consistent with the biased torque).
 """
 from __future__ import annotations
 
@@ -81,6 +104,7 @@ from typing import Iterable
 import numpy as np
 
 from ..config import Checked
+from ..model import x_to_for_torque
 from ..model import ClutchParameters, SpringTable, outputs
 from .thermal_network import FACINGS, N_NODES, TcuNetworkBase, ThermalNetwork
 
@@ -91,6 +115,13 @@ N_T = N_NODES + 1          #: temperatures (the nodes and the cushion spring)
 F1, F2 = FACINGS
 #: speed band of the cached discretisation (convection), rad/s
 SPEED_BAND = 10.0
+
+#: the engine control unit's torque offset: the last state, after the temperatures, the touch point, mu and
+#: the two thermal scales
+IX_OFF = N_STATE
+N_STATE = IX_OFF + 1
+#: nominal torques at which the learned characteristic is compared with the nominal one, N.m
+EVIDENCE_TORQUES_NM = (10.0, 20.0, 40.0, 80.0, 120.0)
 
 
 @dataclass(frozen=True)
@@ -135,6 +166,23 @@ class EkfParams(Checked):
     gate_sd: float = 4.0
     mu_deadband: float = 0.05
     """the engine torque estimate's stated gain accuracy: a learned mu_scale within 1 +- this is not applied"""
+    torque_offset_accuracy_Nm: float = 3.0
+    """the engine torque estimate's stated offset accuracy, N.m: the evidence envelope and the prior sd of
+    the offset state"""
+    offset_walk_Nm2_per_s: float = 1e-4
+    """random walk of the torque estimate's offset (it drifts with the engine's state), N.m2/s"""
+    position_accuracy_m: float = 20e-6
+    """the position sensor's stated offset accuracy, m (the evidence envelope)"""
+    evidence_threshold: float = 1.0
+    """the learned characteristic is applied once its difference from the prior exceeds this multiple of the
+    bias envelope (the touch point and the friction scale fit a gain and offset error of the torque only
+    approximately: with a bias at the envelope the ratio overshot 1 by 4 % in a synthetic launch)"""
+    evidence_release: float = 0.7
+    """the learned characteristic stays applied until its difference from the prior falls below this
+    fraction of the bias envelope"""
+    evidence_confirm: int = 5
+    """... and is applied once the difference has exceeded the envelope in this many consecutive touch-point
+    or friction updates (a transient of the filter within a launch is no evidence)"""
     temperature_update: bool = True
     loss_scale_sd: float = 0.5
     """prior sd of the heat-loss scale (every node's sink conductance: convection and engine block), 1;
@@ -163,9 +211,13 @@ class EkfParams(Checked):
             "mu_sd": (0.0, 1.0), "mu_walk_per_s": (0.0, 1.0), "torque_sd_Nm": (1e-3, 1e3),
             "slip_min_rad_s": (0.0, 1e3), "touch_torque_min_Nm": (0.0, 1e4), "touch_torque_max_Nm": (0.0, 1e4),
             "mu_torque_min_Nm": (0.0, 1e4), "gate_sd": (1.0, 100.0, True),
-            "mu_deadband": (0.0, 0.5), "loss_scale_sd": (0.0, 2.0), "loss_walk_per_s": (0.0, 1.0),
+            "mu_deadband": (0.0, 0.5), "torque_offset_accuracy_Nm": (0.0, 100.0),
+            "position_accuracy_m": (0.0, 1e-3), "evidence_release": (0.0, 1.0), "evidence_threshold": (1.0, 100.0),
+            "offset_walk_Nm2_per_s": (0.0, 100.0),
+            "evidence_confirm": (1, 1000), "loss_scale_sd": (0.0, 2.0), "loss_walk_per_s": (0.0, 1.0),
             "heat_scale_sd": (0.0, 2.0), "heat_walk_per_s": (0.0, 1.0), "loss_excitation_K": (0.0, 500.0), "theta_torque_min_Nm": (0.0, 1e4),
             "scale_min": (0.0, 1.0, True), "scale_max": (1.0, 100.0)})
+        yield from self._integers("evidence_confirm")
         if self.touch_torque_max_Nm <= self.touch_torque_min_Nm:
             yield "ekf.touch_torque_max_Nm: must exceed ekf.touch_torque_min_Nm"
 
@@ -215,12 +267,26 @@ class ClutchEkf:
         self.q_rw = np.array([e.theta_walk_K2_per_s] * N_T + [e.kiss_walk_m2_per_s, e.mu_walk_per_s,
                                                             e.loss_walk_per_s if e.loss_scale_sd > 0 else 0.0,
                                                             e.heat_walk_per_s if e.heat_scale_sd > 0 else 0.0])
+        # the ECU torque offset, appended: prior sd its stated accuracy, a slow random walk
+        self.s = np.append(self.s, 0.0)
+        self.P = np.pad(self.P, (0, 1))
+        self.P[IX_OFF, IX_OFF] = e.torque_offset_accuracy_Nm ** 2
+        self.q_rw = np.append(self.q_rw, e.offset_walk_Nm2_per_s)
         self.energy_J = 0.0
         self.t_acc = 0.0
         self._cache: dict = {}
         self._dcache: dict = {}
+        self._ev_cache: dict = {}
         #: count of accepted measurement updates, and of rejected ones (gate)
         self.accepted = self.rejected = 0
+        #: the prior characteristic: touch-point offset (m), friction scale and the offset's accuracy (m)
+        #: (the nominal calibration; a stored or standstill-learned one after :meth:`set_prior`)
+        self.dx_prior, self.mu_prior, self.x_accuracy = 0.0, 1.0, e.position_accuracy_m
+        #: the learned characteristic differs from the prior by more than the known biases (applied)
+        self.evidence = False
+        self._over = 0
+        #: the last ratio of that difference to the bias envelope (max over EVIDENCE_TORQUES_NM), 1
+        self.evidence_ratio = 0.0
 
     # --- estimates -----------------------------------------------------------------------------
     @property
@@ -244,6 +310,11 @@ class ClutchEkf:
         return float(self.s[IX_MU])
 
     @property
+    def torque_offset(self) -> float:
+        """Learned offset of the engine control unit's torque estimate, N.m (not the clutch's: never applied)."""
+        return float(self.s[IX_OFF])
+
+    @property
     def loss_scale(self) -> float:
         """Learned scale of the network's heat-loss conductances (convection, engine block), 1."""
         return float(self.s[IX_LOSS])
@@ -253,15 +324,38 @@ class ClutchEkf:
         """Learned scale of the slip heat that reaches the network, 1."""
         return float(self.s[IX_HEAT])
 
+    def set_prior(self, dx_m: float, dx_sd_m: float, mu_scale: float = 1.0, loss_scale: float = 1.0,
+                  heat_scale: float = 1.0) -> None:
+        """Start from a stored or standstill-learned characteristic: it becomes the prior (and the state).
+
+        ``dx_m`` touch-point offset (position sensor's frame) with its accuracy ``dx_sd_m`` (m; the
+        state's sd and the evidence envelope's position term), the friction and thermal scales.
+        The touch point's covariance with the rest is reset.
+        """
+        s, pm = self.s, self.P
+        s[IX_DX], s[IX_MU] = dx_m, mu_scale
+        s[IX_LOSS], s[IX_HEAT] = loss_scale, heat_scale
+        pm[IX_DX, :] = pm[:, IX_DX] = 0.0
+        pm[IX_DX, IX_DX] = dx_sd_m ** 2
+        self.dx_prior, self.mu_prior, self.x_accuracy = dx_m, mu_scale, dx_sd_m
+        self.evidence, self.evidence_ratio, self._over = False, 0.0, 0
+
+    @property
+    def dx_used(self) -> float:
+        """The touch-point offset the TCU applies: ``dx_kiss`` on evidence (module docstring), else the
+        prior's, m."""
+        return float(self.s[IX_DX]) if self.evidence else self.dx_prior
+
     @property
     def mu_used(self) -> float:
-        """The friction scale the TCU applies: ``mu_scale`` outside a dead band of ``mu_deadband`` around 1.
+        """The friction scale the TCU applies: without evidence 1; with it ``mu_scale`` outside a dead band
+        of ``mu_deadband`` around 1.
 
         ``mu_scale`` is learned against the engine control unit's torque
         estimate, so it carries that estimate's gain error; a deviation within
         the estimate's stated accuracy is not attributed to the clutch.
         """
-        d = self.s[IX_MU] - 1.0
+        d = (self.s[IX_MU] if self.evidence else self.mu_prior) - 1.0
         band = self.e.mu_deadband
         return 1.0 + (d - band if d > band else (d + band if d < -band else 0.0))
 
@@ -275,6 +369,56 @@ class ClutchEkf:
         theta_cm = float(0.5 * (s[F1] + s[F2]))          # the stack's growth at the estimated facing temperature
         return (float(s[IX_MU]) if mu is None else mu) * outputs(x_m - float(s[IX_DX]), th, self.table, self.p,
                                                                  theta_cm).torque
+
+    def used_torque(self, x_m: float) -> float:
+        """The torque the TCU applies at the measured bearing position ``x_m`` (m): :attr:`dx_used`,
+        :attr:`mu_used`, N.m."""
+        s = self.s.copy()
+        s[IX_DX] = self.dx_used
+        return self.model_torque(x_m, s, mu=self.mu_used)
+
+    def update_evidence(self) -> bool:
+        """Compare the learned characteristic with the nominal one; set and return :attr:`evidence`.
+
+        At each nominal torque ``T`` of :data:`EVIDENCE_TORQUES_NM` the nominal
+        position ``x`` (the estimated temperatures) and its slope ``dT/dx`` give
+        the bias envelope ``g T + o + (dT/dx) x_acc`` (``g`` = ``mu_deadband``,
+        ``o`` = ``torque_offset_accuracy_Nm``, ``x_acc`` = ``position_accuracy_m``);
+        the learned characteristic's difference there, over the envelope, is the
+        ratio. Evidence once the largest ratio exceeds ``evidence_threshold`` in
+        ``evidence_confirm`` consecutive calls, kept until it falls below ``evidence_release``.
+        """
+        e, s = self.e, self.s
+        th = min(max(float(s[IX_CS]), self.table.theta_min_K), self.table.theta_max_K)
+        theta_cm = self.theta_cm
+        key = (round(th, 0), round(theta_cm, 0))
+        pts = self._ev_cache.get(key)
+        if pts is None:
+            pts = []
+            for t in EVIDENCE_TORQUES_NM:
+                try:
+                    x = x_to_for_torque(t, th, self.table, self.p, theta_cm=theta_cm)
+                except ValueError:
+                    continue
+                t0 = outputs(x, th, self.table, self.p, theta_cm).torque
+                if t0 < 0.9 * t:                    # beyond the closed capacity
+                    continue
+                slope = (outputs(x + 10e-6, th, self.table, self.p, theta_cm).torque - t0) / 10e-6
+                pts.append((x, t0, e.mu_deadband * t0 + e.torque_offset_accuracy_Nm, slope))
+            if len(self._ev_cache) > 4096:
+                self._ev_cache.clear()
+            self._ev_cache[key] = pts
+        mu, dx = float(s[IX_MU]), float(s[IX_DX])
+        ratio = 0.0
+        dx0, mu0 = self.dx_prior, self.mu_prior
+        for x, t0, env0, slope in pts:                  # the prior's position for each nominal torque
+            env = mu0 * (env0 + slope * self.x_accuracy)
+            d = abs(mu * outputs(x + dx0 - dx, th, self.table, self.p, theta_cm).torque - mu0 * t0)
+            ratio = max(ratio, d / env if env > 0.0 else math.inf)
+        self.evidence_ratio = ratio
+        self._over = self._over + 1 if ratio > e.evidence_threshold else 0
+        self.evidence = self._over >= e.evidence_confirm or (self.evidence and ratio > e.evidence_release)
+        return self.evidence
 
     # --- prediction ----------------------------------------------------------------------------
     def _parts(self, w_engine: float, w_disc: float, clamped: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -384,6 +528,7 @@ class ClutchEkf:
         if not launching or abs(w_slip_rad_s) < e.slip_min_rad_s:
             return False
         h0 = self.model_torque(x_meas_m)
+        off = float(self.s[IX_OFF])
         mask = np.zeros(N_STATE, dtype=bool)
         if e.touch_torque_min_Nm <= h0 <= e.touch_torque_max_Nm:
             mask[IX_DX] = True
@@ -391,6 +536,7 @@ class ClutchEkf:
             mask[IX_MU] = True
         if not mask.any():
             return False
+        mask[IX_OFF] = True
         if e.temperature_update and h0 >= e.theta_torque_min_Nm:
             mask[:N_T] = True
             mask[IX_HEAT] = e.heat_scale_sd > 0.0
@@ -402,17 +548,20 @@ class ClutchEkf:
             hrow[i] = (self.model_torque(x_meas_m, sp) - h0) / d
         hrow[F2] = hrow[F1]                   # the stack grows with the facings' mean: both enter alike
         hrow[IX_MU] = h0 / max(self.mu_scale, 1e-6)
+        hrow[IX_OFF] = 1.0
         r = (e.torque_sd_Nm if torque_sd_Nm is None else torque_sd_Nm) ** 2
         s_inn = float(hrow @ self.P @ hrow) + r
-        nu = torque_meas_Nm - h0
+        nu = torque_meas_Nm - h0 - off
         if nu * nu > e.gate_sd ** 2 * s_inn:
             self.rejected += 1
             return False
         k = self.P @ hrow / s_inn
         k[~mask] = 0.0
         self.s = self.s + k * nu
-        self.s[IX_LOSS:] = np.clip(self.s[IX_LOSS:], e.scale_min, e.scale_max)
+        self.s[IX_LOSS:IX_HEAT + 1] = np.clip(self.s[IX_LOSS:IX_HEAT + 1], e.scale_min, e.scale_max)
         ikh = np.eye(N_STATE) - np.outer(k, hrow)
         self.P = ikh @ self.P @ ikh.T + r * np.outer(k, k)
         self.accepted += 1
+        if mask[IX_DX] or mask[IX_MU]:
+            self.update_evidence()
         return True

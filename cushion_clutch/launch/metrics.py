@@ -25,6 +25,10 @@ Each metric measures one cause (SI units unless a name says otherwise):
     Peak-to-peak vehicle acceleration in the :data:`SHUFFLE_WINDOW_S` after
     lock-up (driveline shuffle; it includes any acceleration trend there).
 
+``protection_level``
+    The level of the TCU's thermal protection the launch ran at, decided at its start (0 ok,
+    1 warn, 2 limit, 3 inhibited: no launch; :mod:`.protection`).
+
 ``peak_theta_cm_degC``, ``peak_theta_cs_degC``, ``beyond_tables_s``, ``above_damage_s``
     Where the plant model leaves what it knows (issue 28; :func:`temperature_metrics`, from the
     recorded time series): the peak facing and cushion-spring temperatures, the time with
@@ -45,7 +49,8 @@ METRIC_COLUMNS = ("tcu", "launch", "demand_level", "theta_cs_start_degC", "chara
                   "characteristic_error_max_Nm", "tracking_error_rms_Nm", "tracking_error_max_Nm",
                   "creep_error_Nm", "lockup_accel_step_m_s2", "shuffle_amplitude_m_s2", "kiss_point_error_mm",
                   "engagement_time_s", "slip_energy_kJ", "peak_jerk_m_s3", "engine_stall", "theta_cs_error_K",
-                  "hot", "phase", "peak_theta_cm_degC", "peak_theta_cs_degC", "beyond_tables_s", "above_damage_s")
+                  "hot", "phase", "protection_level", "peak_theta_cm_degC", "peak_theta_cs_degC",
+                  "beyond_tables_s", "above_damage_s")
 #: the temperature columns added by temperature_metrics
 TEMPERATURE_COLUMNS = METRIC_COLUMNS[-4:]
 #: demand up to which the creep error is taken, N.m
@@ -81,7 +86,7 @@ class LaunchRecord:
 
     __slots__ = ("launch", "cool", "lock_time", "stall", "slip_J", "n_err", "sq_err", "max_err", "jerk",
                  "n_ch", "sq_ch", "max_ch", "n_creep", "sum_creep", "kiss_err", "theta_cs", "theta_err",
-                 "a_filt", "alpha", "h", "started", "acc", "t_first", "window", "level")
+                 "a_filt", "alpha", "h", "started", "acc", "t_first", "window", "level", "protection")
 
     def __init__(self, launch: int, cool: bool, h: float, level: str = ""):
         self.launch, self.cool, self.h, self.level = launch, cool, h, level
@@ -99,6 +104,8 @@ class LaunchRecord:
         self.started = False
         self.acc: list[float] = []
         self.t_first = math.nan
+        #: the thermal-protection level the launch ran at (0 ok ... 3 inhibited, .protection)
+        self.protection = 0
 
     def start(self, kiss_err_m: float, theta_cs_K: float, theta_err_K: float) -> None:
         """At the first engaged step: the TCU's kiss-point and temperature errors."""
@@ -173,6 +180,7 @@ class LaunchRecord:
             "theta_cs_error_K": self.theta_err if self.theta_err is not None else nan,
             "hot": bool(theta >= hot_degC),
             "phase": "cool-down" if self.cool else "repeated",
+            "protection_level": self.protection,
         }
 
 

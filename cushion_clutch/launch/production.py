@@ -31,13 +31,18 @@ production TCU measures the clutch torque otherwise).
 from __future__ import annotations
 
 import copy
+import math
+from dataclasses import dataclass
 from collections import deque
+from pathlib import Path
 
 from ..model import ClutchParameters, SpringTable, x_to_for_torque
-from .ekf import ClutchEkf, EkfParams, TcuNetworkParams
+from .ekf import IX_DX, ClutchEkf, EkfParams, TcuNetworkParams
 from .mass_grade import MassGrade, MassGradeEstimator
 from .sensors import ProductionSensors, TcuSensors
+from .store import AdaptedState, load_state, save_state
 from .tcu import LAUNCH, OPEN, TcuController, Variant
+from .touchpoint import StandstillResult, learn_touch_point
 
 #: TCU periods over which speeds are differentiated
 WINDOW = 5
@@ -76,6 +81,8 @@ class ProductionTcu(TcuController):
         self.w_prev = (0.0, 0.0)
         self.hist: deque = deque(maxlen=WINDOW + 1)     # (w_e, w_v, T_est, x_meas)
         self.x_offset = sensors.position_offset_m
+        self._closed_key: tuple = ()
+        self._closed_value = 0.0
         super().__init__(variant, sc, table, p, theta0, self.rls.inertia_at_disc_kg_m2(),
                          self.rls.holding_torque_Nm(), j_e_kg_m2, w_idle_rad_s)
 
@@ -92,17 +99,27 @@ class ProductionTcu(TcuController):
 
     def kiss(self) -> float:
         """The kiss point the TCU believes, in the true bearing frame, m."""
-        return self.model_kiss(self.ekf.theta_cs) + self.ekf.dx_kiss - self.x_offset
+        return self.model_kiss(self.ekf.theta_cs) + self.ekf.dx_used - self.x_offset
 
     def command(self, torque_Nm: float) -> float:
         """Bearing position for ``torque_Nm`` (N.m) as the position sensor reads it, m."""
         th = min(max(self.ekf.theta_cs, self.table.theta_min_K), self.table.theta_max_K)
         return (x_to_for_torque(torque_Nm / max(self.ekf.mu_used, 1e-3), th, self.table, self.p,
-                                theta_cm=self.theta_cm_used()) + self.ekf.dx_kiss)
+                                theta_cm=self.theta_cm_used()) + self.ekf.dx_used)
 
     def model_torque(self, x_m: float) -> float:
-        """Torque the TCU believes at the true bearing position ``x_m`` (it sees it through its sensor), N.m."""
-        return self.ekf.model_torque(x_m + self.x_offset, mu=self.ekf.mu_used)
+        """Torque the TCU believes at the true bearing position ``x_m`` (it sees it through its sensor), N.m.
+
+        The value at the closed position (asked every launch cycle for the capacity limit) is kept
+        until the EKF's estimate changes (every ``ekf.period_s`` at most).
+        """
+        e = self.ekf
+        if x_m == self.sc.tcu.x_to_closed_m:
+            key = (e.theta_cs, e.theta_cm, e.dx_used, e.mu_used)
+            if key != self._closed_key:
+                self._closed_key, self._closed_value = key, e.used_torque(x_m + self.x_offset)
+            return self._closed_value
+        return e.used_torque(x_m + self.x_offset)
 
     # --- sensing -------------------------------------------------------------------------------------
     def sense(self, t: float, w_engine: float, w_disc: float, engine_torque_Nm: float) -> None:
@@ -149,7 +166,7 @@ class ProductionTcu(TcuController):
             e.predict(w_e, w_d, True)
             if launching:
                 e.correct(t_c, x_mean, slip, True)
-                if self.rls.ready()[1] and h1[1] > 0.0 and h0[1] > 0.0:
+                if all(self.rls.ready()) and h1[1] > 0.0 and h0[1] > 0.0:    # mass and load both estimated
                     t_vehicle = self.rls.inertia_at_disc_kg_m2() * (h1[1] - h0[1]) / span \
                         + self.rls.holding_torque_Nm()
                     e.correct(t_vehicle, x_mean, slip, True, VEHICLE_TORQUE_SD_NM)
@@ -169,3 +186,65 @@ class ProductionTcu(TcuController):
         super().cycle(launch, tl, locked_once, w_e_m, w_d_m, x_m, theta_cm_true, t_est, level, w_d_m)
         if self.x_cmd != 0.0:
             self.x_cmd -= self.x_offset
+
+    # --- key-on and key-off ----------------------------------------------------------------------
+    def adapted_state(self, starts_since_standstill: int, touch_point_learned: bool) -> AdaptedState:
+        """What the TCU stores at key-off: the characteristic it applies and its thermal scales."""
+        e = self.ekf
+        sd = math.sqrt(max(float(e.P[IX_DX, IX_DX]), 0.0)) if e.evidence else e.x_accuracy
+        return AdaptedState(e.dx_used, min(max(sd, 1e-6), 0.009), e.mu_scale if e.evidence else e.mu_prior,
+                            e.loss_scale, e.heat_scale, touch_point_learned, starts_since_standstill)
+
+
+@dataclass
+class KeyOn:
+    """How the production TCU started: ``start`` ("reset" or "learned: <file>"), the standstill learning
+    (None if not run) and the key-ons since the last standstill learning (this one counted)."""
+
+    start: str
+    standstill: StandstillResult | None
+    starts_since_standstill: int
+    touch_point_learned: bool
+
+
+def key_on(ctl: ProductionTcu, sc, fmu: Path, clutch_start: dict[str, float], j_disc_kg_m2: float,
+           w_idle_rad_s: float) -> KeyOn:
+    """Load the stored state (``[tcu_store]``) and learn the touch point at standstill when due (``[standstill]``).
+
+    A reset TCU has no stored touch point: with ``standstill.learn = "missing"`` it learns it now; a
+    learned one relearns once ``standstill.interval_starts`` key-ons have passed.
+    """
+    st, store = sc.standstill, sc.tcu_store
+    state = AdaptedState()
+    start = "reset"
+    if store.start == "learned":
+        path = Path(store.file)
+        path = path if path.is_absolute() else Path(sc.folder or ".") / path
+        state = load_state(path)
+        start = f"learned: {path.name}"
+        ctl.ekf.set_prior(state.dx_kiss_m, state.dx_kiss_sd_m if state.dx_kiss_sd_m == state.dx_kiss_sd_m
+                          else sc.ekf.kiss_sd_m, state.mu_scale, state.loss_scale, state.heat_scale)
+    since = state.starts_since_standstill + 1
+    due = st.learn == "always" or (st.learn == "missing" and (not state.touch_point_learned
+                                                               or since > st.interval_starts))
+    result = None
+    learned = state.touch_point_learned
+    if due:
+        e = ctl.ekf
+        result = learn_touch_point(fmu, clutch_start, st, sc.tcu_sensors, ctl.table, ctl.p, e.theta_cs, e.theta_cm,
+                                   e.dx_used, j_disc_kg_m2, w_idle_rad_s, sc.tcu.period_s,
+                                   sc.tcu.actuator_time_constant_s, sc.run.step_s)
+        if result.ok:
+            e.set_prior(result.dx_kiss_m, st.accuracy_m, e.mu_prior, e.loss_scale, e.heat_scale)
+            since, learned = 0, True
+    ctl.kiss_now = ctl.kiss()
+    return KeyOn(start, result, since, learned)
+
+
+def key_off(ctl: ProductionTcu, sc, k: KeyOn) -> Path | None:
+    """Write the adapted state to ``tcu_store.save`` (relative to the scenario's folder); its path or None."""
+    if not sc.tcu_store.save:
+        return None
+    path = Path(sc.tcu_store.save)
+    path = path if path.is_absolute() else Path(sc.folder or ".") / path
+    return save_state(ctl.adapted_state(k.starts_since_standstill, k.touch_point_learned), path)

@@ -6,7 +6,9 @@ import math
 from pathlib import Path
 from typing import Callable, Iterable
 
-from ..model import ClutchParameters, SpringTable
+import numpy as np
+
+from ..model import KELVIN, ClutchParameters, SpringTable
 from .metrics import METRIC_COLUMNS, SUMMARY, add_temperature_metrics, summarise
 from .scenario import Scenario
 from .simulate import COLUMNS, LaunchResult, simulate_launches
@@ -37,15 +39,46 @@ def run_both(fmu: Path, sc: Scenario, table: SpringTable,
     return run_all(fmu, sc, table, ("naive", "aware"), progress)
 
 
+def peaks(res: LaunchResult) -> dict:
+    """The plant's peak facing and cushion-spring temperatures and the TCU's peak facing estimate over the
+    run (degC, from the recorded time series), the launches the thermal protection inhibited, and how a
+    production TCU started (``tcu_start``: reset or learned; its standstill touch-point error, um)."""
+    s = res.series
+    est = s["theta_cm_tcu_K"]
+    ko = res.key_on
+    ss = ko.standstill if ko is not None else None
+    return {"plant_theta_cm_peak_degC": float(s["theta_cm_K"].max()) - KELVIN,
+            "plant_theta_cs_peak_degC": float(s["theta_cs_K"].max()) - KELVIN,
+            "tcu_theta_cm_peak_degC": (float(np.nanmax(est)) - KELVIN) if np.isfinite(est).any() else math.nan,
+            "inhibited_launches": sum(m["protection_level"] >= 3 for m in res.metrics),
+            "tcu_start": ko.start if ko is not None else "",
+            "standstill_kiss_error_um": (ss.kiss_error_m * 1e6 if ss is not None and ss.ok else math.nan)}
+
+
 def summary_rows(results: dict[str, LaunchResult]) -> list[dict]:
-    """One row per group with launches and TCU variant: mean and worst of the summarised metrics."""
+    """One row per group with launches and TCU variant: mean and worst of the summarised metrics, and the
+    run's :func:`peaks`."""
     rows = []
     for group, select in GROUPS:
         for name, res in results.items():
             s = summarise(res.metrics, select)
             if s["n"]:
-                rows.append({"group": group, "tcu": name, **s})
+                rows.append({"group": group, "tcu": name, **s, **peaks(res)})
     return rows
+
+
+def peak_lines(results: dict[str, LaunchResult]) -> str:
+    """One line per TCU: the plant's peak temperatures, the TCU's peak estimate, protection and key-on."""
+    out = []
+    for name, res in results.items():
+        k = peaks(res)
+        line = (f"{name}: plant peak theta_cm {k['plant_theta_cm_peak_degC']:.0f} degC, theta_cs "
+                f"{k['plant_theta_cs_peak_degC']:.0f} degC; TCU's facing estimate peak "
+                f"{_f(k['tcu_theta_cm_peak_degC'], '.0f')} degC; {k['inhibited_launches']} launches inhibited")
+        if k["tcu_start"]:
+            line += f"; started {k['tcu_start']}, standstill touch point {_f(k['standstill_kiss_error_um'], '.1f')} um off"
+        out.append(line)
+    return "\n".join(out)
 
 
 def write_outputs(results: dict[str, LaunchResult], out: Path) -> list[Path]:

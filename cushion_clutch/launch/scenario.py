@@ -13,8 +13,9 @@ from ..data import DEFAULT_SCENARIO
 from ..errors import ParameterError
 from .ekf import EkfParams, TcuNetworkParams
 from .mass_grade import MassGrade
+from .protection import Protection
 from .sensors import ProductionSensors
-from .tcu_params import Adaptation, Observer, Sensors
+from .tcu_params import Adaptation, Observer, Sensors, Standstill, TcuStore
 from .thermal_network import PlantThermal
 
 
@@ -303,6 +304,9 @@ class Scenario(Checked):
     tcu_thermal: TcuNetworkParams = field(default_factory=TcuNetworkParams)
     ekf: EkfParams = field(default_factory=EkfParams)
     mass_grade: MassGrade = field(default_factory=MassGrade)
+    standstill: Standstill = field(default_factory=Standstill)
+    tcu_store: TcuStore = field(default_factory=TcuStore)
+    protection: Protection = field(default_factory=Protection)
     folder: str = ""
     """folder of the scenario file (set by :func:`load_scenario`), for relative file names"""
 

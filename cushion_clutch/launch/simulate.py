@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable
 
@@ -36,7 +36,7 @@ from .metrics import LaunchRecord
 from .observer import SpeedSensors
 from .scenario import Scenario
 from .engine import RPM
-from .production import ProductionTcu
+from .production import KeyOn, ProductionTcu, key_off, key_on
 from .tcu import CLOSE, LAUNCH, OPEN, PREFILL, VARIANTS, TcuController
 from .thermal import FacingModel
 from .thermal_network import ThermalNetwork
@@ -50,9 +50,10 @@ X_RETRACTED_M = 1e-6
 COLUMNS = ("time_s", "launch", "w_engine_rad_s", "w_disc_rad_s", "v_m_s", "accel_m_s2", "x_cmd_m",
            "x_to_m", "torque_demand_Nm", "torque_capacity_Nm", "torque_clutch_Nm", "theta_cm_K",
            "theta_cs_K", "theta_cs_tcu_K", "x_kiss_m", "x_kiss_tcu_m", "throttle", "locked", "theta_cm_tcu_K",
-           "torque_believed_Nm", "torque_shaft_Nm", "theta_surface_K", "theta_pressure_plate_K")
+           "torque_believed_Nm", "torque_shaft_Nm", "theta_surface_K", "theta_pressure_plate_K", "protection_level")
 #: theta_surface_K: the hotter metal friction surface (1 mm layer), theta_pressure_plate_K: the pressure plate's
-#: bulk node, both from the plant's thermal network (NaN with the lumped facing or a prescribed profile)
+#: bulk node, both from the plant's thermal network (NaN with the lumped facing or a prescribed profile);
+#: protection_level: the TCU's thermal protection (0 ok, 1 warn, 2 limit, 3 inhibited)
 
 
 @dataclass
@@ -71,6 +72,10 @@ class LaunchResult:
     kiss_estimates: list[tuple[int, float]]
     quiet_s: float = 0.0
     """simulated time advanced in quiet steps (``run.quiet_steps``), s"""
+    key_on: KeyOn | None = None
+    """production TCU: how it started (reset or learned) and its standstill touch-point learning"""
+    protection_events: list = field(default_factory=list)
+    """(s into the launch slot, launch, level, message): what the thermal protection told the driver"""
 
 
 def _facing_profile(path: str) -> Callable[[float], float]:
@@ -127,9 +132,11 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
     r_to_disc = dl.i_tot / dl.r
     prefill, drive_end = tc.prefill_s, tc.prefill_s + tc.drive_time_s
 
-    clutch = ClutchFmu(fmu, {"theta_a": theta_a, "theta_cs_start": theta0,
-                             "x_kiss_ref": p.x_kiss_ref + sc.clutch.x_kiss_offset_m,
-                             **({"facing_wear": sc.clutch.facing_wear_m} if sc.clutch.facing_wear_m else {})})
+    clutch_start = {"theta_a": theta_a, "theta_cs_start": theta0, "x_kiss_ref": p.x_kiss_ref + sc.clutch.x_kiss_offset_m,
+                    **({"facing_wear": sc.clutch.facing_wear_m} if sc.clutch.facing_wear_m else {})}
+    keyed = (key_on(ctl, sc, fmu, clutch_start, sc.driveline.disc_inertia_kg_m2, engine.w_idle)
+             if name == "production" else None)
+    clutch = ClutchFmu(fmu, clutch_start)
     theta_cm = theta0
     x_act = 0.0
     theta_cs, x_kiss = theta0, p.x_kiss_ref
@@ -169,15 +176,22 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
             cycled = countdown == 0
             if cycled:                                           # -- TCU cycle
                 countdown = tcu_every
-                if sense is not None:                             # production TCU: its own sensors
-                    sense(t, dl.w_e, dl.w_d, t_e)
-                ctl.cycle(n + 1, tl, rec.lock_time is not None, sensors.read(dl.w_e), sensors.read(dl.w_d),
-                          x_act, theta_cm, t_e, levels[n], sensors.read(dl.v * r_to_disc))
+                if sense is not None:         # production TCU: its own speed sensors, read from the truth given;
+                    sense(t, dl.w_e, dl.w_d, t_e)                 # the wheel speed as the others read it (ABS)
+                    ctl.cycle(n + 1, tl, rec.lock_time is not None, dl.w_e, dl.w_d, x_act, theta_cm, t_e, levels[n],
+                              sensors.read(dl.v * r_to_disc))
+                else:
+                    ctl.cycle(n + 1, tl, rec.lock_time is not None, sensors.read(dl.w_e), sensors.read(dl.w_d),
+                              x_act, theta_cm, t_e, levels[n], sensors.read(dl.v * r_to_disc))
                 phase = ctl.phase
                 engaged = phase == LAUNCH or phase == CLOSE
                 launching = phase == LAUNCH
                 sampling = (launching or phase == PREFILL) and rec.lock_time is None
-                braking = not engaged and tl >= drive_end
+                braking = not engaged and (tl >= drive_end or ctl.inhibited)   # inhibited: the driver brakes
+                if ctl.launch_level != rec.protection:
+                    rec.protection = ctl.launch_level
+                    if ctl.inhibited and not rec.started:          # an inhibited launch: its start state
+                        rec.start(ctl.kiss_now - x_kiss, theta_cs, ctl.theta_now - theta_cs)
             if (quiet and cycled and braking and ctl.phase == OPEN and ctl.x_cmd == 0.0 and t_cap == 0.0
                     and -X_RETRACTED_M < x_act < X_RETRACTED_M and not stalled and not dl.locked and dl.v == 0.0
                     and dl.w_d == 0.0 and dl.phi == 0.0 and k + tcu_every <= n_steps
@@ -210,7 +224,8 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
                         rec_countdown = record_every
                         rows.append((t + j * h, n + 1, dl.w_e, 0.0, 0.0, 0.0, 0.0, x_act, 0.0, 0.0, 0.0,
                                      theta_cm_step, theta_cs, ctl.theta_now, x_kiss, ctl.kiss_now, engine.throttle,
-                                     0.0, ctl.theta_cm_estimate(), math.nan, 0.0, *net_temps()))
+                                     0.0, ctl.theta_cm_estimate(), math.nan, 0.0, *net_temps(),
+                                     ctl.protection.level if ctl.protection is not None else 0.0))
                         if progress is not None and (k + j) % 10000 == 0:
                             progress(t + j * h)
                     rec_countdown -= 1
@@ -271,7 +286,8 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
                              ctl.t_dem + ctl.t_rate * (tcu_every - countdown) * h, t_cap, dl.t_c, theta_cm_step,
                              theta_cs, ctl.theta_now, x_kiss, ctl.kiss_now, engine.throttle, float(dl.locked),
                              ctl.theta_cm_estimate(), believed if sampling else math.nan,
-                             dl.k * dl.phi + dl.c * (dl.w_d - dl.v * dl.i_tot / dl.r), *net_temps()))
+                             dl.k * dl.phi + dl.c * (dl.w_d - dl.v * dl.i_tot / dl.r), *net_temps(),
+                             ctl.protection.level if ctl.protection is not None else 0.0))
                 if progress is not None and k % 10000 == 0:
                     progress(t)
             rec_countdown -= 1
@@ -284,4 +300,7 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
     series = np.array(rows, dtype=[(c, float) for c in COLUMNS])
     metrics = [r.metrics(run.hot_degC) for r in recs]
     learned = ctl.learner.estimates if ctl.learner is not None else []
-    return LaunchResult(name, series, metrics, dl.en, events, wall, total, cpu, learned, n_quiet * h_quiet)
+    if keyed is not None:
+        key_off(ctl, sc, keyed)
+    return LaunchResult(name, series, metrics, dl.en, events, wall, total, cpu, learned, n_quiet * h_quiet, keyed,
+                        ctl.protection.events if ctl.protection is not None else [])

@@ -55,6 +55,7 @@ from dataclasses import dataclass
 from ..model import KELVIN, ClutchParameters, SpringTable, kiss_point, outputs, thermal_step, x_to_for_torque
 from .adaptation import KissLearner
 from .observer import FacingObserver
+from .protection import LIMIT, ThermalProtection
 from .scenario import Scenario
 
 
@@ -128,6 +129,12 @@ class TcuController:
         self.t_closed = math.inf
         self._kiss_key: tuple = ()
         self._kiss_value = math.nan
+        #: thermal protection by the facing-temperature estimate (:mod:`.protection`), TCUs that have one
+        self.protection = (ThermalProtection(sc.protection)
+                           if sc.protection.enabled and variant.temperature != "none" else None)
+        self.inhibited = self.limited = False
+        #: the protection level the current launch runs at (decided at its start; 3: inhibited)
+        self.launch_level = 0
         #: the assumed theta_cs (K) and believed kiss point (m) after the last cycle
         self.theta_now, self.kiss_now = self.theta_used(), self.kiss()
 
@@ -146,6 +153,10 @@ class TcuController:
     def theta_cm_estimate(self) -> float:
         """The observer's facing temperature, K (NaN without an observer)."""
         return self.observer.theta_cm if self.observer is not None else float("nan")
+
+    def theta_facing_protect(self) -> float:
+        """The facing temperature the thermal protection acts on (the TCU's estimate; ``aware``: the true), K."""
+        return self.theta_cm_ideal if self.v.temperature == "ideal" else self.theta_cm_estimate()
 
     def theta_cm_used(self) -> float | None:
         """The facing temperature the TCU's clutch model assumes (the stack's growth), K; None: theta_cs."""
@@ -216,7 +227,10 @@ class TcuController:
             return t_lock - ds / k + kp * e + self.integral
         if level == "creep":
             return drv.creep_torque_Nm
-        w_t = self.w_idle + drv.pedal(level) * (tc.engine_speed_full_pedal_rpm * math.pi / 30.0 - self.w_idle)
+        full = tc.engine_speed_full_pedal_rpm
+        if self.limited:                                  # slip energy limited (decided at the launch's start)
+            full = min(full, self.protection.p.limit_engine_speed_rpm)
+        w_t = self.w_idle + drv.pedal(level) * (full * math.pi / 30.0 - self.w_idle)
         dw = (w_t - self.w_ref) / tc.engine_speed_time_constant_s
         self.w_ref += dw * dt
         e = w_e - self.w_ref
@@ -237,6 +251,7 @@ class TcuController:
         measured wheel speed at the disc (rad/s, the kiss-point learner's input; default ``w_d``).
         """
         tc = self.sc.tcu
+        prot = self.protection
         if self.v.temperature == "ideal":
             self.theta_ideal = thermal_step(self.theta_ideal, theta_cm_true, self.period, self.p)
             self.theta_cm_ideal = theta_cm_true
@@ -250,6 +265,19 @@ class TcuController:
             self.t_closed = math.inf
             if self.learner is not None:
                 self.learner.start_launch()
+            if prot is not None:
+                self.inhibited = prot.launch_start(self.theta_facing_protect(), tl, launch)
+                # the launch's limit is set at its start: a mid-launch switch of the engine-speed target made the
+                # speed controller pull the engine down (a torque spike of 208 N.m, measured)
+                self.launch_level = prot.update(self.theta_facing_protect(), tl, launch)
+                self.limited = self.launch_level >= LIMIT
+        if prot is not None:
+            prot.update(self.theta_facing_protect(), tl, launch)
+            if self.inhibited:                    # no launch in this slot: the clutch stays open
+                self.phase, self.t_dem, self.t_rate, self.x_cmd = OPEN, 0.0, 0.0, 0.0
+                self.theta_now, self.kiss_now = self.theta_used(), self.kiss()
+                return
+        was_launching = self.phase == LAUNCH
         t_launch = tl - tc.prefill_s
         t_prev = self.t_dem
         if 0.0 <= t_launch < tc.drive_time_s and not locked_once:
@@ -277,4 +305,6 @@ class TcuController:
             self.phase, self.t_dem, self.t_rate, self.x_cmd = OPEN, 0.0, 0.0, 0.0
         if self.phase != LAUNCH:
             self.t_rate = 0.0
+            if was_launching and prot is not None:
+                prot.launch_end(self.theta_facing_protect())
         self.theta_now, self.kiss_now = self.theta_used(), self.kiss()

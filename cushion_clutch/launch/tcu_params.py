@@ -84,3 +84,79 @@ class Adaptation(Checked):
     def _problems(self) -> Iterable[str]:
         yield from self._ranges({"gain": (0.0, 1.0, True), "onset_speed_rad_s": (0.01, 100.0),
                                  "window_s": (1e-3, 1.0)})
+
+
+#: when the production TCU learns its touch point at standstill
+STANDSTILL_LEARN = ("missing", "always", "never")
+
+
+@dataclass(frozen=True)
+class Standstill(Checked):
+    """Section ``[standstill]``: the production TCU's touch-point learning at key-on (:mod:`.touchpoint`).
+
+    Gearbox in neutral, car standing, engine idling: the bearing moves to the believed kiss point less
+    ``start_margin_m`` and then closes at ``ramp_rate_m_per_s`` until the input shaft's Hall sensor
+    reads ``detect_speed_rad_s``; it keeps closing while the shaft spins up to ``fit_speed_rad_s`` and
+    then opens. The shaft's acceleration gives the clutch torque along the way (``J a + drag``: the
+    TCU's ``disc_inertia_kg_m2``, the drag measured in the coast-down after opening), each sample a
+    touch-point offset through the nominal characteristic; their median is the learned value. ``learn``: ``"missing"`` (no stored
+    touch point, or ``interval_starts`` key-ons since the last learning), ``"always"``, ``"never"``.
+    The plant's gearbox drag in neutral is ``plant_drag_Nm + plant_drag_Nm_per_rad_s * w``.
+    """
+
+    learn: str = "missing"
+    interval_starts: int = 20
+    ramp_rate_m_per_s: float = 1e-3
+    start_margin_m: float = 0.5e-3
+    settle_s: float = 0.5
+    detect_speed_rad_s: float = 5.0
+    fit_speed_rad_s: float = 70.0
+    min_torque_Nm: float = 2.0
+    timeout_s: float = 15.0
+    accuracy_m: float = 40e-6
+    """the routine's stated accuracy (its touch point's sd in the EKF), m: measured within 12 um for a
+    drag of 0.5-2.5 N.m and 38 um with the disc inertia 5 % off (tests/test_touchpoint.py)"""
+    disc_inertia_kg_m2: float = 0.03
+    """the TCU's value of the input shaft's inertia in neutral (design data), kg m2"""
+    plant_drag_Nm: float = 1.2
+    plant_drag_Nm_per_rad_s: float = 0.004
+
+    _section = "standstill"
+
+    def _problems(self) -> Iterable[str]:
+        if self.learn not in STANDSTILL_LEARN:
+            yield f"standstill.learn = {self.learn!r}: allowed " + ", ".join(STANDSTILL_LEARN)
+        yield from self._ranges({
+            "interval_starts": (1, 100000), "ramp_rate_m_per_s": (1e-6, 0.01), "start_margin_m": (0.0, 0.005),
+            "settle_s": (0.0, 10.0), "detect_speed_rad_s": (0.5, 200.0), "fit_speed_rad_s": (1.0, 200.0),
+            "min_torque_Nm": (0.0, 100.0), "timeout_s": (0.5, 600.0), "accuracy_m": (1e-7, 1e-3), "disc_inertia_kg_m2": (1e-4, 10.0),
+            "plant_drag_Nm": (0.0, 100.0), "plant_drag_Nm_per_rad_s": (0.0, 10.0)})
+        yield from self._integers("interval_starts")
+        if self.fit_speed_rad_s <= self.detect_speed_rad_s:
+            yield "standstill.fit_speed_rad_s: must exceed standstill.detect_speed_rad_s"
+
+
+#: how the production TCU starts a run
+STORE_START = ("reset", "learned")
+
+
+@dataclass(frozen=True)
+class TcuStore(Checked):
+    """Section ``[tcu_store]``: the production TCU's adapted state kept in non-volatile memory (:mod:`.store`).
+
+    ``start = "reset"``: a new or reset TCU (nominal calibration, no stored touch point: it learns at
+    standstill, ``[standstill]``); ``"learned"``: the state in ``file`` (JSON, relative to the
+    scenario's folder). ``save``: write the state at the end of the run there ("" = not).
+    """
+
+    start: str = "reset"
+    file: str = ""
+    save: str = ""
+
+    _section = "tcu_store"
+
+    def _problems(self) -> Iterable[str]:
+        if self.start not in STORE_START:
+            yield f"tcu_store.start = {self.start!r}: allowed " + ", ".join(STORE_START)
+        if self.start == "learned" and not self.file:
+            yield "tcu_store.file: must name the stored state when tcu_store.start = \"learned\""

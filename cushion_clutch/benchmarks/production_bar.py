@@ -1,0 +1,80 @@
+"""Issue 26's bar for the production TCU: every shipped scenario, naive and production, from the launch metrics.
+
+    python -m cushion_clutch.benchmarks.production_bar [--scenarios default,cooldown,...] [--repeat N]
+
+Per scenario: production's worst characteristic error over all launches (the first included; target
+<= 7.2 N.m, 3 % of the engine's 240 N.m peak) and over the hot launches, naive's, every launch starting
+below 40 degC where production is more than 0.5 N.m worse than naive (target: none), the largest
+|theta_cs error| at a launch start, how the production TCU started (reset / learned; its standstill
+touch-point error), the plant's peak temperatures and the CPU-time real-time factors (median of
+``--repeat`` runs). Machines are noisy: compare the factors of one run.
+"""
+from __future__ import annotations
+
+import argparse
+import math
+import statistics
+import tempfile
+from pathlib import Path
+
+SHIPPED = ("default", "cooldown", "creep", "fade", "wear", "wear_learned", "tolerance", "protection")
+
+
+def bar(name: str, repeat: int = 1) -> dict:
+    """Run ``name`` with the naive and the production TCU; the bar's figures."""
+    from cushion_clutch.data import DEFAULT_TABLES
+    from cushion_clutch.launch.plant import build_plant_fmu
+    from cushion_clutch.launch.report import peaks
+    from cushion_clutch.launch.scenario import load_scenario, scenario_path
+    from cushion_clutch.launch.simulate import simulate_launches
+    from cushion_clutch.model import load_table
+
+    sc = load_scenario(scenario_path(name))
+    tables = Path(DEFAULT_TABLES)
+    table = load_table(sc.tables_path("tcu") or tables)
+    with tempfile.TemporaryDirectory() as tmp:
+        fmu = build_plant_fmu(tables, sc, Path(tmp) / "CushionClutch.fmu")
+        res, rtf = {}, {}
+        for v in ("naive", "production"):
+            runs = [simulate_launches(fmu, sc, table, v) for _ in range(repeat)]
+            res[v] = runs[0]
+            rtf[v] = statistics.median(r.sim_time_s / r.cpu_time_s for r in runs)
+    n, p = res["naive"].metrics, res["production"].metrics
+    ch = "characteristic_error_max_Nm"
+    valid = [m for m in p if not math.isnan(m[ch])]
+    cold = [(m["launch"], m[ch], a[ch]) for m, a in zip(p, n)
+            if m["theta_cs_start_degC"] < 40.0 and not math.isnan(m[ch])]
+    return {"scenario": name, "n": len(p),
+            "prod_all": max(m[ch] for m in valid),
+            "prod_hot": max((m[ch] for m in valid if m["hot"]), default=math.nan),
+            "naive_all": max(m[ch] for m in n if not math.isnan(m[ch])),
+            "naive_hot": max((m[ch] for m in n if m["hot"] and not math.isnan(m[ch])), default=math.nan),
+            "cold": cold, "cold_fail": [c for c in cold if c[1] > c[2] + 0.5],
+            "theta_err": max(abs(m["theta_cs_error_K"]) for m in p if not math.isnan(m["theta_cs_error_K"])),
+            "rtf_naive": rtf["naive"], "rtf_prod": rtf["production"],
+            **{f"prod_{k}": v for k, v in peaks(res["production"]).items()},
+            "naive_theta_cm_peak_degC": peaks(res["naive"])["plant_theta_cm_peak_degC"]}
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--scenarios", default=",".join(SHIPPED))
+    ap.add_argument("--repeat", type=int, default=1)
+    a = ap.parse_args()
+    print("| scenario | launches | production worst, all | production worst, hot | naive worst, all | naive worst, hot "
+          "| launches < 40 degC: production / naive | bar | max abs theta_cs error at a start [K] | start, standstill "
+          "error [um] | plant peak theta_cm / theta_cs [degC] (naive's theta_cm) | RTF naive / production (CPU) |")
+    print("|" + "---|" * 12)
+    for name in a.scenarios.split(","):
+        b = bar(name, a.repeat)
+        ok = b["prod_all"] <= 7.2 and not b["cold_fail"]
+        cold = ", ".join(f"L{k}: {x:.2f} / {y:.2f}" for k, x, y in b["cold"]) or "–"
+        print(f"| {name} | {b['n']} | {b['prod_all']:.2f} | {b['prod_hot']:.2f} | {b['naive_all']:.2f} | "
+              f"{b['naive_hot']:.2f} | {cold} | {'met' if ok else 'MISSED'} | {b['theta_err']:.1f} | "
+              f"{b['prod_tcu_start']}, {b['prod_standstill_kiss_error_um']:.1f} | "
+              f"{b['prod_plant_theta_cm_peak_degC']:.0f} / {b['prod_plant_theta_cs_peak_degC']:.0f} "
+              f"({b['naive_theta_cm_peak_degC']:.0f}) | {b['rtf_naive']:.0f} / {b['rtf_prod']:.0f} |", flush=True)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,79 @@
+"""Thermal protection: its levels on the facing-temperature estimate, and on a heavy-duty launch run."""
+import dataclasses
+
+import numpy as np
+import pytest
+
+from cushion_clutch.errors import ParameterError
+from cushion_clutch.launch.protection import INHIBIT, LIMIT, OK, WARN, Protection, ThermalProtection
+from cushion_clutch.model import KELVIN
+
+
+def k(deg):
+    return deg + KELVIN
+
+
+def test_levels_rise_with_the_estimate_and_fall_with_hysteresis():
+    p = ThermalProtection(Protection())
+    assert p.update(k(200.0), 0.0, 1) == OK
+    assert p.update(k(255.0), 0.1, 1) == WARN
+    assert p.update(k(285.0), 0.2, 1) == LIMIT
+    assert p.update(k(275.0), 0.3, 1) == LIMIT          # within the 10 K hysteresis
+    assert p.update(k(265.0), 0.4, 1) == WARN
+    assert p.update(k(239.0), 0.5, 1) == OK
+    assert [e[2] for e in p.events] == [WARN, LIMIT, WARN, OK]
+    assert "hot" in p.events[0][3]                       # the driver is told
+
+
+def test_a_launch_is_inhibited_until_the_clutch_has_cooled():
+    p = ThermalProtection(Protection())
+    assert not p.launch_start(k(300.0), 0.0, 1)
+    p.launch_end(k(330.0))                               # this launch raised the estimate by 30 K
+    assert p.launch_start(k(312.0), 0.0, 2)              # above inhibit_degC
+    assert p.level == INHIBIT
+    assert p.update(k(200.0), 1.0, 2) == INHIBIT         # holds for the whole launch slot
+    assert p.launch_start(k(260.0), 0.0, 3)              # not yet below resume_degC
+    assert not p.launch_start(k(245.0), 0.0, 4) and p.level in (OK, WARN)
+
+
+def test_the_next_launch_rise_counts():
+    p = ThermalProtection(Protection())
+    p.launch_start(k(200.0), 0.0, 1)
+    p.launch_end(k(260.0))                               # +60 K in one launch
+    assert p.launch_start(k(295.0), 0.0, 2)              # 295 + 60 reaches the 350 degC damage limit
+
+
+def test_thresholds_are_checked():
+    with pytest.raises(ParameterError) as err:
+        Protection(warn_degC=300.0, limit_degC=280.0)
+    assert "warn_degC <= limit_degC" in str(err.value)
+    with pytest.raises(ParameterError, match="resume_degC"):
+        Protection(resume_degC=320.0)
+
+
+@pytest.mark.fmu
+def test_protected_tcus_keep_their_estimate_below_the_damage_limit(tmp_path):
+    """The protection scenario with every threshold lowered (a short run reaches them)."""
+    from cushion_clutch.data import DEFAULT_TABLES
+    from cushion_clutch.fmu.build import build_fmu
+    from cushion_clutch.launch.scenario import load_scenario, scenario_path
+    from cushion_clutch.launch.simulate import simulate_launches
+    from cushion_clutch.model import load_table
+
+    fmu = build_fmu(DEFAULT_TABLES, tmp_path / "CushionClutch.fmu")
+    sc = load_scenario(scenario_path("protection"))
+    sc = dataclasses.replace(
+        sc, run=dataclasses.replace(sc.run, launches=7),
+        protection=Protection(enabled=True, warn_degC=60.0, limit_degC=80.0, inhibit_degC=100.0, resume_degC=60.0,
+                              damage_degC=130.0))
+    naive = simulate_launches(fmu, sc, load_table(), "naive")
+    assert naive.series["theta_cm_K"].max() - KELVIN > 130.0          # unprotected: past the (lowered) limit
+    for name in ("production", "aware"):
+        r = simulate_launches(fmu, sc, load_table(), name)
+        est = r.series["theta_cm_tcu_K"] if name == "production" else r.series["theta_cm_K"]
+        assert np.nanmax(est) - KELVIN < 130.0
+        levels = [m["protection_level"] for m in r.metrics]
+        assert max(levels) == INHIBIT and levels[0] == OK
+        limited = [m["slip_energy_kJ"] for m in r.metrics if m["protection_level"] == LIMIT]
+        assert limited and max(limited) < 0.8 * r.metrics[0]["slip_energy_kJ"]
+        assert np.nanmax(r.series["protection_level"]) == INHIBIT

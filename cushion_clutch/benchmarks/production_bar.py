@@ -17,7 +17,7 @@ import statistics
 import tempfile
 from pathlib import Path
 
-SHIPPED = ("default", "cooldown", "creep", "fade", "wear", "wear_learned", "tolerance", "protection")
+SHIPPED = ("default", "trailer", "cooldown", "creep", "fade", "wear", "wear_learned", "tolerance", "protection")
 
 
 def bar(name: str, repeat: int = 1) -> dict:

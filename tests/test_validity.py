@@ -83,7 +83,7 @@ def test_every_input_and_parameter_has_min_max_nominal(get):
 
 def test_bounds_come_from_the_ranges_and_inputs_are_physical():
     b = cm.variable_bounds()
-    assert b["x_to"][:2] == (-0.002, 0.025) and b["theta_cm"][:2] == (200.0, 1000.0)
+    assert b["x_to"][:2] == (-0.002, 0.025) and b["theta_cm"][:2] == (200.0, 800.0)
     assert b["omega_slip"][:2] == (-1500.0, 1500.0)
     for name, (lo, hi, _, _) in cm.ClutchParameters.RANGES.items():
         assert b[name][:2] == (lo, hi)
@@ -96,7 +96,7 @@ def test_stroke_reaches_past_lift_off_at_the_wear_limit(table):
     lim = wear_limit(p.cover, p.lever_ratio, table, p.x_kiss_ref, cm.THETA_MIN_K, cm.THETA_MAX_K)
     g = CoverMap(p.cover, p.lever_ratio)
     latest = max(g.prepare(a, b, lim, table, p.x_kiss_ref).x_lift
-                 for a in temperature_grid(table, 200.0, 1000.0, 100.0) for b in (200.0, 600.0, 1000.0))
+                 for a in temperature_grid(table, 200.0, 800.0, 100.0) for b in (200.0, 600.0, 800.0))
     assert 0.015 < latest <= cm.X_TO_MAX - 0.005
 
 
@@ -105,7 +105,7 @@ def test_stroke_reaches_past_lift_off_at_the_wear_limit(table):
 @pytest.mark.parametrize("variant", VARIANTS, ids=[v[0] for v in VARIANTS])
 def test_celsius_in_a_kelvin_input_is_refused_naming_kelvin(capsys, variant):
     res, log = _run(capsys, variant, {"theta_cm": 100.0})
-    assert "theta_cm = 100" in log and "[200, 1000] K" in log and "in kelvin" in log, log
+    assert "theta_cm = 100" in log and "[200, 800] K" in log and "in kelvin" in log, log
     assert isinstance(res, FMICallException) or np.all(res["torque"] == 0.0)   # refused: never an answer
 
 
@@ -162,7 +162,7 @@ def test_hot_cushion_beyond_the_tables_is_flagged_1(capsys, variant):
 @pytest.mark.parametrize("variant", VARIANTS, ids=[v[0] for v in VARIANTS])
 def test_wear_beyond_the_limit_is_refused_at_initialisation_naming_it(capsys, variant):
     res, log = _run(capsys, variant, {"facing_wear": 0.003})
-    assert "facing_wear = 0.003 m" in log and "the wear limit of this cover is 0.00224" in log, log
+    assert "facing_wear = 0.003 m" in log and "the wear limit of this cover is 0.00233" in log, log
     if variant[0].startswith("native"):        # pythonfmu's wrapper cannot return Error: it refuses every step
         assert isinstance(res, FMICallException) and "ExitInitializationMode" in str(res)
     else:
@@ -198,7 +198,7 @@ def test_api_refuses_celsius_naming_kelvin(table):
     p = ClutchParameters()
     for call in (lambda: outputs(0.008, 100.0, table, p), lambda: thermal_step(300.0, 100.0, 0.1, p),
                  lambda: kiss_point(100.0, table, p), lambda: x_to_for_torque(50.0, 100.0, table, p)):
-        with pytest.raises(ValueError, match=r"= 100.0 K is outside \[200, 1000\] K \(the input is in kelvin"):
+        with pytest.raises(ValueError, match=r"= 100.0 K is outside \[200, 800\] K \(the input is in kelvin"):
             call()
     with pytest.raises(ValueError, match=r"x_to = 0.1 m is outside \[-0.002, 0.025\] m"):
         outputs(0.1, 300.0, table, p)
@@ -207,7 +207,7 @@ def test_api_refuses_celsius_naming_kelvin(table):
 def test_api_refuses_wear_beyond_the_limit(table):
     p = ClutchParameters(facing_wear=0.003)
     for call in (lambda: outputs(0.008, 300.0, table, p), lambda: x_to_for_torque(50.0, 300.0, table, p)):
-        with pytest.raises(ValueError, match="the wear limit of this cover is 0.00224"):
+        with pytest.raises(ValueError, match="the wear limit of this cover is 0.00233"):
             call()
 
 
@@ -239,16 +239,16 @@ def test_default_cover_wear_reserve_and_hump(table):
     assert 0.0005 <= hump <= 0.001                              # the hump mid-way through the reserve
     p = ClutchParameters()
     reserve = wear_reserve(p.cover, p.lever_ratio, table, p.x_kiss_ref, GAIN)
-    assert 0.0015 <= reserve < wear_limit(p.cover, p.lever_ratio, table, p.x_kiss_ref, 200.0, 1000.0)
+    assert 0.0015 <= reserve < wear_limit(p.cover, p.lever_ratio, table, p.x_kiss_ref, 200.0, 800.0)
     assert GAIN * _closed(table, reserve) == pytest.approx(300.0, abs=0.05)
     assert outputs(0.020, 293.15, table, ClutchParameters(facing_wear=0.0015)).torque >= 300.0
 
 
 def test_wear_limit_is_where_the_diaphragm_lets_go(table):
     p = ClutchParameters()
-    lim = wear_limit(p.cover, p.lever_ratio, table, p.x_kiss_ref, 200.0, 1000.0)
-    assert hold_problem(p.cover, p.lever_ratio, table, p.x_kiss_ref, lim, 200.0, 1000.0) is None
-    msg = hold_problem(p.cover, p.lever_ratio, table, p.x_kiss_ref, lim + 2e-7, 200.0, 1000.0)
+    lim = wear_limit(p.cover, p.lever_ratio, table, p.x_kiss_ref, 200.0, 800.0)
+    assert hold_problem(p.cover, p.lever_ratio, table, p.x_kiss_ref, lim, 200.0, 800.0) is None
+    msg = hold_problem(p.cover, p.lever_ratio, table, p.x_kiss_ref, lim + 2e-7, 200.0, 800.0)
     assert msg and f"{lim:.6g} m" in msg
     # a narrower temperature box is never stricter
     assert wear_limit(p.cover, p.lever_ratio, table, p.x_kiss_ref, 293.15, 573.15) >= lim

@@ -92,6 +92,8 @@ def figure(f: dict, path: Path) -> None:
 
 
 def markdown(f: dict, png: Path) -> str:
+    from cushion_clutch.model import clutch_model as cm
+
     p = f["p"]
     today = datetime.date.today().isoformat()
     return "\n".join([
@@ -103,7 +105,7 @@ def markdown(f: dict, png: Path) -> str:
         f"n mu R_eq = {f['gain']:.5f} m).",
         "",
         f"- wear limit (the diaphragm still holds the fully compressed cushion at every temperature pair in "
-        f"[200, 1000] K): **{f['limit'] * 1e3:.3f} mm**",
+        f"[{cm.THETA_MIN_K:g}, {cm.THETA_MAX_K:g}] K): **{f['limit'] * 1e3:.3f} mm**",
         f"- wear reserve (closed capacity at 20 degC >= {f['factor']:g} x {f['engine']:g} N.m = {f['need']:g} N.m): "
         f"**{f['reserve'] * 1e3:.3f} mm**",
         f"- finger bending compliance at the bearing (derived): {f['fingers'] * 1e6:.3f} um/N of the "

@@ -72,12 +72,13 @@ def peak_lines(results: dict[str, LaunchResult]) -> str:
     out = []
     for name, res in results.items():
         k = peaks(res)
-        line = (f"{name}: plant peak theta_cm {k['plant_theta_cm_peak_degC']:.0f} degC, theta_cs "
-                f"{k['plant_theta_cs_peak_degC']:.0f} degC; TCU's facing estimate peak "
-                f"{_f(k['tcu_theta_cm_peak_degC'], '.0f')} degC; {k['inhibited_launches']} launches inhibited")
+        # within 100 columns: the TCU on its own line, then peaks, then (production) how it started
+        out.append(f"{name + ':':<25} peak theta_cm {k['plant_theta_cm_peak_degC']:.0f} degC (TCU's estimate "
+                   f"{_f(k['tcu_theta_cm_peak_degC'], '.0f')}), theta_cs {k['plant_theta_cs_peak_degC']:.0f} degC; "
+                   f"{k['inhibited_launches']} inhibited")
         if k["tcu_start"]:
-            line += f"; started {k['tcu_start']}, standstill touch point {_f(k['standstill_kiss_error_um'], '.1f')} um off"
-        out.append(line)
+            out.append(f"  {name} started {k['tcu_start']}; standstill touch point "
+                       f"{_f(k['standstill_kiss_error_um'], '.1f')} um off")
     return "\n".join(out)
 
 

@@ -11,11 +11,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from fmpy import extract, read_model_description, simulate_fmu
+from fmpy import read_model_description, simulate_fmu
 from fmpy.fmi1 import FMICallException
-from fmpy.fmi2 import FMU2Slave
 from fmpy.validation import validate_fmu
 
+from cushion_clutch.benchmarks.thermal_fmu import CsInstance
 from cushion_clutch.cli import main
 from cushion_clutch.fmu.build import build_fmu
 from cushion_clutch.fmu.thermal_chain import chain_of, node_output
@@ -45,38 +45,9 @@ def fmus():
     thermal_fmus.cache_clear()
 
 
-class Slave:
+def Slave(fmu: Path, start: dict[str, float] | None = None) -> CsInstance:
     """An FMI 2.0 Co-Simulation instance of the thermal FMU, stepped with held inputs."""
-
-    def __init__(self, fmu: Path, start: dict[str, float] | None = None):
-        md = read_model_description(str(fmu))
-        self.vr = {v.name: v.valueReference for v in md.modelVariables}
-        self.unzip = extract(str(fmu))
-        self.s = FMU2Slave(guid=md.guid, unzipDirectory=self.unzip, modelIdentifier=md.coSimulation.modelIdentifier,
-                           instanceName="thermal")
-        self.s.instantiate()
-        try:
-            self.s.setupExperiment(startTime=0.0)
-            if start:
-                self.s.setReal([self.vr[k] for k in start], list(start.values()))
-            self.s.enterInitializationMode()
-            self.s.exitInitializationMode()
-        except FMICallException:
-            self.s.freeInstance()
-            shutil.rmtree(self.unzip, ignore_errors=True)
-            raise
-        self.t = 0.0
-
-    def step(self, h: float, names: list[str], **inputs: float) -> list[float]:
-        self.s.setReal([self.vr[k] for k in inputs], list(inputs.values()))
-        self.s.doStep(self.t, h)
-        self.t += h
-        return self.s.getReal([self.vr[k] for k in names])
-
-    def close(self):
-        self.s.terminate()
-        self.s.freeInstance()
-        shutil.rmtree(self.unzip, ignore_errors=True)
+    return CsInstance(fmu, start, name="thermal")
 
 
 def test_interface_and_validation(fmus):

@@ -24,23 +24,29 @@ from pathlib import Path
 import numpy as np
 
 
-class _Cs:
-    """A Co-Simulation instance of an FMI 2.0 FMU, stepped with held inputs (fmpy)."""
+class CsInstance:
+    """A Co-Simulation instance of an FMI 2.0 FMU, stepped with held inputs (fmpy); the tests use it too."""
 
-    def __init__(self, fmu: Path, start: dict[str, float] | None = None):
+    def __init__(self, fmu: Path, start: dict[str, float] | None = None, name: str = "bench"):
         from fmpy import extract, read_model_description
+        from fmpy.fmi1 import FMICallException
         from fmpy.fmi2 import FMU2Slave
         md = read_model_description(str(fmu))
         self.vr = {v.name: v.valueReference for v in md.modelVariables}
         self.unzip = extract(str(fmu))
         self.s = FMU2Slave(guid=md.guid, unzipDirectory=self.unzip, modelIdentifier=md.coSimulation.modelIdentifier,
-                           instanceName="bench")
+                           instanceName=name)
         self.s.instantiate()
-        self.s.setupExperiment(startTime=0.0)
-        if start:
-            self.s.setReal([self.vr[k] for k in start], list(start.values()))
-        self.s.enterInitializationMode()
-        self.s.exitInitializationMode()
+        try:
+            self.s.setupExperiment(startTime=0.0)
+            if start:
+                self.s.setReal([self.vr[k] for k in start], list(start.values()))
+            self.s.enterInitializationMode()
+            self.s.exitInitializationMode()
+        except FMICallException:             # a refused start: nothing left behind
+            self.s.freeInstance()
+            shutil.rmtree(self.unzip, ignore_errors=True)
+            raise
         self.t = 0.0
 
     def step(self, h: float, names: list[str], **inputs: float) -> list[float]:
@@ -58,7 +64,7 @@ class _Cs:
 def bar_duty(fmu: Path, h: float = 0.01) -> dict[str, float]:
     """The bar's twelve slips: slip energy (J), theta_cm rise (K) and per kJ, and the open steps where
     theta_cm did not fall (count)."""
-    s = _Cs(fmu)
+    s = CsInstance(fmu)
     try:
         theta0 = s.step(0.0, ["theta_cm"], x_to=0.0, omega_slip=0.0, omega_engine=100.0)[0]
         energy, last, not_falling, peak = 0.0, theta0, 0, theta0
@@ -99,7 +105,7 @@ def plant_replay() -> dict[str, float]:
         res = simulate_launches(plain, sc, load_table(), "naive", record_every=1)
         s = res.series
         theta_a, theta0 = sc.facing.ambient_degC + KELVIN, sc.facing.initial_degC + KELVIN
-        f = _Cs(thermal, {"theta_a": theta_a, "theta_cs_start": theta0, "theta_network_start": theta0})
+        f = CsInstance(thermal, {"theta_a": theta_a, "theta_cs_start": theta0, "theta_network_start": theta0})
         try:
             out = np.array([f.step(sc.run.step_s, ["theta_cm", "theta_cs", "slip_power"], x_to=float(x),
                                    omega_slip=float(we - wd), omega_engine=float(we))

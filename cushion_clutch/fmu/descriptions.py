@@ -175,11 +175,11 @@ def fmi3_description(token: str, has_friction: bool, x_kiss_ref_m: float | None 
     return _finish(root)
 
 
-def fmi3_build_description() -> str:
-    """sources/buildDescription.xml of the FMI 3.0 FMU."""
+def fmi3_build_description(model_identifier: str = SLAVE, source_files: list[str] | None = None) -> str:
+    """sources/buildDescription.xml of an FMI 3.0 FMU (default: the clutch FMU and its sources)."""
     root = ET.Element("fmiBuildDescription", fmiVersion="3.0")
-    config = ET.SubElement(root, "BuildConfiguration", modelIdentifier=SLAVE)
+    config = ET.SubElement(root, "BuildConfiguration", modelIdentifier=model_identifier)
     files = ET.SubElement(config, "SourceFileSet", language="C99")
-    for name in sources(3):
+    for name in sources(3) if source_files is None else source_files:
         ET.SubElement(files, "SourceFile", name=name)
     return _finish(root)

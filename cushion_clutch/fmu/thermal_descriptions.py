@@ -16,7 +16,7 @@ from xml.etree import ElementTree as ET
 
 from ..model import clutch_model
 from .constants import sources
-from .descriptions import _finish, dependencies, fmi2_description, fmi3_description, vr_der
+from .descriptions import _finish, dependencies, fmi2_description, fmi3_build_description, fmi3_description, vr_der
 from .thermal_chain import (NETWORK_SOURCES, THERMAL_SLAVE, Chain, node_output, thermal_ranges, thermal_starts,
                             thermal_variables)
 
@@ -212,12 +212,7 @@ def thermal_fmi3_description(token: str, has_friction: bool, chain: Chain, x_kis
 
 def thermal_fmi3_build_description() -> str:
     """sources/buildDescription.xml of the FMI 3.0 thermal FMU."""
-    root = ET.Element("fmiBuildDescription", fmiVersion="3.0")
-    config = ET.SubElement(root, "BuildConfiguration", modelIdentifier=THERMAL_SLAVE)
-    files = ET.SubElement(config, "SourceFileSet", language="C99")
-    for name in thermal_sources(3):
-        ET.SubElement(files, "SourceFile", name=name)
-    return _finish(root)
+    return fmi3_build_description(THERMAL_SLAVE, thermal_sources(3))
 
 
 def thermal_descriptions_into(fmu: Path, guid: str, has_friction: bool, chain: Chain, x_kiss_ref_m: float | None,

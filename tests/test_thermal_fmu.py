@@ -3,7 +3,6 @@ twelve slips, a launch replayed in lock-step against the Python plant's network 
 FMI 3.0 vs 2.0, and the errors it reports."""
 from __future__ import annotations
 
-import dataclasses
 import functools
 import shutil
 import tempfile
@@ -15,12 +14,11 @@ from fmpy import read_model_description, simulate_fmu
 from fmpy.fmi1 import FMICallException
 from fmpy.validation import validate_fmu
 
-from cushion_clutch.benchmarks.thermal_fmu import CsInstance
+from cushion_clutch.benchmarks.thermal_fmu import CsInstance, recorded_launch
 from cushion_clutch.cli import main
 from cushion_clutch.fmu.build import build_fmu
 from cushion_clutch.fmu.thermal_chain import chain_of, node_output
 from cushion_clutch.data import DEFAULT_TABLES
-from cushion_clutch.launch.scenario import load_scenario
 from cushion_clutch.launch.thermal_network import NODES, ThermalNetwork
 from cushion_clutch.model import ClutchParameters, clutch_model, load_table, outputs, thermal_step
 
@@ -94,17 +92,7 @@ def test_twelve_slips_heat_the_facings_by_a_physical_amount(fmus):
 def launch_inputs():
     """Per-step x_to (m), slip and engine speeds (rad/s) of one launch of the default scenario with the plant's
     thermal network on (the plain clutch FMU in the loop), from ``simulate_launches`` recording every step."""
-    from cushion_clutch.fmu.native import build_native_fmu
-    from cushion_clutch.fmu.crossbuild import HOST
-    from cushion_clutch.launch.simulate import simulate_launches
-    sc = load_scenario()
-    tcu = dataclasses.replace(sc.tcu, drive_time_s=4.0)
-    sc = dataclasses.replace(sc, tcu=tcu, run=dataclasses.replace(sc.run, launches=1, quiet_steps=False,
-                                                                  period_s=tcu.prefill_s + tcu.drive_time_s + 5.5),
-                             plant_thermal=dataclasses.replace(sc.plant_thermal, enabled=True))
-    with tempfile.TemporaryDirectory() as tmp:
-        plain = build_native_fmu(DEFAULT_TABLES, Path(tmp) / "plain.fmu", platforms=(HOST[2],))
-        res = simulate_launches(plain, sc, load_table(), "naive", record_every=1)
+    sc, res = recorded_launch()
     s = res.series
     return sc, s["x_to_m"], s["w_engine_rad_s"] - s["w_disc_rad_s"], s["w_engine_rad_s"], s["theta_cm_K"]
 

@@ -83,15 +83,15 @@ def bar_duty(fmu: Path, h: float = 0.01) -> dict[str, float]:
             "peak_rise_K": peak - theta0, "open_steps_not_falling": not_falling}
 
 
-def plant_replay() -> dict[str, float]:
-    """One default launch (network on) through simulate_launches, replayed through the thermal FMU."""
+def recorded_launch():
+    """(scenario, LaunchResult): one shortened default launch with the plant's network on, through the plain clutch
+    FMU with the naive TCU, every 1 ms step recorded (the thermal FMU's replay input)."""
     from cushion_clutch.data import DEFAULT_TABLES
     from cushion_clutch.fmu.crossbuild import HOST
     from cushion_clutch.fmu.native import build_native_fmu
-    from cushion_clutch.fmu.thermal_chain import chain_of
     from cushion_clutch.launch.scenario import load_scenario
     from cushion_clutch.launch.simulate import simulate_launches
-    from cushion_clutch.model import KELVIN, load_table
+    from cushion_clutch.model import load_table
 
     sc = load_scenario()
     tcu = dataclasses.replace(sc.tcu, drive_time_s=4.0)
@@ -100,10 +100,22 @@ def plant_replay() -> dict[str, float]:
                              plant_thermal=dataclasses.replace(sc.plant_thermal, enabled=True))
     with tempfile.TemporaryDirectory() as tmp:
         plain = build_native_fmu(DEFAULT_TABLES, Path(tmp) / "plain.fmu", platforms=(HOST[2],))
+        return sc, simulate_launches(plain, sc, load_table(), "naive", record_every=1)
+
+
+def plant_replay() -> dict[str, float]:
+    """One default launch (network on) through simulate_launches, replayed through the thermal FMU."""
+    from cushion_clutch.data import DEFAULT_TABLES
+    from cushion_clutch.fmu.crossbuild import HOST
+    from cushion_clutch.fmu.native import build_native_fmu
+    from cushion_clutch.fmu.thermal_chain import chain_of
+    from cushion_clutch.model import KELVIN
+
+    sc, res = recorded_launch()
+    s = res.series
+    with tempfile.TemporaryDirectory() as tmp:
         thermal = build_native_fmu(DEFAULT_TABLES, Path(tmp) / "thermal.fmu", platforms=(HOST[2],),
                                    chain=chain_of(sc.plant_thermal))
-        res = simulate_launches(plain, sc, load_table(), "naive", record_every=1)
-        s = res.series
         theta_a, theta0 = sc.facing.ambient_degC + KELVIN, sc.facing.initial_degC + KELVIN
         f = CsInstance(thermal, {"theta_a": theta_a, "theta_cs_start": theta0, "theta_network_start": theta0})
         try:

@@ -13,9 +13,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from fmpy import extract, read_model_description, simulate_fmu
+from fmpy import read_model_description, simulate_fmu
 from fmpy.fmi1 import FMICallException
-from fmpy.fmi2 import FMU2Slave
 
 from cushion_clutch.data import DEFAULT_TABLES
 from cushion_clutch.fmu.build import build_fmu

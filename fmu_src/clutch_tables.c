@@ -40,16 +40,41 @@ static void pchip_slopes(const double *x, const double *y, double *d, int n) {
                          (y[n - 2] - y[n - 3]) / (x[n - 2] - x[n - 3]));
 }
 
+/* buckets per interval of the locator (cc_curve_locate) */
+#define CC_BUCKETS_PER_INTERVAL 4
+
+int cc_curve_locate(const Curve *c, double u) {
+    const double *x = c->x;
+    double f = (u - x[0]) * c->b_scale;
+    int b = f < (double)c->nb ? (int)f : c->nb - 1, i;
+    if (b < 0) b = 0;
+    i = c->bucket[b];
+    while (x[i + 1] <= u) ++i; /* stops: u < x[n-1] */
+    while (x[i] > u) --i;      /* stops: x[0] < u */
+    return i;
+}
+
+/* the locator's buckets of a loaded curve (n >= 2, x increasing); -1 if out of memory */
+static int curve_buckets(Curve *c) {
+    int b, i = 0;
+    c->nb = CC_BUCKETS_PER_INTERVAL * (c->n - 1);
+    c->bucket = (int *)malloc(sizeof(int) * c->nb);
+    if (!c->bucket) return -1;
+    c->b_scale = c->nb / (c->x[c->n - 1] - c->x[0]);
+    for (b = 0; b < c->nb; ++b) {
+        double start = c->x[0] + b / c->b_scale;
+        while (i < c->n - 2 && c->x[i + 1] <= start) ++i;
+        c->bucket[b] = i;
+    }
+    return 0;
+}
+
 static double curve_eval(const Curve *c, double u) {
-    int lo = 0, hi = c->n - 1, i;
+    int i;
     double h, t, t2, t3;
     if (u <= c->x[0]) return c->y[0];
     if (u >= c->x[c->n - 1]) return c->y[c->n - 1];
-    while (hi - lo > 1) { /* x[lo] <= u < x[hi] */
-        int mid = (lo + hi) / 2;
-        if (c->x[mid] <= u) lo = mid; else hi = mid;
-    }
-    i = lo;
+    i = cc_curve_locate(c, u);
     h = c->x[i + 1] - c->x[i];
     t = (u - c->x[i]) / h;
     t2 = t * t;
@@ -82,6 +107,7 @@ void cc_table_bracket(const Table *tb, double theta, TBracket *br) {
     int i;
     double w, span;
     table_index(tb, theta, &i, &w);
+    br->i = i;
     br->c0 = &tb->curves[i];
     br->w = w;
     if (w == 0.0) {
@@ -123,6 +149,12 @@ double cc_table_delta(const Table *tb, double theta) {
     return w == 0.0 ? tb->delta[i] : (1.0 - w) * tb->delta[i] + w * tb->delta[i + 1];
 }
 
+double cc_table_delta_at(const Table *tb, const TBracket *br) {
+    int i = br->i;
+    double w = br->w;
+    return w == 0.0 ? tb->delta[i] : (1.0 - w) * tb->delta[i] + w * tb->delta[i + 1];
+}
+
 /* mu(theta_cm degC, |omega|): bilinear on the friction grid, clamped (as friction.FrictionTable) */
 double cc_table_mu(const Table *tb, double theta, double omega) {
     int i, j, i1, j1;
@@ -156,7 +188,9 @@ static int unique_sorted(const double *data, int rows, int ncol, int col, double
 void cc_table_free(Table *tb) {
     int k;
     if (tb->curves)
-        for (k = 0; k < tb->nt; ++k) { free(tb->curves[k].x); free(tb->curves[k].y); free(tb->curves[k].d); }
+        for (k = 0; k < tb->nt; ++k) {
+            free(tb->curves[k].x); free(tb->curves[k].y); free(tb->curves[k].d); free(tb->curves[k].bucket);
+        }
     free(tb->curves); free(tb->theta); free(tb->delta);
     free(tb->f_theta); free(tb->f_omega); free(tb->f_mu);
     memset(tb, 0, sizeof *tb);
@@ -327,6 +361,7 @@ int cc_table_load(Table *tb, const char *dir, char *err, size_t errlen) {
             goto fail;
         }
         pchip_slopes(c->x, c->y, c->d, n);
+        if (curve_buckets(c) != 0) { snprintf(err, errlen, "out of memory"); goto fail; }
         for (j = 0, c->x_first = c->x[0]; j < n; ++j)
             if (c->y[j] == c->y[0]) c->x_first = c->x[j];
     }

@@ -57,7 +57,7 @@ void cc_cover_prepare(CcCover *cv, const double *par, double lever_ratio, double
     f_to = (moment(cv, s_k0, par[CV_E]) - cc_table_force(tb, 0.0, th_ref) * cv->L_pp) / cv->L_b;
     cv->xc = x_kiss_ref + cv->kb * s_k0 + par[CV_C] * f_to;
     cv->f_theta_cs = NAN; /* no frame yet */
-    cv->hint[0] = cv->hint[1] = cv->hint_k[0] = cv->hint_k[1] = 0;
+    cv->hint[0] = cv->hint[1] = cv->hint_k[0] = cv->hint_k[1] = cv->hint_t = 0;
     memset(cv->memo_c, 0, sizeof cv->memo_c);
 }
 
@@ -120,27 +120,23 @@ static inline double cushion_slope(const TBracket *b, const CurvePt *pt) {
 /* the frame's cushion force at u (the full compression or the kiss point, slot 0 or 1): the curves' values
    are kept per curve and the curve's own compression, so a new temperature that reads a curve at the same
    point costs no curve evaluation (exact: the same numbers as cushion()) */
-static double frame_cushion(CcCover *cv, const TBracket *b, double u, int slot) {
-    double f0, f1, v = u - b->first;
+/* F of curve c at uk through memo slot j (exact: the value curve_value gives) */
+static inline double memo_value(CcCover *cv, int j, const Curve *c, double uk, int *hint) {
     CurvePt pt;
-    const Curve *c[2];
-    double uk[2];
-    int k;
-    c[0] = b->c0;
-    c[1] = b->c1;
-    uk[0] = b->w == 0.0 ? u : b->c0->x_first + v * b->r0;
-    uk[1] = b->c1->x_first + v * b->r1;
-    for (k = 0; k < (b->w == 0.0 ? 1 : 2); ++k) {
-        int j = 2 * slot + k;
-        if (!(cv->memo_c[j] == c[k] && cv->memo_u[j] == uk[k])) {
-            cv->memo_c[j] = c[k];
-            cv->memo_u[j] = uk[k];
-            cv->memo_f[j] = curve_value(c[k], uk[k], &cv->hint_k[k], &pt);
-        }
+    if (!(cv->memo_c[j] == c && cv->memo_u[j] == uk)) {
+        cv->memo_c[j] = c;
+        cv->memo_u[j] = uk;
+        cv->memo_f[j] = curve_value(c, uk, hint, &pt);
     }
-    f0 = cv->memo_f[2 * slot];
-    if (b->w == 0.0) return f0;
-    f1 = cv->memo_f[2 * slot + 1];
+    return cv->memo_f[j];
+}
+
+static double frame_cushion(CcCover *cv, const TBracket *b, double u, int slot) {
+    double f0, f1, v;
+    if (b->w == 0.0) return memo_value(cv, 2 * slot, b->c0, u, &cv->hint_k[0]);
+    v = u - b->first;
+    f0 = memo_value(cv, 2 * slot, b->c0, b->c0->x_first + v * b->r0, &cv->hint_k[0]);
+    f1 = memo_value(cv, 2 * slot + 1, b->c1, b->c1->x_first + v * b->r1, &cv->hint_k[1]);
     return (1.0 - b->w) * f0 + b->w * f1;
 }
 
@@ -156,7 +152,7 @@ int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
         double stack, m_solid;
         TBracket b;
         e_mod = youngs(cv, theta_cs);
-        cc_table_bracket(tb, th, &b);
+        cc_table_bracket_hint(tb, th, &b, &cv->hint_t);
         stack = cc_table_delta_at(tb, &b) +
                 (p[CV_TF] * p[CV_AF] + p[CV_TPP] * p[CV_APP] + p[CV_LFW] * p[CV_AFW]) * (theta_cm - p[CV_TREF]);
         cv->f_e = e_mod;

@@ -84,29 +84,43 @@ static double curve_eval(const Curve *c, double u) {
 }
 
 /* grid index and weight of v in g[0..n-1] (clamped) */
-static void grid_bracket(const double *g, int n, double v, int *i, double *w) {
+static void grid_bracket_hint(const double *g, int n, double v, int *i, double *w, int *hint) {
     int lo = 0, hi = n - 1;
     if (n == 1 || v <= g[0]) { *i = 0; *w = 0.0; return; }
     if (v >= g[n - 1]) { *i = n - 2; *w = 1.0; return; }
+    if (hint && *hint >= 0 && *hint < n - 1 && g[*hint] <= v && v < g[*hint + 1]) {
+        /* the interval of the last call: the one the search finds (g[lo] <= v < g[lo + 1] is unique) */
+        lo = *hint;
+        *i = lo;
+        *w = (v - g[lo]) / (g[lo + 1] - g[lo]);
+        return;
+    }
     while (hi - lo > 1) {
         int mid = (lo + hi) / 2;
         if (g[mid] <= v) lo = mid; else hi = mid;
     }
     *i = lo;
     *w = (v - g[lo]) / (g[lo + 1] - g[lo]);
+    if (hint) *hint = lo;
+}
+
+static void grid_bracket(const double *g, int n, double v, int *i, double *w) {
+    grid_bracket_hint(g, n, v, i, w, NULL);
 }
 
 /* the table index and weight of theta: w = 0 at a table temperature and beyond either end (as
    SpringTable._bracket) */
-static void table_index(const Table *tb, double theta, int *i, double *w) {
-    grid_bracket(tb->theta, tb->nt, theta, i, w);
+static void table_index(const Table *tb, double theta, int *i, double *w, int *hint) {
+    grid_bracket_hint(tb->theta, tb->nt, theta, i, w, hint);
     if (*w == 1.0) { *i += 1; *w = 0.0; }
 }
 
-void cc_table_bracket(const Table *tb, double theta, TBracket *br) {
+void cc_table_bracket(const Table *tb, double theta, TBracket *br) { cc_table_bracket_hint(tb, theta, br, NULL); }
+
+void cc_table_bracket_hint(const Table *tb, double theta, TBracket *br, int *hint) {
     int i;
     double w, span;
-    table_index(tb, theta, &i, &w);
+    table_index(tb, theta, &i, &w, hint);
     br->i = i;
     br->c0 = &tb->curves[i];
     br->w = w;
@@ -145,7 +159,7 @@ double cc_table_force(const Table *tb, double u, double theta) {
 
 double cc_table_delta(const Table *tb, double theta) {
     int i; double w;
-    table_index(tb, theta, &i, &w);
+    table_index(tb, theta, &i, &w, NULL);
     return w == 0.0 ? tb->delta[i] : (1.0 - w) * tb->delta[i] + w * tb->delta[i + 1];
 }
 

@@ -67,6 +67,13 @@ double cc_cover_slope_bound(const CcCover *cv) {
     return cv->kb + cv->p[CV_C] * moment_slope(cv, cv->p[CV_H], e_max) / cv->L_b;
 }
 
+/* the Newton loop's curve functions are inlined (the loop's constants stay in registers) */
+#if defined(__GNUC__)
+#define CC_INLINE static inline __attribute__((always_inline))
+#else
+#define CC_INLINE static inline
+#endif
+
 /* a point of one curve where F was evaluated: its interval i (-1: beyond either end, dF/du = 0), t, t^2, h */
 typedef struct {
     int i;
@@ -75,7 +82,7 @@ typedef struct {
 
 /* F(u) of one curve (PCHIP, as clutch_tables.c); *hint: the last interval, checked before use; the point is
    kept in *pt for curve_slope */
-static inline double curve_value(const Curve *c, double u, int *hint, CurvePt *pt) {
+CC_INLINE double curve_value(const Curve *c, double u, int *hint, CurvePt *pt) {
     int n = c->n, i = *hint;
     double h, t, t2;
     if (u <= c->x[0]) { pt->i = -1; return c->y[0]; }
@@ -93,7 +100,7 @@ static inline double curve_value(const Curve *c, double u, int *hint, CurvePt *p
 }
 
 /* dF/du of one curve at a point of curve_value (computed only where Newton needs it) */
-static inline double curve_slope(const Curve *c, const CurvePt *pt) {
+CC_INLINE double curve_slope(const Curve *c, const CurvePt *pt) {
     int i = pt->i;
     double t = pt->t, t2 = pt->t2, h = pt->h;
     if (i < 0) return 0.0;
@@ -102,7 +109,7 @@ static inline double curve_slope(const Curve *c, const CurvePt *pt) {
 }
 
 /* the cushion force at one temperature (as spring_table.Bracket.force); the points in pt[0..1] */
-static inline double cushion(const TBracket *b, double u, int *hint, CurvePt *pt) {
+CC_INLINE double cushion(const TBracket *b, double u, int *hint, CurvePt *pt) {
     double f0, f1, v;
     if (b->w == 0.0) return curve_value(b->c0, u, &hint[0], &pt[0]);
     v = u - b->first;
@@ -112,7 +119,7 @@ static inline double cushion(const TBracket *b, double u, int *hint, CurvePt *pt
 }
 
 /* its slope at the points of the last cushion() call (as spring_table.Bracket.slope) */
-static inline double cushion_slope(const TBracket *b, const CurvePt *pt) {
+CC_INLINE double cushion_slope(const TBracket *b, const CurvePt *pt) {
     if (b->w == 0.0) return curve_slope(b->c0, &pt[0]);
     return (1.0 - b->w) * curve_slope(b->c0, &pt[0]) * b->r0 + b->w * curve_slope(b->c1, &pt[1]) * b->r1;
 }
@@ -145,7 +152,7 @@ int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
     const double *p = cv->p;
     double th = theta_cs - KELVIN, kb = cv->kb, kp = cv->kp, comp = p[CV_C];
     double lo, hi, s, r, fc, fto, dfc, e_mod;
-    CurvePt pt[2];
+    CurvePt pt[2] = {{-1, 0.0, 0.0, 0.0}, {-1, 0.0, 0.0, 0.0}}; /* pt[1]: used only where w != 0 */
     int k;
     if (!(theta_cs == cv->f_theta_cs && theta_cm == cv->f_theta_cm && wear == cv->f_wear)) {
         /* the frame: everything that depends on temperature and wear, not on x_to */

@@ -50,10 +50,6 @@ typedef struct {
     int n;
     double *x, *y, *d;
     double x_first; /* first contact: the last row still at the first force, m (spring_table.Curve.x_first) */
-    /* the interval locator (cc_curve_locate): bucket b of nb equal parts of [x[0], x[n-1]] starts in interval
-       bucket[b]; a speed-up only: the interval found is the binary search's, exactly */
-    int nb, *bucket;
-    double b_scale; /* nb / (x[n-1] - x[0]), 1/m */
 } Curve;
 
 /* F(u) at one temperature: curves c0 and c1 (weight w of c1; c1 = c0 where w = 0) blended on a common
@@ -147,7 +143,7 @@ double cc_table_force(const Table *tb, double u, double theta_degC);
 double cc_table_delta(const Table *tb, double theta_degC);
 /* the kiss shift of a bracket's temperature (the same number as cc_table_delta at that temperature), m */
 double cc_table_delta_at(const Table *tb, const TBracket *br);
-/* the interval i of x[0] < u < x[n-1]: x[i] <= u < x[i+1] (the binary search's, found through the buckets) */
+/* the interval i of x[0] < u < x[n-1]: x[i] <= u < x[i+1] (binary search) */
 int cc_curve_locate(const Curve *c, double u);
 double cc_table_mu(const Table *tb, double theta_degC, double omega);
 double cc_table_full(const Table *tb, double theta_degC);

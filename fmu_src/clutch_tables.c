@@ -40,33 +40,14 @@ static void pchip_slopes(const double *x, const double *y, double *d, int n) {
                          (y[n - 2] - y[n - 3]) / (x[n - 2] - x[n - 3]));
 }
 
-/* buckets per interval of the locator (cc_curve_locate) */
-#define CC_BUCKETS_PER_INTERVAL 4
-
 int cc_curve_locate(const Curve *c, double u) {
-    const double *x = c->x;
-    double f = (u - x[0]) * c->b_scale;
-    int b = f < (double)c->nb ? (int)f : c->nb - 1, i;
-    if (b < 0) b = 0;
-    i = c->bucket[b];
-    while (x[i + 1] <= u) ++i; /* stops: u < x[n-1] */
-    while (x[i] > u) --i;      /* stops: x[0] < u */
-    return i;
-}
-
-/* the locator's buckets of a loaded curve (n >= 2, x increasing); -1 if out of memory */
-static int curve_buckets(Curve *c) {
-    int b, i = 0;
-    c->nb = CC_BUCKETS_PER_INTERVAL * (c->n - 1);
-    c->bucket = (int *)malloc(sizeof(int) * c->nb);
-    if (!c->bucket) return -1;
-    c->b_scale = c->nb / (c->x[c->n - 1] - c->x[0]);
-    for (b = 0; b < c->nb; ++b) {
-        double start = c->x[0] + b / c->b_scale;
-        while (i < c->n - 2 && c->x[i + 1] <= start) ++i;
-        c->bucket[b] = i;
+    int lo = 0, hi = c->n - 1;
+    while (hi - lo > 1) { /* x[lo] <= u < x[hi]; written for conditional moves (no mispredicted branches) */
+        int mid = (lo + hi) / 2, le = c->x[mid] <= u;
+        lo = le ? mid : lo;
+        hi = le ? hi : mid;
     }
-    return 0;
+    return lo;
 }
 
 static double curve_eval(const Curve *c, double u) {
@@ -203,7 +184,7 @@ void cc_table_free(Table *tb) {
     int k;
     if (tb->curves)
         for (k = 0; k < tb->nt; ++k) {
-            free(tb->curves[k].x); free(tb->curves[k].y); free(tb->curves[k].d); free(tb->curves[k].bucket);
+            free(tb->curves[k].x); free(tb->curves[k].y); free(tb->curves[k].d);
         }
     free(tb->curves); free(tb->theta); free(tb->delta);
     free(tb->f_theta); free(tb->f_omega); free(tb->f_mu);
@@ -375,7 +356,6 @@ int cc_table_load(Table *tb, const char *dir, char *err, size_t errlen) {
             goto fail;
         }
         pchip_slopes(c->x, c->y, c->d, n);
-        if (curve_buckets(c) != 0) { snprintf(err, errlen, "out of memory"); goto fail; }
         for (j = 0, c->x_first = c->x[0]; j < n; ++j)
             if (c->y[j] == c->y[0]) c->x_first = c->x[j];
     }

@@ -305,6 +305,15 @@ int cc_set_real(CcModel *m, const unsigned int vr[], size_t n, const double v[],
     int after_init = (m->phase & (PH_STEP | PH_EVENT | PH_CONT)) != 0;
     if (!cc_allowed(m, PH_INSTANTIATED | PH_INIT | PH_STEP | PH_EVENT | PH_CONT, fn)) return CC_ERROR;
     if (n && (!vr || !v)) { cc_log(m, CC_ERROR, "%s: NULL value reference or value array", fn); return CC_ERROR; }
+#if !CC_THERMAL
+    /* the step's usual call: inputs only (what the checks below allow in every phase) */
+    for (k = 0; k < n && vr[k] < CC_NVARS && CC_VARIABLES[vr[k]].causality == CC_INPUT; ++k) {}
+    if (k == n && n) {
+        for (k = 0; k < n; ++k) m->r[vr[k]] = v[k];
+        m->dirty = 1;
+        return CC_OK;
+    }
+#endif
     for (k = 0; k < n; ++k) { /* validate all first: a refused call changes nothing */
         if (vr[k] >= CC_NVARS) {
             cc_log(m, CC_ERROR, "%s: unknown value reference %u", fn, vr[k]);
@@ -335,6 +344,13 @@ int cc_get_real(CcModel *m, const unsigned int vr[], size_t n, double v[], const
     size_t k;
     if (!cc_allowed(m, PH_ANY & ~PH_INSTANTIATED, fn)) return CC_ERROR;
     if (n && (!vr || !v)) { cc_log(m, CC_ERROR, "%s: NULL value reference or value array", fn); return CC_ERROR; }
+    if (!m->dirty) { /* the usual call after a step: every reference known, outputs up to date */
+        for (k = 0; k < n && vr[k] < CC_NVARS; ++k) {}
+        if (k == n) {
+            for (k = 0; k < n; ++k) v[k] = m->r[vr[k]];
+            return CC_OK;
+        }
+    }
     for (k = 0; k < n; ++k)
         if (vr[k] >= CC_NVARS) {
             cc_log(m, CC_ERROR, "%s: unknown value reference %u", fn, vr[k]);

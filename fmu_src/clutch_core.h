@@ -58,6 +58,7 @@ typedef struct {
 typedef struct {
     const Curve *c0, *c1;
     double w, first, full, r0, r1;
+    int i; /* c0 = curves[i] (the table index of theta) */
 } TBracket;
 
 typedef struct {
@@ -83,6 +84,7 @@ typedef struct {
     double u_full_ref;                /* cushion full compression at the reference temperature, m */
     double xc;                        /* bearing-system constant X_c, m */
     int hint[2], hint_k[2];           /* last table intervals (Newton; kiss and solid points) */
+    int hint_t;                       /* last interval of the table temperatures (the frame's bracket) */
     const Curve *memo_c[4];           /* frame_cushion: curve, u and F of the solid (0, 1) and kiss (2, 3) points */
     double memo_u[4], memo_f[4];
     /* the frame of the last (theta_cs K, theta_cm K, wear m): bracket, E, positions and forces */
@@ -139,10 +141,16 @@ int cc_table_load(Table *tb, const char *dir, char *err, size_t errlen);
 void cc_table_free(Table *tb);
 double cc_table_force(const Table *tb, double u, double theta_degC);
 double cc_table_delta(const Table *tb, double theta_degC);
+/* the kiss shift of a bracket's temperature (the same number as cc_table_delta at that temperature), m */
+double cc_table_delta_at(const Table *tb, const TBracket *br);
+/* the interval i of x[0] < u < x[n-1]: x[i] <= u < x[i+1] (binary search) */
+int cc_curve_locate(const Curve *c, double u);
 double cc_table_mu(const Table *tb, double theta_degC, double omega);
 double cc_table_full(const Table *tb, double theta_degC);
 /* table temperatures i and i+1 around theta with weight w of i+1 (clamped: w = 0 or 1) */
 void cc_table_bracket(const Table *tb, double theta_degC, TBracket *br);
+/* the same, trying the table interval *hint first (the last one found, kept in *hint) */
+void cc_table_bracket_hint(const Table *tb, double theta_degC, TBracket *br, int *hint);
 
 /* ---- cover (clutch_cover.c) */
 void cc_cover_prepare(CcCover *cv, const double *par, double lever_ratio, double x_kiss_ref, const Table *tb);

@@ -57,7 +57,7 @@ void cc_cover_prepare(CcCover *cv, const double *par, double lever_ratio, double
     f_to = (moment(cv, s_k0, par[CV_E]) - cc_table_force(tb, 0.0, th_ref) * cv->L_pp) / cv->L_b;
     cv->xc = x_kiss_ref + cv->kb * s_k0 + par[CV_C] * f_to;
     cv->f_theta_cs = NAN; /* no frame yet */
-    cv->hint[0] = cv->hint[1] = cv->hint_k[0] = cv->hint_k[1] = 0;
+    cv->hint[0] = cv->hint[1] = cv->hint_k[0] = cv->hint_k[1] = cv->hint_t = 0;
     memset(cv->memo_c, 0, sizeof cv->memo_c);
 }
 
@@ -67,63 +67,83 @@ double cc_cover_slope_bound(const CcCover *cv) {
     return cv->kb + cv->p[CV_C] * moment_slope(cv, cv->p[CV_H], e_max) / cv->L_b;
 }
 
-/* F(u) and dF/du of one curve (PCHIP, as clutch_tables.c); *hint: the last interval, checked before use */
-static double curve_vd(const Curve *c, double u, double *dfdu, int *hint) {
+/* the Newton loop's curve functions are inlined (the loop's constants stay in registers) */
+#if defined(__GNUC__)
+#define CC_INLINE static inline __attribute__((always_inline))
+#else
+#define CC_INLINE static inline
+#endif
+
+/* a point of one curve where F was evaluated: its interval i (-1: beyond either end, dF/du = 0), t, t^2, h */
+typedef struct {
+    int i;
+    double t, t2, h;
+} CurvePt;
+
+/* F(u) of one curve (PCHIP, as clutch_tables.c); *hint: the last interval, checked before use; the point is
+   kept in *pt for curve_slope */
+CC_INLINE double curve_value(const Curve *c, double u, int *hint, CurvePt *pt) {
     int n = c->n, i = *hint;
     double h, t, t2;
-    if (u <= c->x[0]) { *dfdu = 0.0; return c->y[0]; }
-    if (u >= c->x[n - 1]) { *dfdu = 0.0; return c->y[n - 1]; }
-    if (!(i >= 0 && i < n - 1 && c->x[i] <= u && u < c->x[i + 1])) {
-        int lo = 0, hi = n - 1;
-        while (hi - lo > 1) { /* x[lo] <= u < x[hi] */
-            int mid = (lo + hi) / 2;
-            if (c->x[mid] <= u) lo = mid; else hi = mid;
-        }
-        i = *hint = lo;
-    }
+    if (u <= c->x[0]) { pt->i = -1; return c->y[0]; }
+    if (u >= c->x[n - 1]) { pt->i = -1; return c->y[n - 1]; }
+    if (!(i >= 0 && i < n - 1 && c->x[i] <= u && u < c->x[i + 1])) i = *hint = cc_curve_locate(c, u);
     h = c->x[i + 1] - c->x[i];
     t = (u - c->x[i]) / h;
     t2 = t * t;
-    *dfdu = (6 * t2 - 6 * t) * (c->y[i] - c->y[i + 1]) / h + (3 * t2 - 4 * t + 1) * c->d[i] +
-            (3 * t2 - 2 * t) * c->d[i + 1];
+    pt->i = i;
+    pt->t = t;
+    pt->t2 = t2;
+    pt->h = h;
     return (2 * t2 * t - 3 * t2 + 1) * c->y[i] + (t2 * t - 2 * t2 + t) * h * c->d[i] + (-2 * t2 * t + 3 * t2) *
            c->y[i + 1] + (t2 * t - t2) * h * c->d[i + 1];
 }
 
-/* the cushion force and its slope at one temperature (as spring_table.Bracket.force and .slope) */
-static double cushion(const TBracket *b, double u, double *dfdu, int *hint) {
-    double d0, d1, f0, f1, v;
-    if (b->w == 0.0) return curve_vd(b->c0, u, dfdu, &hint[0]);
+/* dF/du of one curve at a point of curve_value (computed only where Newton needs it) */
+CC_INLINE double curve_slope(const Curve *c, const CurvePt *pt) {
+    int i = pt->i;
+    double t = pt->t, t2 = pt->t2, h = pt->h;
+    if (i < 0) return 0.0;
+    return (6 * t2 - 6 * t) * (c->y[i] - c->y[i + 1]) / h + (3 * t2 - 4 * t + 1) * c->d[i] +
+           (3 * t2 - 2 * t) * c->d[i + 1];
+}
+
+/* the cushion force at one temperature (as spring_table.Bracket.force); the points in pt[0..1] */
+CC_INLINE double cushion(const TBracket *b, double u, int *hint, CurvePt *pt) {
+    double f0, f1, v;
+    if (b->w == 0.0) return curve_value(b->c0, u, &hint[0], &pt[0]);
     v = u - b->first;
-    f0 = curve_vd(b->c0, b->c0->x_first + v * b->r0, &d0, &hint[0]);
-    f1 = curve_vd(b->c1, b->c1->x_first + v * b->r1, &d1, &hint[1]);
-    *dfdu = (1.0 - b->w) * d0 * b->r0 + b->w * d1 * b->r1;
+    f0 = curve_value(b->c0, b->c0->x_first + v * b->r0, &hint[0], &pt[0]);
+    f1 = curve_value(b->c1, b->c1->x_first + v * b->r1, &hint[1], &pt[1]);
     return (1.0 - b->w) * f0 + b->w * f1;
+}
+
+/* its slope at the points of the last cushion() call (as spring_table.Bracket.slope) */
+CC_INLINE double cushion_slope(const TBracket *b, const CurvePt *pt) {
+    if (b->w == 0.0) return curve_slope(b->c0, &pt[0]);
+    return (1.0 - b->w) * curve_slope(b->c0, &pt[0]) * b->r0 + b->w * curve_slope(b->c1, &pt[1]) * b->r1;
 }
 
 /* the frame's cushion force at u (the full compression or the kiss point, slot 0 or 1): the curves' values
    are kept per curve and the curve's own compression, so a new temperature that reads a curve at the same
    point costs no curve evaluation (exact: the same numbers as cushion()) */
-static double frame_cushion(CcCover *cv, const TBracket *b, double u, int slot) {
-    double f0, f1, d, v = u - b->first;
-    const Curve *c[2];
-    double uk[2];
-    int k;
-    c[0] = b->c0;
-    c[1] = b->c1;
-    uk[0] = b->w == 0.0 ? u : b->c0->x_first + v * b->r0;
-    uk[1] = b->c1->x_first + v * b->r1;
-    for (k = 0; k < (b->w == 0.0 ? 1 : 2); ++k) {
-        int j = 2 * slot + k;
-        if (!(cv->memo_c[j] == c[k] && cv->memo_u[j] == uk[k])) {
-            cv->memo_c[j] = c[k];
-            cv->memo_u[j] = uk[k];
-            cv->memo_f[j] = curve_vd(c[k], uk[k], &d, &cv->hint_k[k]);
-        }
+/* F of curve c at uk through memo slot j (exact: the value curve_value gives) */
+static inline double memo_value(CcCover *cv, int j, const Curve *c, double uk, int *hint) {
+    CurvePt pt;
+    if (!(cv->memo_c[j] == c && cv->memo_u[j] == uk)) {
+        cv->memo_c[j] = c;
+        cv->memo_u[j] = uk;
+        cv->memo_f[j] = curve_value(c, uk, hint, &pt);
     }
-    f0 = cv->memo_f[2 * slot];
-    if (b->w == 0.0) return f0;
-    f1 = cv->memo_f[2 * slot + 1];
+    return cv->memo_f[j];
+}
+
+static double frame_cushion(CcCover *cv, const TBracket *b, double u, int slot) {
+    double f0, f1, v;
+    if (b->w == 0.0) return memo_value(cv, 2 * slot, b->c0, u, &cv->hint_k[0]);
+    v = u - b->first;
+    f0 = memo_value(cv, 2 * slot, b->c0, b->c0->x_first + v * b->r0, &cv->hint_k[0]);
+    f1 = memo_value(cv, 2 * slot + 1, b->c1, b->c1->x_first + v * b->r1, &cv->hint_k[1]);
     return (1.0 - b->w) * f0 + b->w * f1;
 }
 
@@ -132,14 +152,15 @@ int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
     const double *p = cv->p;
     double th = theta_cs - KELVIN, kb = cv->kb, kp = cv->kp, comp = p[CV_C];
     double lo, hi, s, r, fc, fto, dfc, e_mod;
+    CurvePt pt[2] = {{-1, 0.0, 0.0, 0.0}, {-1, 0.0, 0.0, 0.0}}; /* pt[1]: used only where w != 0 */
     int k;
     if (!(theta_cs == cv->f_theta_cs && theta_cm == cv->f_theta_cm && wear == cv->f_wear)) {
         /* the frame: everything that depends on temperature and wear, not on x_to */
         double stack, m_solid;
         TBracket b;
         e_mod = youngs(cv, theta_cs);
-        cc_table_bracket(tb, th, &b);
-        stack = cc_table_delta(tb, th) +
+        cc_table_bracket_hint(tb, th, &b, &cv->hint_t);
+        stack = cc_table_delta_at(tb, &b) +
                 (p[CV_TF] * p[CV_AF] + p[CV_TPP] * p[CV_APP] + p[CV_LFW] * p[CV_AFW]) * (theta_cm - p[CV_TREF]);
         cv->f_e = e_mod;
         cv->f_br = b;
@@ -173,31 +194,42 @@ int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
         return 0;
     }
     {
+        /* the frame's constants in locals (the same operations as moment() and moment_slope(), in the same
+           order: (fal E) (s/t) (...) e and ((fal E)/t) (...) e; only loads are saved) */
         const TBracket b = cv->f_br;
-        double s_kiss = cv->s_kiss;
+        const double s_kiss = cv->s_kiss, xc = cv->xc, L_pp = cv->L_pp, L_b = cv->L_b, e = cv->e;
+        const double t = p[CV_T], h = p[CV_H], tt = t * t, h15 = 1.5 * h, fe = cv->fal * e_mod, fe_t = fe / t;
+        const double tol_r = 1e-15 * (1.0 + fabs(x_to));
+        int hint[2];
+        hint[0] = cv->hint[0];
+        hint[1] = cv->hint[1];
         lo = cv->s_solid;
-        hi = (cv->xc - x_to) / kb;
+        hi = (xc - x_to) / kb;
         /* start (from the inputs only, so the result never depends on the call history): the chord of
            x(s) between the solid and kiss points (cushion phase) or the rigid lever shifted by the
            kiss-point compliance (open) */
         if (x_to >= cv->x_kiss)
             s = cv->s_solid + (cv->s_kiss - cv->s_solid) * (cv->x_solid - x_to) / (cv->x_solid - cv->x_kiss);
-        else s = (cv->xc - x_to - comp * cv->fto_kiss) / kb;
+        else s = (xc - x_to - comp * cv->fto_kiss) / kb;
         if (!(s > lo && s < hi)) s = hi;
-        fc = cushion(&b, (s_kiss - s) * kp, &dfc, cv->hint);
-        fto = (moment(cv, s, e_mod) - fc * cv->L_pp) / cv->L_b;
-        r = cv->xc - kb * s - comp * fto - x_to;
+        fc = cushion(&b, (s_kiss - s) * kp, hint, pt);
+        fto = (fe * (s / t) * ((h - s) * (h - 0.5 * s) / tt + 1.0) * e - fc * L_pp) / L_b;
+        r = xc - kb * s - comp * fto - x_to;
         for (k = 0; k < 100; ++k) {
-            double slope, s_new;
-            if (fabs(r) <= 1e-15 * (1.0 + fabs(x_to)) || hi - lo <= 1e-15 * (1.0 + hi)) break;
+            double slope, s_new, m_s;
+            if (fabs(r) <= tol_r || hi - lo <= 1e-15 * (1.0 + hi)) break;
             if (r > 0.0) lo = s; else hi = s;
-            slope = -kb - comp * (moment_slope(cv, s, e_mod) + dfc * kp * cv->L_pp) / cv->L_b;
+            dfc = cushion_slope(&b, pt);
+            m_s = fe_t * ((h - s) * (h - 0.5 * s) / tt + 1.0 - s * (h15 - s) / tt) * e;
+            slope = -kb - comp * (m_s + dfc * kp * L_pp) / L_b;
             s_new = slope < 0.0 ? s - r / slope : 0.5 * (lo + hi);
             s = (s_new > lo && s_new < hi) ? s_new : 0.5 * (lo + hi);
-            fc = cushion(&b, (s_kiss - s) * kp, &dfc, cv->hint);
-            fto = (moment(cv, s, e_mod) - fc * cv->L_pp) / cv->L_b;
-            r = cv->xc - kb * s - comp * fto - x_to;
+            fc = cushion(&b, (s_kiss - s) * kp, hint, pt);
+            fto = (fe * (s / t) * ((h - s) * (h - 0.5 * s) / tt + 1.0) * e - fc * L_pp) / L_b;
+            r = xc - kb * s - comp * fto - x_to;
         }
+        cv->hint[0] = hint[0];
+        cv->hint[1] = hint[1];
         out->clamp = fc;
         out->bearing = fto;
         out->cushion = fc;

@@ -40,16 +40,22 @@ static void pchip_slopes(const double *x, const double *y, double *d, int n) {
                          (y[n - 2] - y[n - 3]) / (x[n - 2] - x[n - 3]));
 }
 
+int cc_curve_locate(const Curve *c, double u) {
+    int lo = 0, hi = c->n - 1;
+    while (hi - lo > 1) { /* x[lo] <= u < x[hi]; written for conditional moves (no mispredicted branches) */
+        int mid = (lo + hi) / 2, le = c->x[mid] <= u;
+        lo = le ? mid : lo;
+        hi = le ? hi : mid;
+    }
+    return lo;
+}
+
 static double curve_eval(const Curve *c, double u) {
-    int lo = 0, hi = c->n - 1, i;
+    int i;
     double h, t, t2, t3;
     if (u <= c->x[0]) return c->y[0];
     if (u >= c->x[c->n - 1]) return c->y[c->n - 1];
-    while (hi - lo > 1) { /* x[lo] <= u < x[hi] */
-        int mid = (lo + hi) / 2;
-        if (c->x[mid] <= u) lo = mid; else hi = mid;
-    }
-    i = lo;
+    i = cc_curve_locate(c, u);
     h = c->x[i + 1] - c->x[i];
     t = (u - c->x[i]) / h;
     t2 = t * t;
@@ -59,29 +65,44 @@ static double curve_eval(const Curve *c, double u) {
 }
 
 /* grid index and weight of v in g[0..n-1] (clamped) */
-static void grid_bracket(const double *g, int n, double v, int *i, double *w) {
+static void grid_bracket_hint(const double *g, int n, double v, int *i, double *w, int *hint) {
     int lo = 0, hi = n - 1;
     if (n == 1 || v <= g[0]) { *i = 0; *w = 0.0; return; }
     if (v >= g[n - 1]) { *i = n - 2; *w = 1.0; return; }
+    if (hint && *hint >= 0 && *hint < n - 1 && g[*hint] <= v && v < g[*hint + 1]) {
+        /* the interval of the last call: the one the search finds (g[lo] <= v < g[lo + 1] is unique) */
+        lo = *hint;
+        *i = lo;
+        *w = (v - g[lo]) / (g[lo + 1] - g[lo]);
+        return;
+    }
     while (hi - lo > 1) {
         int mid = (lo + hi) / 2;
         if (g[mid] <= v) lo = mid; else hi = mid;
     }
     *i = lo;
     *w = (v - g[lo]) / (g[lo + 1] - g[lo]);
+    if (hint) *hint = lo;
+}
+
+static void grid_bracket(const double *g, int n, double v, int *i, double *w) {
+    grid_bracket_hint(g, n, v, i, w, NULL);
 }
 
 /* the table index and weight of theta: w = 0 at a table temperature and beyond either end (as
    SpringTable._bracket) */
-static void table_index(const Table *tb, double theta, int *i, double *w) {
-    grid_bracket(tb->theta, tb->nt, theta, i, w);
+static void table_index(const Table *tb, double theta, int *i, double *w, int *hint) {
+    grid_bracket_hint(tb->theta, tb->nt, theta, i, w, hint);
     if (*w == 1.0) { *i += 1; *w = 0.0; }
 }
 
-void cc_table_bracket(const Table *tb, double theta, TBracket *br) {
+void cc_table_bracket(const Table *tb, double theta, TBracket *br) { cc_table_bracket_hint(tb, theta, br, NULL); }
+
+void cc_table_bracket_hint(const Table *tb, double theta, TBracket *br, int *hint) {
     int i;
     double w, span;
-    table_index(tb, theta, &i, &w);
+    table_index(tb, theta, &i, &w, hint);
+    br->i = i;
     br->c0 = &tb->curves[i];
     br->w = w;
     if (w == 0.0) {
@@ -119,7 +140,13 @@ double cc_table_force(const Table *tb, double u, double theta) {
 
 double cc_table_delta(const Table *tb, double theta) {
     int i; double w;
-    table_index(tb, theta, &i, &w);
+    table_index(tb, theta, &i, &w, NULL);
+    return w == 0.0 ? tb->delta[i] : (1.0 - w) * tb->delta[i] + w * tb->delta[i + 1];
+}
+
+double cc_table_delta_at(const Table *tb, const TBracket *br) {
+    int i = br->i;
+    double w = br->w;
     return w == 0.0 ? tb->delta[i] : (1.0 - w) * tb->delta[i] + w * tb->delta[i + 1];
 }
 
@@ -156,7 +183,9 @@ static int unique_sorted(const double *data, int rows, int ncol, int col, double
 void cc_table_free(Table *tb) {
     int k;
     if (tb->curves)
-        for (k = 0; k < tb->nt; ++k) { free(tb->curves[k].x); free(tb->curves[k].y); free(tb->curves[k].d); }
+        for (k = 0; k < tb->nt; ++k) {
+            free(tb->curves[k].x); free(tb->curves[k].y); free(tb->curves[k].d);
+        }
     free(tb->curves); free(tb->theta); free(tb->delta);
     free(tb->f_theta); free(tb->f_omega); free(tb->f_mu);
     memset(tb, 0, sizeof *tb);

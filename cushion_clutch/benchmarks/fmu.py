@@ -5,12 +5,17 @@ host (fmu_src/hosts/fmi2_host.c, dlopen), and the Python model alone; the time
 to build the native FMU with the binaries of every platform (FMI 2.0: 3, FMI 3.0: 5),
 with zig's cache warm, and with ``--cold`` also from an empty zig cache.
 
-    python -m cushion_clutch.benchmarks.fmu [--steps 200000] [--cold] [--thermal-only]
+    python -m cushion_clutch.benchmarks.fmu [--steps 200000] [--cold] [--thermal-only] [--ab REF]
 
 The thermal FMU (``build-fmu --thermal``) against the plain one, both native in the C host
 ``fmu_src/hosts/fmi2_duty_host.c`` on the same bearing sweep with 100 rad/s of slip (the plain FMU
 also gets a theta_cm sweep, the thermal one an engine speed): median of 5 alternating runs and the ratio
 (target: at most 3x). ``--thermal-only`` runs only this comparison.
+
+``--ab REF`` compares the native step of this checkout's C sources with those of git ref ``REF`` (e.g. ``main``):
+both built for linux64 with the FMU build's compiler and flags, from the same generated headers and tables, run
+alternately in the C host (median of 9 on the same machine state), their callgrind instructions per step (if
+valgrind is installed) and whether every output of every step is the same bit for bit (the host's ``checksum``).
 """
 from __future__ import annotations
 
@@ -124,6 +129,67 @@ def time_thermal(tmp: Path, n: int, repeats: int = 5) -> tuple[float, float]:
     return plain, thermal
 
 
+def _host_run(cmd: list[str]) -> dict[str, str]:
+    out = subprocess.run(cmd, capture_output=True, text=True, check=True).stdout
+    return {ln.split()[0]: ln.split(None, 1)[1] for ln in out.splitlines() if ln.strip()}
+
+
+def _callgrind_ir(cmd: list[str]) -> int:
+    res = subprocess.run(["valgrind", "--tool=callgrind", "--callgrind-out-file=/dev/null", *cmd],
+                         capture_output=True, text=True, check=True)
+    return int(next(ln for ln in res.stderr.splitlines() if "Collected" in ln).split()[-1])
+
+
+def time_ab(tmp: Path, ref: str, n: int, repeats: int = 9) -> dict[str, float]:
+    """The native FMI 2.0 step of git ref ``ref``'s C sources against this checkout's: median us per
+    set+doStep+get in the C host (alternating runs), callgrind Ir per step, and the bit-for-bit checksum."""
+    import statistics
+
+    from fmpy import read_model_description
+
+    from cushion_clutch.data import DEFAULT_TABLES, fmu_sources
+    from cushion_clutch.fmu.constants import CORE_HEADERS
+    from cushion_clutch.fmu.crossbuild import HOST, compile_command
+    from cushion_clutch.fmu.native import build_native_fmu, sources
+
+    fmu = build_native_fmu(DEFAULT_TABLES, tmp / "ab.fmu", 2, platforms=(HOST[2],))
+    unzip = tmp / "ab"
+    zipfile.ZipFile(fmu).extractall(unzip)
+    guid = read_model_description(str(fmu)).guid
+    files = sources(2)
+    libs = {}
+    for label in (ref, "worktree"):
+        src = tmp / f"src_{len(libs)}"
+        shutil.copytree(unzip / "sources", src)
+        if label == ref:                 # the ref's model sources over the generated headers of this checkout
+            for name in (*files, *CORE_HEADERS):
+                text = subprocess.run(["git", "-C", str(fmu_sources()), "show", f"{ref}:fmu_src/{name}"],
+                                      capture_output=True, text=True, check=True).stdout
+                (src / name).write_text(text)
+        libs[label] = tmp / f"lib_{len(libs)}.so"
+        subprocess.run(compile_command(HOST[2], 2, src, files, libs[label]), check=True)
+    host = compile_host(tmp / "ab_host")
+    cmd = {k: [str(host), str(lib), (unzip / "resources").as_uri(), guid] for k, lib in libs.items()}
+    sums = {k: _host_run(c + [str(n), "0.001", "checksum"])["checksum"] for k, c in cmd.items()}
+    times: dict[str, list[float]] = {k: [] for k in cmd}
+    for _ in range(repeats):
+        for k, c in cmd.items():
+            times[k].append(float(_host_run(c + [str(n), "0.001"])["us_per_step"]))
+    med = {k: statistics.median(v) for k, v in times.items()}
+    print(f"C host, {n} steps of 1 ms, median of {repeats} alternating runs: {ref} {med[ref]:.3f} us/step, "
+          f"worktree {med['worktree']:.3f} us/step, ratio {med[ref] / med['worktree']:.2f}")
+    if shutil.which("valgrind"):
+        ir = {k: (_callgrind_ir(c + ["120000", "0.001"]) - _callgrind_ir(c + ["20000", "0.001"])) / 100000
+              for k, c in cmd.items()}
+        print(f"callgrind: {ref} {ir[ref]:.0f} Ir/step, worktree {ir['worktree']:.0f} Ir/step, "
+              f"ratio {ir[ref] / ir['worktree']:.2f}")
+        med.update({f"ir_{k}": v for k, v in ir.items()})
+    same = sums[ref] == sums["worktree"]
+    print(f"every output of every step {'identical' if same else 'DIFFERENT'} bit for bit "
+          f"(checksums {sums[ref]}, {sums['worktree']})")
+    return med
+
+
 def time_builds(tmp: Path, cold: bool) -> None:
     """Print the time to build the native FMU for all platforms, per FMI version (warm, optionally cold)."""
     from cushion_clutch.fmu.build import build_fmu
@@ -170,6 +236,8 @@ def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--thermal-only", action="store_true",
                     help="only the thermal FMU's step against the plain FMU's in the C host")
+    ap.add_argument("--ab", metavar="REF", help="only the native step of git ref REF's C sources against this "
+                    "checkout's (time, callgrind, bit-for-bit checksum)")
     ap.add_argument("--steps", type=int, default=200_000)
     ap.add_argument("--cold", action="store_true", help="also time builds from an empty zig cache (minutes)")
     ap.add_argument("--markdown", action="store_true", help="with --out: the results page")
@@ -181,6 +249,10 @@ def main(argv=None) -> None:
 
 def _run(args, build_fmu, DEFAULT_TABLES, ClutchParameters, load_table, outputs, thermal_step) -> None:
     n = args.steps
+    if args.ab:
+        with tempfile.TemporaryDirectory() as tmp:
+            time_ab(Path(tmp), args.ab, n * 5)
+        return
     if args.thermal_only:
         with tempfile.TemporaryDirectory() as tmp:
             time_thermal(Path(tmp), n)

@@ -3,7 +3,10 @@
  * LoadLibrary on Windows: the same source is cross-compiled with zig and run under Wine),
  * run a deterministic input sequence, print the final outputs and the time per step.
  *
- *   fmi2_host LIBRARY RESOURCE_URI GUID STEPS STEP_SIZE
+ *   fmi2_host LIBRARY RESOURCE_URI GUID STEPS STEP_SIZE [checksum]
+ *
+ * With "checksum", also prints an FNV-1a 64 hash of the bytes of every step's outputs (a bit-for-bit
+ * comparison of two builds over the whole sequence; benchmarks/fmu.py, tests/test_native_speed.py).
  *
  * Inputs at step k: x_to = 0.003 + 0.005 * ((k * 7919) % 1000) / 1000 m,
  *                   theta_cm = 300 + 300 * ((k * 104729) % 1000) / 1000 K.
@@ -12,6 +15,7 @@
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 #include "host_platform.h" /* LIB, OPEN, SYM, CLOSE, now_s() */
 
 #include "fmi2Functions.h"
@@ -39,8 +43,10 @@ int main(int argc, char **argv) {
     fmi2CallbackFunctions cb = {logger, calloc, free, NULL, NULL};
     fmi2Component c;
     double t0, t1;
-    if (argc != 6) {
-        fprintf(stderr, "usage: %s LIBRARY RESOURCE_URI GUID STEPS STEP_SIZE\n", argv[0]);
+    unsigned long long hash = 14695981039346656037ULL;
+    int checksum = argc == 7 && !strcmp(argv[6], "checksum");
+    if (argc != 6 && !checksum) {
+        fprintf(stderr, "usage: %s LIBRARY RESOURCE_URI GUID STEPS STEP_SIZE [checksum]\n", argv[0]);
         return 2;
     }
     steps = atol(argv[4]);
@@ -68,10 +74,16 @@ int main(int argc, char **argv) {
                 return 1;
             }
             t += h;
+            if (checksum) {
+                const unsigned char *b = (const unsigned char *)out;
+                size_t j;
+                for (j = 0; j < sizeof out; ++j) hash = (hash ^ b[j]) * 1099511628211ULL;
+            }
         }
         t1 = now_s();
         printf("outputs %.17g %.17g %.17g %.17g %.17g\n", out[0], out[1], out[2], out[3], out[4]);
         printf("us_per_step %.4f\n", (t1 - t0) * 1e6 / steps);
+        if (checksum) printf("checksum %016llx\n", hash);
         fmi2Terminate(c);
         fmi2FreeInstance(c);
     }

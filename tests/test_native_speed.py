@@ -1,0 +1,161 @@
+"""The native step's caches are exact: the branch-free interval search, the table-interval hint, the Newton hints and the
+frame memo of the cover (fmu_src/clutch_tables.c, clutch_cover.c) give the same bits as the plain searches and
+a freshly prepared cover, over random sequences (a C driver over the shipped default tables).
+
+Their speed is measured by ``python -m cushion_clutch.benchmarks.fmu`` (the C host's time per step) and with
+callgrind (docs/reference/fmu.md); the C host's ``checksum`` mode compares two builds bit for bit."""
+import shutil
+import subprocess
+import zipfile
+
+import pytest
+from fmpy import read_model_description
+
+from cushion_clutch.data import DEFAULT_TABLES, fmu_sources
+from cushion_clutch.fmu.build import build_fmu
+from cushion_clutch.fmu.native import fmi2_header_dir, stage_sources
+from cushion_clutch.model.table_format import table_set_x_kiss_ref
+
+pytestmark = pytest.mark.fmu
+
+DRIVER = r"""
+#define CC_DEFINE_VARIABLE_TABLE
+#include "clutch_core.h"
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+static unsigned long long rng = 88172645463325252ULL;
+static double urand(void) { /* xorshift64, [0, 1) */
+    rng ^= rng << 13; rng ^= rng >> 7; rng ^= rng << 17;
+    return (double)(rng >> 11) / 9007199254740992.0;
+}
+
+static int bsearch_interval(const Curve *c, double u) { /* the plain search */
+    int lo = 0, hi = c->n - 1;
+    while (hi - lo > 1) { int mid = (lo + hi) / 2; if (c->x[mid] <= u) lo = mid; else hi = mid; }
+    return lo;
+}
+
+static int same(const void *a, const void *b, size_t n) { return memcmp(a, b, n) == 0; }
+
+static int same_bracket(const TBracket *a, const TBracket *b) { /* field by field: the struct has padding */
+    return a->c0 == b->c0 && a->c1 == b->c1 && a->i == b->i && same(&a->w, &b->w, 8) &&
+           same(&a->first, &b->first, 8) && same(&a->full, &b->full, 8) && same(&a->r0, &b->r0, 8) &&
+           same(&a->r1, &b->r1, 8);
+}
+
+int main(int argc, char **argv) {
+    Table tb;
+    char err[600];
+    double r[CC_NVARS];
+    CcCover warm, cold;
+    long k, bad = 0, checked = 0;
+    int t, j, hint = 0;
+    if (argc != 2 || cc_table_load(&tb, argv[1], err, sizeof err) != 0) { printf("load failed %s\n", err); return 2; }
+    for (k = 0; k < CC_NVARS; ++k) r[k] = CC_VARIABLES[k].start;
+    /* 1: the locator finds the binary search's interval: at every knot, its neighbours, and random points */
+    for (t = 0; t < tb.nt; ++t) {
+        const Curve *c = &tb.curves[t];
+        for (j = 0; j < c->n; ++j) {
+            double pts[3] = {c->x[j], nextafter(c->x[j], -INFINITY), nextafter(c->x[j], INFINITY)};
+            int q;
+            for (q = 0; q < 3; ++q) {
+                double u = pts[q];
+                if (!(u > c->x[0] && u < c->x[c->n - 1])) continue;
+                ++checked;
+                if (cc_curve_locate(c, u) != bsearch_interval(c, u)) { ++bad; printf("locate mismatch t %d u %.17g\n", t, u); }
+            }
+        }
+        for (k = 0; k < 20000; ++k) {
+            double u = c->x[0] + (c->x[c->n - 1] - c->x[0]) * urand();
+            if (!(u > c->x[0])) continue;
+            ++checked;
+            if (cc_curve_locate(c, u) != bsearch_interval(c, u)) { ++bad; printf("locate mismatch t %d u %.17g\n", t, u); }
+        }
+    }
+    /* 2: the bracket with the interval hint equals the one without (table temperatures, beyond both ends) */
+    for (k = 0; k < 20000; ++k) {
+        TBracket a, b;
+        double th = k % 7 == 0 ? tb.theta[k % tb.nt] : -80.0 + 500.0 * urand();
+        if (k % 11 == 0) th = nextafter(tb.theta[k % tb.nt], k % 2 ? INFINITY : -INFINITY);
+        cc_table_bracket(&tb, th, &a);
+        cc_table_bracket_hint(&tb, th, &b, &hint);
+        ++checked;
+        if (!same_bracket(&a, &b) || cc_table_delta(&tb, th) != cc_table_delta_at(&tb, &b)) {
+            ++bad; printf("bracket mismatch theta %.17g\n", th);
+        }
+    }
+    /* 3: a warm cover (hints and frame memo from every call before) answers as a freshly prepared one:
+          random bearing positions over the stroke, temperatures that repeat, sit on the tables or beyond */
+    cc_cover_prepare(&warm, r + VR_DIAPHRAGM_OUTER_RADIUS_M, r[VR_LEVER_RATIO], r[VR_X_KISS_REF], &tb);
+    {
+        double th_cs = 350.0, th_cm = 360.0, wear = 0.0;
+        for (k = 0; k < 30000; ++k) {
+            CcCoverState a, b;
+            int ra, rb;
+            double x_to = -0.002 + 0.014 * urand();
+            if (k % 3 == 0) th_cs = 250.0 + 400.0 * urand();      /* else: the same frame, a new x_to */
+            if (k % 17 == 0) th_cs = tb.theta[k % tb.nt] + 273.15;  /* a table temperature (w = 0) */
+            if (k % 5 == 0) th_cm = 250.0 + 400.0 * urand();
+            if (k % 101 == 0) wear = 0.001 * urand();
+            ra = cc_cover_state(&warm, &tb, x_to, th_cs, th_cm, wear, &a);
+            cc_cover_prepare(&cold, r + VR_DIAPHRAGM_OUTER_RADIUS_M, r[VR_LEVER_RATIO], r[VR_X_KISS_REF], &tb);
+            rb = cc_cover_state(&cold, &tb, x_to, th_cs, th_cm, wear, &b);
+            ++checked;
+            if (ra != rb || !same(&a, &b, sizeof a)) {
+                ++bad;
+                if (bad < 10) printf("cover mismatch x_to %.17g theta_cs %.17g theta_cm %.17g\n", x_to, th_cs, th_cm);
+            }
+        }
+    }
+    cc_table_free(&tb);
+    printf("checked %ld mismatches %ld\n", checked, bad);
+    return bad != 0;
+}
+"""
+
+
+def test_caches_give_the_bits_of_the_plain_searches_and_a_cold_cover(tmp_path):
+    cc = shutil.which("gcc")
+    if cc is None:
+        pytest.skip("gcc not installed")
+    src = tmp_path / "src"
+    stage_sources(src, "{00000000-0000-0000-0000-000000000000}", 2, table_set_x_kiss_ref(DEFAULT_TABLES))
+    (src / "driver.c").write_text(DRIVER)
+    res_dir = tmp_path / "res"
+    res_dir.mkdir()
+    (res_dir / "tables").symlink_to(DEFAULT_TABLES)
+    exe = tmp_path / "driver"
+    subprocess.run([cc, "-std=c99", "-O2", "-Wall", f"-I{src}", *(str(src / f) for f in
+                    ("driver.c", "clutch_tables.c", "clutch_cover.c", "resource_uri.c")), "-o", str(exe), "-lm"],
+                   check=True)
+    res = subprocess.run([str(exe), str(res_dir)], capture_output=True, text=True, timeout=120)
+    assert res.returncode == 0, res.stdout[-2000:] + res.stderr[-2000:]
+    checked = int(res.stdout.split()[-3])
+    assert checked > 100_000 and res.stdout.strip().endswith("mismatches 0")
+
+
+def test_c_host_checksum_is_deterministic_and_independent_of_the_compiler(tmp_path):
+    """The host's checksum mode: the FMU's own (zig-built) binary and a gcc -O2 build of its sources give the
+    same bits for every output of every step (no contraction into FMA, no x87: the arithmetic is IEEE double)."""
+    cc = shutil.which("gcc")
+    if cc is None:
+        pytest.skip("gcc not installed")
+    fmu = build_fmu(DEFAULT_TABLES, tmp_path / "native.fmu", backend="native")
+    unzip = tmp_path / "fmu"
+    zipfile.ZipFile(fmu).extractall(unzip)
+    host = tmp_path / "host"
+    subprocess.run([cc, "-std=c99", "-D_POSIX_C_SOURCE=199309L", "-O2", f"-I{fmi2_header_dir()}",
+                    str(fmu_sources() / "hosts" / "fmi2_host.c"), "-o", str(host), "-ldl"], check=True)
+    gcc_lib = tmp_path / "gcc.so"
+    files = [str(p) for p in sorted((unzip / "sources").glob("*.c"))]
+    subprocess.run([cc, "-std=c99", "-O2", "-fPIC", "-shared", "-fvisibility=hidden", f"-I{unzip / 'sources'}",
+                    *files, "-o", str(gcc_lib), "-lm"], check=True)
+    guid = read_model_description(str(fmu)).guid
+    sums = []
+    for lib in (unzip / "binaries/linux64/CushionClutch.so", gcc_lib, gcc_lib):
+        out = subprocess.run([str(host), str(lib), (unzip / "resources").as_uri(), guid, "20000", "0.001",
+                              "checksum"], capture_output=True, text=True, check=True).stdout
+        sums.append(next(ln.split()[1] for ln in out.splitlines() if ln.startswith("checksum")))
+    assert len(sums[0]) == 16 and sums[0] == sums[1] == sums[2]

@@ -173,7 +173,7 @@ class EkfParams(Checked):
     mu_slope_sd: float = 0.03
     """prior sd of the friction's slip-speed slope, 1 per 100 rad/s (0: mu does not depend on the slip)"""
     mu_slope_walk_per_s: float = 1e-7
-    mu_slope_evidence_sd: float = 2.0
+    mu_slope_evidence_sd: float = 1.0
     """the slope is applied only beyond this many of its standard deviations (by the excess)"""
     """random walk of the slip-speed slope, 1/s"""
     torque_sd_Nm: float = 8.0
@@ -321,6 +321,9 @@ class ClutchEkf:
         #: the friction has changed since the gain was referenced by more than its accuracy (applied), the
         #: ratio of that change to the accuracy, and the count of consecutive updates above it
         self.mu_evidence, self.mu_evidence_ratio, self._mu_over = False, 0.0, 0
+        #: the filter's torque over the prior's at the highest evidence torque (its touch point against the
+        #: prior's), 1: scales the friction applied on friction evidence alone
+        self._mu_dx_factor = 1.0
         #: the friction scale's sd when the gain was last referenced, 1
         self.gain_ref_sd = e.mu_deadband
 
@@ -393,8 +396,10 @@ class ClutchEkf:
         the estimate's stated accuracy is not attributed to the clutch.
         """
         band = self.e.mu_deadband
-        if (self.evidence or self.mu_evidence) and self.gain_ref is not None:
+        if self.evidence and self.gain_ref is not None:
             return float(self.s[IX_MU]) / self.gain_ref
+        if self.mu_evidence:                    # with the prior's touch point: the filter's torque at the top
+            return float(self.s[IX_MU]) / self.gain_ref * self._mu_dx_factor       # evidence torque
         d = (self.s[IX_MU] if self.evidence else self.mu_prior) - 1.0
         return 1.0 + (d - band if d > band else (d + band if d < -band else 0.0))
 
@@ -488,6 +493,10 @@ class ClutchEkf:
         if self.gain_ref is not None:                   # a change of the friction since the gain was referenced
             g_res = min(e.mu_deadband, 2.0 * self.gain_ref_sd)
             mu = float(s[IX_MU]) / self.gain_ref
+            if pts:                 # the filter's friction and touch point against the prior's touch point
+                x, t0 = pts[-1][0], pts[-1][1]
+                self._mu_dx_factor = outputs(x + dx0 - float(s[IX_DX]), th, self.table, self.p, theta_cm).torque / t0
+            mu *= self._mu_dx_factor
             r = abs(mu - mu0) / (mu0 * g_res) if g_res > 0.0 else math.inf
             self.mu_evidence_ratio = r
             self._mu_over = self._mu_over + 1 if r > e.evidence_threshold else 0

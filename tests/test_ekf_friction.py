@@ -84,3 +84,10 @@ def test_fade_on_hot_facings_is_applied_relative_to_the_gain_learned_cool(table)
     assert ekf.mu_evidence and not ekf.evidence and ekf.dx_used == 0.0     # the friction only
     assert ekf.mu_used == pytest.approx(0.85, abs=0.03)
     assert first > 8.0 and last < 0.7 * first               # N.m
+
+
+def test_friction_parameters_are_checked():
+    from cushion_clutch.errors import ParameterError
+    with pytest.raises(ParameterError) as err:
+        EkfParams(mu_slope_sd=-0.1, mu_walk_per_K=2.0)
+    assert "ekf.mu_slope_sd" in str(err.value) and "ekf.mu_walk_per_K" in str(err.value)

@@ -76,6 +76,17 @@ State (K for each network node and the cushion spring, m, 1, 1, 1)::
 
 A torque residual larger than ``gate_sd`` standard deviations is rejected.
 
+**Friction that depends on slip speed and fades** (docs/explanation/production_tcu.md, section 5).
+The friction is ``mu_scale + slope (|slip| - SLIP_REF_RAD_S) / SLIP_UNIT_RAD_S`` at the measured slip:
+the slope is a state (prior 0, sd ``mu_slope_sd``), corrected with ``mu_scale`` and applied beyond
+``mu_slope_evidence_sd`` of its standard deviation. ``mu_scale``'s variance grows by ``mu_walk_per_K``
+per kelvin the estimated facings heat above ``mu_reference_max_degC``. Below that temperature the
+nominal mu is taken to hold, so ``mu_scale`` there (within 1 +- ``mu_deadband``) is the engine torque
+estimate's gain, ``gain_ref``; above, a change of ``mu_scale / gain_ref`` beyond twice the scale's sd at
+referencing is friction evidence of its own: it applies the friction with the gain cancelled (and the
+filter's characteristic at the highest evidence torque against the prior's touch point), not the touch
+point.
+
 **The nominal calibration as the prior** (what the TCU *applies*). The torque
 the EKF learns against is the engine control unit's estimate, whose stated
 accuracy is ``mu_deadband`` in gain and ``torque_offset_accuracy_Nm`` in offset,
@@ -228,7 +239,8 @@ class EkfParams(Checked):
             "period_s": (1e-3, 10.0), "theta0_sd_K": (0.0, 500.0), "heat_share_sd": (0.0, 10.0),
             "theta_walk_K2_per_s": (0.0, 1e4), "kiss_sd_m": (0.0, 0.01), "kiss_walk_m2_per_s": (0.0, 1e-3),
             "mu_sd": (0.0, 1.0), "mu_walk_per_s": (0.0, 1.0),
-            "mu_walk_per_K": (0.0, 1.0), "mu_reference_max_degC": (-50.0, 1000.0), "mu_slope_sd": (0.0, 1.0), "mu_slope_walk_per_s": (0.0, 1.0),
+            "mu_walk_per_K": (0.0, 1.0), "mu_reference_max_degC": (-50.0, 1000.0), "mu_slope_sd": (0.0, 1.0),
+            "mu_slope_walk_per_s": (0.0, 1.0),
             "mu_slope_evidence_sd": (0.0, 100.0), "torque_sd_Nm": (1e-3, 1e3),
             "slip_min_rad_s": (0.0, 1e3), "touch_torque_min_Nm": (0.0, 1e4), "touch_torque_max_Nm": (0.0, 1e4),
             "mu_torque_min_Nm": (0.0, 1e4), "gate_sd": (1.0, 100.0, True),

@@ -76,6 +76,17 @@ State (K for each network node and the cushion spring, m, 1, 1, 1)::
 
 A torque residual larger than ``gate_sd`` standard deviations is rejected.
 
+**Friction that depends on slip speed and fades** (docs/explanation/production_tcu.md, section 5).
+The friction is ``mu_scale + slope (|slip| - SLIP_REF_RAD_S) / SLIP_UNIT_RAD_S`` at the measured slip:
+the slope is a state (prior 0, sd ``mu_slope_sd``), corrected with ``mu_scale`` and applied beyond
+``mu_slope_evidence_sd`` of its standard deviation. ``mu_scale``'s variance grows by ``mu_walk_per_K``
+per kelvin the estimated facings heat above ``mu_reference_max_degC``. Below that temperature the
+nominal mu is taken to hold, so ``mu_scale`` there (within 1 +- ``mu_deadband``) is the engine torque
+estimate's gain, ``gain_ref``; above, a change of ``mu_scale / gain_ref`` beyond twice the scale's sd at
+referencing is friction evidence of its own: it applies the friction with the gain cancelled (and the
+filter's characteristic at the highest evidence torque against the prior's touch point), not the touch
+point.
+
 **The nominal calibration as the prior** (what the TCU *applies*). The torque
 the EKF learns against is the engine control unit's estimate, whose stated
 accuracy is ``mu_deadband`` in gain and ``torque_offset_accuracy_Nm`` in offset,
@@ -119,7 +130,12 @@ SPEED_BAND = 10.0
 #: the engine control unit's torque offset: the last state, after the temperatures, the touch point, mu and
 #: the two thermal scales
 IX_OFF = N_STATE
-N_STATE = IX_OFF + 1
+#: the friction's slip-speed slope (per :data:`SLIP_UNIT_RAD_S` of slip, about :data:`SLIP_REF_RAD_S`): the last state
+IX_SLOPE = IX_OFF + 1
+N_STATE = IX_SLOPE + 1
+#: slip speed about which the friction scale is stated, and the unit of the slope, rad/s
+SLIP_REF_RAD_S = 150.0
+SLIP_UNIT_RAD_S = 100.0
 #: nominal torques at which the learned characteristic is compared with the nominal one, N.m
 EVIDENCE_TORQUES_NM = (10.0, 20.0, 40.0, 80.0, 120.0)
 
@@ -157,6 +173,20 @@ class EkfParams(Checked):
     kiss_walk_m2_per_s: float = 1e-12
     mu_sd: float = 0.1
     mu_walk_per_s: float = 1e-6
+    mu_walk_per_K: float = 5e-4
+    """variance of the friction scale's random walk per kelvin the estimated facings heat above
+    ``mu_reference_max_degC``, 1/K (a facing's friction changes with its temperature, by an amount the
+    calibration does not know: fade)"""
+    mu_reference_max_degC: float = 80.0
+    """friction updates while the estimated facings are below this temperature (degC) learn the engine
+    torque estimate's gain (the nominal mu holds on cool facings); above, ``mu_scale`` relative to it is the
+    clutch's friction"""
+    mu_slope_sd: float = 0.03
+    """prior sd of the friction's slip-speed slope, 1 per 100 rad/s (0: mu does not depend on the slip)"""
+    mu_slope_walk_per_s: float = 1e-7
+    mu_slope_evidence_sd: float = 1.0
+    """the slope is applied only beyond this many of its standard deviations (by the excess)"""
+    """random walk of the slip-speed slope, 1/s"""
     torque_sd_Nm: float = 8.0
     """measurement noise of the engine-side clutch torque"""
     slip_min_rad_s: float = 10.0
@@ -208,7 +238,10 @@ class EkfParams(Checked):
         yield from self._ranges({
             "period_s": (1e-3, 10.0), "theta0_sd_K": (0.0, 500.0), "heat_share_sd": (0.0, 10.0),
             "theta_walk_K2_per_s": (0.0, 1e4), "kiss_sd_m": (0.0, 0.01), "kiss_walk_m2_per_s": (0.0, 1e-3),
-            "mu_sd": (0.0, 1.0), "mu_walk_per_s": (0.0, 1.0), "torque_sd_Nm": (1e-3, 1e3),
+            "mu_sd": (0.0, 1.0), "mu_walk_per_s": (0.0, 1.0),
+            "mu_walk_per_K": (0.0, 1.0), "mu_reference_max_degC": (-50.0, 1000.0), "mu_slope_sd": (0.0, 1.0),
+            "mu_slope_walk_per_s": (0.0, 1.0),
+            "mu_slope_evidence_sd": (0.0, 100.0), "torque_sd_Nm": (1e-3, 1e3),
             "slip_min_rad_s": (0.0, 1e3), "touch_torque_min_Nm": (0.0, 1e4), "touch_torque_max_Nm": (0.0, 1e4),
             "mu_torque_min_Nm": (0.0, 1e4), "gate_sd": (1.0, 100.0, True),
             "mu_deadband": (0.0, 0.5), "torque_offset_accuracy_Nm": (0.0, 100.0),
@@ -272,6 +305,13 @@ class ClutchEkf:
         self.P = np.pad(self.P, (0, 1))
         self.P[IX_OFF, IX_OFF] = e.torque_offset_accuracy_Nm ** 2
         self.q_rw = np.append(self.q_rw, e.offset_walk_Nm2_per_s)
+        # the friction's slip-speed slope, appended: prior 0 (the nominal mu is constant) with sd mu_slope_sd
+        self.s = np.append(self.s, 0.0)
+        self.P = np.pad(self.P, (0, 1))
+        self.P[IX_SLOPE, IX_SLOPE] = e.mu_slope_sd ** 2
+        self.q_rw = np.append(self.q_rw, e.mu_slope_walk_per_s if e.mu_slope_sd > 0.0 else 0.0)
+        #: the measured slip speed the characteristic is evaluated at (:meth:`set_slip`), rad/s
+        self.slip = SLIP_REF_RAD_S
         self.energy_J = 0.0
         self.t_acc = 0.0
         self._cache: dict = {}
@@ -287,6 +327,17 @@ class ClutchEkf:
         self._over = 0
         #: the last ratio of that difference to the bias envelope (max over EVIDENCE_TORQUES_NM), 1
         self.evidence_ratio = 0.0
+        #: the engine torque estimate's gain as learned on cool facings (``mu_scale`` there, within 1 +-
+        #: ``mu_deadband``), or None before any friction update on cool facings
+        self.gain_ref: float | None = None
+        #: the friction has changed since the gain was referenced by more than its accuracy (applied), the
+        #: ratio of that change to the accuracy, and the count of consecutive updates above it
+        self.mu_evidence, self.mu_evidence_ratio, self._mu_over = False, 0.0, 0
+        #: the filter's torque over the prior's at the highest evidence torque (its touch point against the
+        #: prior's), 1: scales the friction applied on friction evidence alone
+        self._mu_dx_factor = 1.0
+        #: the friction scale's sd when the gain was last referenced, 1
+        self.gain_ref_sd = e.mu_deadband
 
     # --- estimates -----------------------------------------------------------------------------
     @property
@@ -339,6 +390,7 @@ class ClutchEkf:
         pm[IX_DX, IX_DX] = dx_sd_m ** 2
         self.dx_prior, self.mu_prior, self.x_accuracy = dx_m, mu_scale, dx_sd_m
         self.evidence, self.evidence_ratio, self._over = False, 0.0, 0
+        self.mu_evidence, self.mu_evidence_ratio, self._mu_over = False, 0.0, 0
 
     @property
     def dx_used(self) -> float:
@@ -355,9 +407,28 @@ class ClutchEkf:
         estimate, so it carries that estimate's gain error; a deviation within
         the estimate's stated accuracy is not attributed to the clutch.
         """
-        d = (self.s[IX_MU] if self.evidence else self.mu_prior) - 1.0
         band = self.e.mu_deadband
+        if self.evidence and self.gain_ref is not None:
+            return float(self.s[IX_MU]) / self.gain_ref
+        if self.mu_evidence:                    # with the prior's touch point: the filter's torque at the top
+            return float(self.s[IX_MU]) / self.gain_ref * self._mu_dx_factor       # evidence torque
+        d = (self.s[IX_MU] if self.evidence else self.mu_prior) - 1.0
         return 1.0 + (d - band if d > band else (d + band if d < -band else 0.0))
+
+    @property
+    def mu_applied(self) -> float:
+        """The friction relative to the nominal mu the TCU applies at the measured slip: :attr:`mu_used` plus
+        the slip-speed slope's term (:meth:`mu_factor`), 1."""
+        return self.mu_used + self.slope_used * (abs(self.slip) - SLIP_REF_RAD_S) / SLIP_UNIT_RAD_S
+
+    @property
+    def slope_used(self) -> float:
+        """The slip-speed slope of the friction the TCU applies (per ``SLIP_UNIT_RAD_S``): the learned slope
+        beyond ``mu_slope_evidence_sd`` of its standard deviation (0 while the filter cannot tell it from
+        none: the nominal mu is constant), 1."""
+        d, band = float(self.s[IX_SLOPE]), self.e.mu_slope_evidence_sd * math.sqrt(max(float(self.P[IX_SLOPE,
+                                                                                                   IX_SLOPE]), 0.0))
+        return d - band if d > band else (d + band if d < -band else 0.0)
 
     def model_torque(self, x_m: float, s: np.ndarray | None = None, mu: float | None = None) -> float:
         """The TCU's torque at bearing position ``x_m`` (m) with state ``s`` (default: the estimate), N.m.
@@ -367,15 +438,26 @@ class ClutchEkf:
         s = self.s if s is None else s
         th = min(max(float(s[IX_CS]), self.table.theta_min_K), self.table.theta_max_K)
         theta_cm = float(0.5 * (s[F1] + s[F2]))          # the stack's growth at the estimated facing temperature
-        return (float(s[IX_MU]) if mu is None else mu) * outputs(x_m - float(s[IX_DX]), th, self.table, self.p,
-                                                                 theta_cm).torque
+        return self.mu_factor(s, mu) * outputs(x_m - float(s[IX_DX]), th, self.table, self.p, theta_cm).torque
 
-    def used_torque(self, x_m: float) -> float:
-        """The torque the TCU applies at the measured bearing position ``x_m`` (m): :attr:`dx_used`,
-        :attr:`mu_used`, N.m."""
+    def mu_factor(self, s: np.ndarray | None = None, mu: float | None = None) -> float:
+        """Friction relative to the nominal mu at the measured slip :attr:`slip`: the scale (``mu`` if given)
+        plus the slip-speed slope times ``(|slip| - SLIP_REF_RAD_S) / SLIP_UNIT_RAD_S``, 1."""
+        s = self.s if s is None else s
+        return ((float(s[IX_MU]) if mu is None else mu)
+                + float(s[IX_SLOPE]) * (abs(self.slip) - SLIP_REF_RAD_S) / SLIP_UNIT_RAD_S)
+
+    def set_slip(self, w_slip_rad_s: float) -> None:
+        """The measured slip speed (rad/s) at which the characteristic is evaluated from now on."""
+        self.slip = abs(w_slip_rad_s)
+
+    def used_torque(self, x_m: float, mu: float | None = None) -> float:
+        """The torque the TCU applies at the measured bearing position ``x_m`` (m): :attr:`dx_used` and
+        :attr:`mu_applied` (``mu`` replaces the latter), N.m."""
         s = self.s.copy()
         s[IX_DX] = self.dx_used
-        return self.model_torque(x_m, s, mu=self.mu_used)
+        s[IX_SLOPE] = 0.0 if mu is not None else self.slope_used
+        return self.model_torque(x_m, s, mu=self.mu_used if mu is None else mu)
 
     def update_evidence(self) -> bool:
         """Compare the learned characteristic with the nominal one; set and return :attr:`evidence`.
@@ -408,9 +490,11 @@ class ClutchEkf:
             if len(self._ev_cache) > 4096:
                 self._ev_cache.clear()
             self._ev_cache[key] = pts
-        mu, dx = float(s[IX_MU]), float(s[IX_DX])
-        ratio = 0.0
         dx0, mu0 = self.dx_prior, self.mu_prior
+        # before the gain is referenced the touch point and the friction are judged together (nearly collinear,
+        # module docstring); after, the friction has its own evidence (below) and this is the touch point's
+        mu, dx = (float(s[IX_MU]) if self.gain_ref is None else mu0), float(s[IX_DX])
+        ratio = 0.0
         for x, t0, env0, slope in pts:                  # the prior's position for each nominal torque
             env = mu0 * (env0 + slope * self.x_accuracy)
             d = abs(mu * outputs(x + dx0 - dx, th, self.table, self.p, theta_cm).torque - mu0 * t0)
@@ -418,6 +502,17 @@ class ClutchEkf:
         self.evidence_ratio = ratio
         self._over = self._over + 1 if ratio > e.evidence_threshold else 0
         self.evidence = self._over >= e.evidence_confirm or (self.evidence and ratio > e.evidence_release)
+        if self.gain_ref is not None:                   # a change of the friction since the gain was referenced
+            g_res = min(e.mu_deadband, 2.0 * self.gain_ref_sd)
+            mu = float(s[IX_MU]) / self.gain_ref
+            if pts:                 # the filter's friction and touch point against the prior's touch point
+                x, t0 = pts[-1][0], pts[-1][1]
+                self._mu_dx_factor = outputs(x + dx0 - float(s[IX_DX]), th, self.table, self.p, theta_cm).torque / t0
+            mu *= self._mu_dx_factor
+            r = abs(mu - mu0) / (mu0 * g_res) if g_res > 0.0 else math.inf
+            self.mu_evidence_ratio = r
+            self._mu_over = self._mu_over + 1 if r > e.evidence_threshold else 0
+            self.mu_evidence = self._mu_over >= e.evidence_confirm or (self.mu_evidence and r > e.evidence_release)
         return self.evidence
 
     # --- prediction ----------------------------------------------------------------------------
@@ -513,6 +608,9 @@ class ClutchEkf:
         self.s = s_new
         qn = self.q_rw * dt
         qn[:N_T] += (self.e.heat_share_sd * k_heat * q * dt) ** 2
+        ref = self.e.mu_reference_max_degC + 273.15      # the friction may change as the facings heat above it
+        d_cm = max(0.5 * float(s_new[F1] + s_new[F2]), ref) - max(0.5 * float(s[F1] + s[F2]), ref)
+        qn[IX_MU] += self.e.mu_walk_per_K * max(d_cm, 0.0)
         self.P = f @ self.P @ f.T + np.diag(qn)
         self.energy_J = self.t_acc = 0.0
 
@@ -527,6 +625,7 @@ class ClutchEkf:
         e = self.e
         if not launching or abs(w_slip_rad_s) < e.slip_min_rad_s:
             return False
+        self.set_slip(w_slip_rad_s)
         h0 = self.model_torque(x_meas_m)
         off = float(self.s[IX_OFF])
         mask = np.zeros(N_STATE, dtype=bool)
@@ -534,6 +633,7 @@ class ClutchEkf:
             mask[IX_DX] = True
         if h0 >= e.mu_torque_min_Nm:
             mask[IX_MU] = True
+            mask[IX_SLOPE] = e.mu_slope_sd > 0.0
         if not mask.any():
             return False
         mask[IX_OFF] = True
@@ -547,7 +647,9 @@ class ClutchEkf:
             sp[i] += d
             hrow[i] = (self.model_torque(x_meas_m, sp) - h0) / d
         hrow[F2] = hrow[F1]                   # the stack grows with the facings' mean: both enter alike
-        hrow[IX_MU] = h0 / max(self.mu_scale, 1e-6)
+        t_nominal = h0 / max(self.mu_factor(), 1e-6)
+        hrow[IX_MU] = t_nominal
+        hrow[IX_SLOPE] = t_nominal * (self.slip - SLIP_REF_RAD_S) / SLIP_UNIT_RAD_S
         hrow[IX_OFF] = 1.0
         r = (e.torque_sd_Nm if torque_sd_Nm is None else torque_sd_Nm) ** 2
         s_inn = float(hrow @ self.P @ hrow) + r
@@ -562,6 +664,10 @@ class ClutchEkf:
         ikh = np.eye(N_STATE) - np.outer(k, hrow)
         self.P = ikh @ self.P @ ikh.T + r * np.outer(k, k)
         self.accepted += 1
+        if mask[IX_MU] and self.theta_cm < e.mu_reference_max_degC + 273.15:
+            band = e.mu_deadband
+            self.gain_ref = min(max(self.mu_scale, 1.0 - band), 1.0 + band)
+            self.gain_ref_sd = math.sqrt(max(float(self.P[IX_MU, IX_MU]), 0.0))
         if mask[IX_DX] or mask[IX_MU]:
             self.update_evidence()
         return True

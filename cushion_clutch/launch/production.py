@@ -104,21 +104,22 @@ class ProductionTcu(TcuController):
     def command(self, torque_Nm: float) -> float:
         """Bearing position for ``torque_Nm`` (N.m) as the position sensor reads it, m."""
         th = min(max(self.ekf.theta_cs, self.table.theta_min_K), self.table.theta_max_K)
-        return (x_to_for_torque(torque_Nm / max(self.ekf.mu_used, 1e-3), th, self.table, self.p,
+        return (x_to_for_torque(torque_Nm / max(self.ekf.mu_applied, 1e-3), th, self.table, self.p,
                                 theta_cm=self.theta_cm_used()) + self.ekf.dx_used)
 
     def model_torque(self, x_m: float) -> float:
         """Torque the TCU believes at the true bearing position ``x_m`` (it sees it through its sensor), N.m.
 
         The value at the closed position (asked every launch cycle for the capacity limit) is kept
-        until the EKF's estimate changes (every ``ekf.period_s`` at most).
+        until the EKF's estimate changes (every ``ekf.period_s`` at most), and scaled by the friction the TCU
+        applies at the measured slip.
         """
         e = self.ekf
         if x_m == self.sc.tcu.x_to_closed_m:
-            key = (e.theta_cs, e.theta_cm, e.dx_used, e.mu_used)
-            if key != self._closed_key:
-                self._closed_key, self._closed_value = key, e.used_torque(x_m + self.x_offset)
-            return self._closed_value
+            key = (e.theta_cs, e.theta_cm, e.dx_used)
+            if key != self._closed_key:                 # the nominal-friction torque; the friction scales it
+                self._closed_key, self._closed_value = key, e.used_torque(x_m + self.x_offset, mu=1.0)
+            return self._closed_value * e.mu_applied
         return e.used_torque(x_m + self.x_offset)
 
     # --- sensing -------------------------------------------------------------------------------------
@@ -145,6 +146,7 @@ class ProductionTcu(TcuController):
         readings = (w_e, w_d, x_meas, t_est)
         launching = self.phase == LAUNCH
         slip = w_e - w_d
+        e.set_slip(slip)                  # the characteristic (friction) at the measured slip speed
         if len(self.hist) <= WINDOW:
             return readings
         if self.phase == OPEN:            # clutch open: no clutch torque, no RLS update, no correction

@@ -1,0 +1,93 @@
+"""The production TCU's EKF: friction that depends on the slip speed, and friction fade on hot facings
+referenced to the engine torque estimate's gain learned on cool ones."""
+import numpy as np
+import pytest
+
+from cushion_clutch.launch.ekf import F1, F2, ClutchEkf, EkfParams, TcuNetworkParams
+from cushion_clutch.model import ClutchParameters, load_table, outputs, x_to_for_torque
+
+TA = 293.15
+#: the launch: torque demand (N.m) and slip speed (rad/s) falling from 300 rad/s to lock-up
+RAMP = np.concatenate([np.linspace(20.0, 180.0, 30), np.full(30, 180.0)])
+SLIP = np.linspace(300.0, 15.0, len(RAMP))
+
+
+@pytest.fixture(scope="module")
+def table():
+    return load_table()
+
+
+def launch(ekf, table, p, mu_true, gain=0.0, offset=0.0):
+    """One launch on a clutch of friction ``mu_true(slip)`` (relative to nominal) at the EKF's own
+    temperatures (the test isolates the friction), measured through an ECU torque ``(1 + gain) T + offset``;
+    the bearing set through the characteristic the TCU applies. Returns the worst |believed - true| (N.m)."""
+    worst = 0.0
+    for t, w in zip(RAMP, SLIP):
+        ekf.set_slip(w)
+        th, tcm = ekf.theta_cs, ekf.theta_cm
+        x = x_to_for_torque(t / ekf.mu_applied, th, table, p, theta_cm=tcm) + ekf.dx_used
+        true = mu_true(w) * outputs(x, th, table, p, tcm).torque
+        worst = max(worst, abs(ekf.used_torque(x) - true))
+        ekf.accumulate(0.1, 0.0)
+        ekf.predict(190.0, 190.0 - w, True)
+        ekf.correct((1.0 + gain) * true + offset, x, w, True)
+    return worst
+
+
+def heat_facings(ekf, degC):
+    """Slip heat into the TCU's network until its facings' estimate passes ``degC`` (as on repeated launches)."""
+    while ekf.theta_cm < degC + 273.15:
+        ekf.accumulate(1.0, 40e3)
+        ekf.predict(190.0, 100.0, True)
+
+
+def test_a_slip_speed_dependent_friction_is_learned_and_applied(table):
+    """mu falls by 4 % per 100 rad/s of slip (about 150 rad/s: +6 % at lock-up): one scale cannot follow it."""
+    p = ClutchParameters()
+    mu = lambda w: 1.0 - 0.04 * (w - 150.0) / 100.0        # noqa: E731
+    with_slope = ClutchEkf(TcuNetworkParams(), EkfParams(temperature_update=False), table, p, TA, TA)
+    scale_only = ClutchEkf(TcuNetworkParams(), EkfParams(temperature_update=False, mu_slope_sd=0.0), table, p,
+                           TA, TA)
+    for _ in range(4):
+        err = launch(with_slope, table, p, mu)
+        err_scale = launch(scale_only, table, p, mu)
+    assert with_slope.s[-1] == pytest.approx(-0.04, abs=0.01) and with_slope.slope_used < -0.02
+    assert scale_only.slope_used == 0.0
+    assert err < 0.5 * err_scale                            # N.m, the last launch
+
+
+def test_a_constant_friction_applies_no_slope(table):
+    """On a nominal clutch through a biased ECU estimate the slip sweep gives no slope to apply: the nominal
+    calibration stays (the prior)."""
+    p = ClutchParameters()
+    ekf = ClutchEkf(TcuNetworkParams(), EkfParams(temperature_update=False), table, p, TA, TA)
+    for _ in range(4):
+        launch(ekf, table, p, lambda w: 1.0, gain=0.04, offset=3.0)
+    assert ekf.slope_used == 0.0 and not ekf.evidence and ekf.mu_applied == 1.0
+
+
+def test_fade_on_hot_facings_is_applied_relative_to_the_gain_learned_cool(table):
+    """ECU gain +4 %, offset +3 N.m. On cool facings the TCU keeps the nominal calibration and references
+    the gain; after the facings heat past 250 degC the friction drops by 15 %: the TCU applies the drop with
+    the gain cancelled (the dead band alone would leave it 9 % high), and not the touch point the filter
+    has learned from the ECU's biases (no evidence for it)."""
+    p = ClutchParameters()
+    ekf = ClutchEkf(TcuNetworkParams(), EkfParams(temperature_update=False), table, p, TA, TA)
+    for _ in range(3):
+        launch(ekf, table, p, lambda w: 1.0, gain=0.04, offset=3.0)
+    assert 1.01 < ekf.gain_ref <= 1.05 and not ekf.evidence and not ekf.mu_evidence and ekf.mu_used == 1.0
+    heat_facings(ekf, 250.0)
+    assert ekf.theta_cm > 523.0 and ekf.s[F1] != ekf.s[F2]
+    first = launch(ekf, table, p, lambda w: 0.85, gain=0.04, offset=3.0)
+    for _ in range(2):
+        last = launch(ekf, table, p, lambda w: 0.85, gain=0.04, offset=3.0)
+    assert ekf.mu_evidence and not ekf.evidence and ekf.dx_used == 0.0     # the friction only
+    assert ekf.mu_used == pytest.approx(0.85, abs=0.03)
+    assert first > 8.0 and last < 0.7 * first               # N.m
+
+
+def test_friction_parameters_are_checked():
+    from cushion_clutch.errors import ParameterError
+    with pytest.raises(ParameterError) as err:
+        EkfParams(mu_slope_sd=-0.1, mu_walk_per_K=2.0)
+    assert "ekf.mu_slope_sd" in str(err.value) and "ekf.mu_walk_per_K" in str(err.value)

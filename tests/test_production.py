@@ -67,7 +67,21 @@ def test_on_a_nominal_clutch_production_is_never_worse_than_naive(plant, section
     sc = dataclasses.replace(sc, standstill=dataclasses.replace(sc.standstill, learn=learn))
     naive = simulate_launches(plant, sc, load_table(), "naive").metrics[0]["characteristic_error_max_Nm"]
     prod = simulate_launches(plant, sc, load_table(), "production")
-    assert prod.metrics[0]["characteristic_error_max_Nm"] <= naive + 0.5
+    # with standstill learning (every shipped scenario) the position sensor's offset is learned with the touch
+    # point; without it (learn = never) nothing can reveal it, and the characteristic read at the offset
+    # position differs by up to the torque's slope times the offset (the sensors' stated +20 um): allowed on top
+    allowed = naive + 0.5 + (0.0 if learn == "missing" else _offset_torque_Nm(sc.tcu_sensors.position_offset_m))
+    assert prod.metrics[0]["characteristic_error_max_Nm"] <= allowed
+
+
+def _offset_torque_Nm(offset_m: float) -> float:
+    """The largest torque change over ``offset_m`` of bearing travel below 200 N.m (20 degC, nominal clutch)."""
+    from cushion_clutch.model import ClutchParameters, outputs
+    table, p = load_table(), ClutchParameters()
+    x = np.arange(0.0, 0.015, 5e-6)
+    t = np.array([outputs(float(v), 293.15, table, p).torque for v in x])
+    x, t = x[t <= 200.0], t[t <= 200.0]
+    return float(np.max(np.interp(x + offset_m, x, t) - t))
 
 
 def test_the_temperature_estimate_holds_on_heavy_duty(plant):

@@ -1,7 +1,7 @@
 """Benchmark: real-time factor of a launch scenario for every TCU variant, or the launch results page.
 
     python -m cushion_clutch.benchmarks.launch [--scenario NAME|FILE] [--backend native|python] [--repeat N]
-    python -m cushion_clutch.benchmarks.launch --markdown [--scenarios default,trailer,creep,cooldown,fade,wear,tolerance]
+    python -m cushion_clutch.benchmarks.launch --markdown [--scenarios default,trailer,creep,cooldown,fade,wear,wear_learned,tolerance,protection]
     python -m cushion_clutch.benchmarks.launch --markdown --out docs/results/launch.md
 
 The first form also times one FMU step (set inputs, doStep, get outputs)
@@ -191,7 +191,7 @@ def main(argv=None) -> None:
     ap.add_argument("--backend", default="native", choices=("native", "python"))
     ap.add_argument("--repeat", type=int, default=1, help="runs per variant; the median is printed")
     ap.add_argument("--markdown", action="store_true", help="print the launch results tables")
-    ap.add_argument("--scenarios", default="default,trailer,creep,cooldown,fade,wear,tolerance", help="with --markdown")
+    ap.add_argument("--scenarios", default="default,trailer,creep,cooldown,fade,wear,wear_learned,tolerance,protection", help="with --markdown")
     ap.add_argument("--out", type=Path, help="with --markdown: write the results page (e.g. docs/results/launch.md)")
     args = ap.parse_args(argv)
     if args.markdown and args.out:

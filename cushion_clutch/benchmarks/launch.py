@@ -98,7 +98,7 @@ def markdown(scenarios: list[str], backend: str = "native", keep: dict | None = 
             parts = []
             sc = load_scenario(scenario_path(name))
             fmu = build_plant_fmu(DEFAULT_TABLES, sc, Path(tmp) / name / "CushionClutch.fmu", backend=backend)
-            results = run_all(fmu, sc, load_table())
+            results = run_all(fmu, sc, load_table(sc.tables_path("tcu") or DEFAULT_TABLES))
             groups = sorted({g for r in results.values() for m in r.metrics
                              for g in (("hot",) if m["hot"] and m["phase"] == "repeated" else ())
                              + (("cool-down",) if m["phase"] == "cool-down" else ())})
@@ -154,7 +154,7 @@ def check_run(backend: str = "native", launches: int = CHECK_LAUNCHES) -> str:
     sc = dataclasses.replace(sc, run=dataclasses.replace(sc.run, launches=launches))
     with tempfile.TemporaryDirectory() as tmp:
         fmu = build_plant_fmu(DEFAULT_TABLES, sc, Path(tmp) / "CushionClutch.fmu", backend=backend)
-        return check_table(run_all(fmu, sc, load_table()), launches)
+        return check_table(run_all(fmu, sc, load_table(sc.tables_path("tcu") or DEFAULT_TABLES)), launches)
 
 
 CHECK_HEADING = "## Check figures"
@@ -210,7 +210,7 @@ def main(argv=None) -> None:
         print(f"FMU step (set 3 inputs, doStep, get 3 outputs), {args.backend} FMU: {ours:.2f} us through the "
               f"cffi client, {theirs:.2f} us through fmpy FMU2Slave ({theirs / ours:.1f}x)")
         for name in VARIANTS:
-            runs = [simulate_launches(fmu, sc, load_table(), name) for _ in range(args.repeat)]
+            runs = [simulate_launches(fmu, sc, load_table(sc.tables_path("tcu") or DEFAULT_TABLES), name) for _ in range(args.repeat)]
             wall = statistics.median(r.wall_time_s for r in runs)
             cpu = statistics.median(r.cpu_time_s for r in runs)
             print(f"{name:>24} TCU: {sim:g} s simulated in {wall:.2f} s wall -> real-time factor "

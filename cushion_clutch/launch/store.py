@@ -92,30 +92,3 @@ def load_state(path: str | Path) -> AdaptedState:
     if problems:
         raise ParameterError(problems, str(path))
     return state
-
-
-def learn_state(scenario: str | Path, out: Path, tables: Path | None = None) -> Path:
-    """Run ``scenario`` with a reset production TCU and store its adapted state at key-off in ``out`` (JSON):
-    the file a scenario with ``tcu_store.start = "learned"`` starts from."""
-    import dataclasses
-    import tempfile
-
-    from ..data import DEFAULT_TABLES
-    from ..model import load_table
-    from .plant import build_plant_fmu
-    from .scenario import load_scenario, scenario_path
-    from .simulate import simulate_launches
-    from .tcu_params import TcuStore
-
-    sc = load_scenario(scenario_path(str(scenario)))
-    sc = dataclasses.replace(sc, tcu_store=TcuStore(start="reset", save=str(Path(out).resolve())))
-    tables = Path(tables or DEFAULT_TABLES)
-    with tempfile.TemporaryDirectory() as tmp:
-        fmu = build_plant_fmu(tables, sc, Path(tmp) / "CushionClutch.fmu")
-        simulate_launches(fmu, sc, load_table(sc.tables_path("tcu") or tables), "production")
-    return Path(out)
-
-
-if __name__ == "__main__":      # python -m cushion_clutch.launch.store <scenario> <out.json>
-    import sys
-    print(learn_state(sys.argv[1], Path(sys.argv[2])))

@@ -471,9 +471,11 @@ def build_parser() -> argparse.ArgumentParser:
     add_build_arguments(bf)
 
     ex = _command(sub, "export", _export, "write the tables for Simulink (.mat) and Modelica (CombiTable)",
-                  "Write cushion_spring_tables.mat (Simulink 2-D Lookup Table) and cushion_spring_tables.txt "
-                  "(Modelica CombiTable2Ds/1Ds, #1 format) with the cushion force, the kiss-point shift and "
-                  "the cover's clamp and bearing force maps.",
+                  "Write cushion_spring_tables.mat (Simulink 2-D Lookup Tables, and a 3-D clamp-force table in "
+                  "x_to, theta_cs, theta_cm for the n-D Lookup Table) and cushion_spring_tables.txt (Modelica "
+                  "CombiTable2Ds/1Ds, #1 format) with the cushion force, the kiss-point shift, the kiss point at "
+                  "the bearing and the cover's clamp and bearing force maps; each file states the torque formula, "
+                  "the parameters its tables assume and the measured error of a linear lookup.",
                   "cushion-clutch export --tables lookup_tables/default --out out_tables")
     ex.add_argument("--tables", default=DEFAULT_TABLES, help="table folder")
     _out(ex, "output folder (default: out)", default="out")

@@ -9,27 +9,12 @@
  *   MODE 1 (thermal): VR_B omega_slip = 100 rad/s, VR_C omega_engine = 150 rad/s.
  * Outputs read every step: torque 2, theta_cs 4, x_kiss 6 (the clutch model's value references in both).
  */
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 
-#include "host_platform.h" /* LIB, OPEN, SYM, CLOSE, now_s() */
+#include "host_platform.h" /* LIB, OPEN, SYM, CLOSE, LOAD, now_s() */
 #include "fmi2Functions.h"
-
-static void logger(fmi2ComponentEnvironment env, fmi2String name, fmi2Status status,
-                   fmi2String category, fmi2String message, ...) {
-    va_list ap;
-    (void)env;
-    va_start(ap, message);
-    fprintf(stderr, "[%s %d %s] ", name, (int)status, category);
-    vfprintf(stderr, message, ap);
-    fprintf(stderr, "\n");
-    va_end(ap);
-}
-
-#define LOAD(name) \
-    name##TYPE *name = (name##TYPE *)SYM(lib, #name); \
-    if (!name) { fprintf(stderr, "missing symbol %s\n", #name); return 2; }
+#include "host_fmi2_logger.h" /* logger: every message to stderr */
 
 int main(int argc, char **argv) {
     LIB lib;

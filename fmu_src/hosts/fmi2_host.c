@@ -12,28 +12,13 @@
  *                   theta_cm = 300 + 300 * ((k * 104729) % 1000) / 1000 K.
  * Value references: x_to 0, theta_cm 1, torque 2, force 3, theta_cs 4, u_f 5, x_kiss 6.
  */
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include "host_platform.h" /* LIB, OPEN, SYM, CLOSE, now_s() */
+#include "host_platform.h" /* LIB, OPEN, SYM, CLOSE, LOAD, now_s() */
 
 #include "fmi2Functions.h"
-
-static void logger(fmi2ComponentEnvironment env, fmi2String name, fmi2Status status,
-                   fmi2String category, fmi2String message, ...) {
-    va_list ap;
-    (void)env;
-    va_start(ap, message);
-    fprintf(stderr, "[%s %d %s] ", name, (int)status, category);
-    vfprintf(stderr, message, ap);
-    fprintf(stderr, "\n");
-    va_end(ap);
-}
-
-#define LOAD(name) \
-    name##TYPE *name = (name##TYPE *)SYM(lib, #name); \
-    if (!name) { fprintf(stderr, "missing symbol %s\n", #name); return 2; }
+#include "host_fmi2_logger.h" /* logger: every message to stderr */
 
 int main(int argc, char **argv) {
     LIB lib;

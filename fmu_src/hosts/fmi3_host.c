@@ -12,7 +12,7 @@
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
-#include "host_platform.h" /* LIB, OPEN, SYM, CLOSE, now_s() */
+#include "host_platform.h" /* LIB, OPEN, SYM, CLOSE, LOAD, now_s() */
 
 #include "fmi3Functions.h"
 
@@ -20,10 +20,6 @@ static void logger(fmi3InstanceEnvironment env, fmi3Status status, fmi3String ca
     (void)env;
     fprintf(stderr, "[%d %s] %s\n", (int)status, category, message);
 }
-
-#define LOAD(name) \
-    name##TYPE *name = (name##TYPE *)SYM(lib, #name); \
-    if (!name) { fprintf(stderr, "missing symbol %s\n", #name); return 2; }
 
 int main(int argc, char **argv) {
     LIB lib;

@@ -90,6 +90,21 @@ def _finish(root: ET.Element) -> str:
     return '<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
 
 
+
+def scalar_real(variables: ET.Element, vr: int, name: str, causality: str, unit: str, desc: str) -> ET.Element:
+    """Append an FMI 2.0 ``ScalarVariable`` with its ``Real`` element to ``variables``; return the ``Real``.
+
+    Parameters are fixed and exact, everything else continuous; the description ends with the unit, and a
+    kelvin variable is displayed in degC.
+    """
+    attrs = dict(name=name, valueReference=str(vr), description=f"{desc} [{unit}]", causality=causality)
+    attrs.update(variability="fixed", initial="exact") if causality == "parameter" else attrs.update(
+        variability="continuous")
+    real = ET.SubElement(ET.SubElement(variables, "ScalarVariable", attrs), "Real", unit=unit)
+    if unit == "K":
+        real.set("displayUnit", "degC")
+    return real
+
 def fmi2_description(guid: str, has_friction: bool, x_kiss_ref_m: float | None = None) -> str:
     """FMI 2.0 modelDescription.xml: ME and CS, SourceFiles, ModelStructure with dependencies."""
     root = ET.Element("fmiModelDescription", fmiVersion="2.0", modelName=SLAVE, guid=guid, description=DESCRIPTION,
@@ -109,12 +124,7 @@ def fmi2_description(guid: str, has_friction: bool, x_kiss_ref_m: float | None =
     _log_categories(root)
     variables = ET.SubElement(root, "ModelVariables")
     for vr, name, causality, unit, desc, start in _variables(x_kiss_ref_m):
-        attrs = dict(name=name, valueReference=str(vr), description=f"{desc} [{unit}]", causality=causality)
-        attrs.update(variability="fixed", initial="exact") if causality == "parameter" else attrs.update(
-            variability="continuous")
-        real = ET.SubElement(ET.SubElement(variables, "ScalarVariable", attrs), "Real", unit=unit)
-        if unit == "K":
-            real.set("displayUnit", "degC")
+        real = scalar_real(variables, vr, name, causality, unit, desc)
         if vr == vr_der():
             real.set("derivative", str(_vr("theta_cs") + 1))
         for key, value in bounds_attributes(name).items():

@@ -94,38 +94,22 @@ class Chain:
 
 def chain_of(p=None) -> Chain:
     """The plant's network (:class:`~cushion_clutch.launch.thermal_network.NetworkParams`, default: its
-    defaults) as a :class:`Chain`, in the plant's node order and with its conductance laws.
-
-    Network v2 exposes its chain as arrays (``thermal_network.coefficients``): they are taken as they are.
-    The four-node network before it (no ``coefficients``) is mapped here: its convection
-    ``G0 (1 + (gain - 1) x)`` is ``area (h_still + h_rot x)`` with area = G0, h_still = 1, h_rot = gain - 1.
+    defaults) as a :class:`Chain`, in the plant's node order and with its conductance laws, taken as they are
+    from the network's arrays (``thermal_network.coefficients``).
     """
     from ..launch import thermal_network as tn
     from ..model import KELVIN
     p = p or tn.NetworkParams()
-    if hasattr(tn, "coefficients"):
-        c = tn.coefficients(p)
-        n = len(tn.NODES)
-        return Chain(nodes=tuple(tn.NODES), capacity_J_per_K=tuple(c["caps"]), heat_share=tuple(c["shares"]),
-                     cooled_area_m2=tuple(c["area_cooled"]),
-                     speed=tuple(("engine", "disc")[s] for s in tn.SPEED_OF_NODE),
-                     engine_W_per_K=tuple(c["engine"]), link_always_W_per_K=tuple(c["link_always"]),
-                     link_clamped_W_per_K=tuple(c["link_clamped"]),
-                     theta_cm_weights=tuple(0.5 if i in tn.FACINGS else 0.0 for i in range(n)),
-                     engine_K=p.engine_degC + KELVIN, still_air_W_per_m2_K=p.still_air_W_per_m2_K,
-                     rotating_W_per_m2_K=p.rotating_W_per_m2_K,
-                     convection_reference_rad_s=p.convection_reference_rad_s)
-    net = tn.ThermalNetwork(p, 293.15, 293.15)                 # v1: four nodes
-    open_links, _, _ = net.conductances(0.0, 0.0, False)
-    clamped_links, _, _ = net.conductances(0.0, 0.0, True)
-    return Chain(nodes=tuple(tn.NODES), capacity_J_per_K=tuple(net.caps), heat_share=tuple(net.heat_inputs(1.0)),
-                 cooled_area_m2=(p.flywheel_convection_W_per_K, p.facing_convection_W_per_K,
-                                 p.facing_convection_W_per_K, p.pressure_plate_convection_W_per_K),
-                 speed=("engine", "disc", "disc", "engine"), engine_W_per_K=(p.engine_W_per_K, 0.0, 0.0, 0.0),
-                 link_always_W_per_K=tuple(open_links),
-                 link_clamped_W_per_K=tuple(c - o for c, o in zip(clamped_links, open_links)),
-                 theta_cm_weights=(0.0, 0.5, 0.5, 0.0), engine_K=p.engine_degC + KELVIN, still_air_W_per_m2_K=1.0,
-                 rotating_W_per_m2_K=p.convection_gain_at_reference - 1.0,
+    c = tn.coefficients(p)
+    n = len(tn.NODES)
+    return Chain(nodes=tuple(tn.NODES), capacity_J_per_K=tuple(c["caps"]), heat_share=tuple(c["shares"]),
+                 cooled_area_m2=tuple(c["area_cooled"]),
+                 speed=tuple(("engine", "disc")[s] for s in tn.SPEED_OF_NODE),
+                 engine_W_per_K=tuple(c["engine"]), link_always_W_per_K=tuple(c["link_always"]),
+                 link_clamped_W_per_K=tuple(c["link_clamped"]),
+                 theta_cm_weights=tuple(0.5 if i in tn.FACINGS else 0.0 for i in range(n)),
+                 engine_K=p.engine_degC + KELVIN, still_air_W_per_m2_K=p.still_air_W_per_m2_K,
+                 rotating_W_per_m2_K=p.rotating_W_per_m2_K,
                  convection_reference_rad_s=p.convection_reference_rad_s)
 
 

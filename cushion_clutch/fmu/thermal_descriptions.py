@@ -16,7 +16,8 @@ from xml.etree import ElementTree as ET
 
 from ..model import clutch_model
 from .constants import sources
-from .descriptions import _finish, dependencies, fmi2_description, fmi3_build_description, fmi3_description, vr_der
+from .descriptions import (_finish, dependencies, fmi2_description, fmi3_build_description, fmi3_description,
+                           scalar_real, vr_der)
 from .thermal_chain import (NETWORK_SOURCES, THERMAL_SLAVE, Chain, node_output, thermal_ranges, thermal_starts,
                             thermal_variables)
 
@@ -131,12 +132,7 @@ def thermal_fmi2_description(guid: str, has_friction: bool, chain: Chain, x_kiss
         index[name] = vr + 1
         if vr < len(clutch_model.VARIABLES) or name == "der(theta_cs)":
             continue
-        attrs = dict(name=name, valueReference=str(vr), description=f"{desc} [{unit}]", causality=causality)
-        attrs.update(variability="fixed", initial="exact") if causality == "parameter" else attrs.update(
-            variability="continuous")
-        real = ET.SubElement(ET.SubElement(variables, "ScalarVariable", attrs), "Real", unit=unit)
-        if unit == "K":
-            real.set("displayUnit", "degC")
+        real = scalar_real(variables, vr, name, causality, unit, desc)
         if causality in ("input", "parameter"):
             real.set("start", repr(starts[name]))
             for k, v in _bounds(chain, name).items():

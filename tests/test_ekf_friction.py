@@ -3,7 +3,7 @@ referenced to the engine torque estimate's gain learned on cool ones."""
 import numpy as np
 import pytest
 
-from cushion_clutch.launch.ekf import F1, F2, ClutchEkf, EkfParams, TcuNetworkParams
+from cushion_clutch.launch.ekf import F1, F2, IX_SLOPE, ClutchEkf, EkfParams, TcuNetworkParams
 from cushion_clutch.model import ClutchParameters, load_table, outputs, x_to_for_torque
 
 TA = 293.15
@@ -51,7 +51,7 @@ def test_a_slip_speed_dependent_friction_is_learned_and_applied(table):
     for _ in range(4):
         err = launch(with_slope, table, p, mu)
         err_scale = launch(scale_only, table, p, mu)
-    assert with_slope.s[-1] == pytest.approx(-0.04, abs=0.01) and with_slope.slope_used < -0.02
+    assert with_slope.s[IX_SLOPE] == pytest.approx(-0.04, abs=0.01) and with_slope.slope_used < -0.02
     assert scale_only.slope_used == 0.0
     assert err < 0.5 * err_scale                            # N.m, the last launch
 

@@ -79,13 +79,21 @@ A torque residual larger than ``gate_sd`` standard deviations is rejected.
 **Friction that depends on slip speed and fades** (docs/explanation/production_tcu.md, section 5).
 The friction is ``mu_scale + slope (|slip| - SLIP_REF_RAD_S) / SLIP_UNIT_RAD_S`` at the measured slip:
 the slope is a state (prior 0, sd ``mu_slope_sd``), corrected with ``mu_scale`` and applied beyond
-``mu_slope_evidence_sd`` of its standard deviation. ``mu_scale``'s variance grows by ``mu_walk_per_K``
-per kelvin the estimated facings heat above ``mu_reference_max_degC``. Below that temperature the
-nominal mu is taken to hold, so ``mu_scale`` there (within 1 +- ``mu_deadband``) is the engine torque
-estimate's gain, ``gain_ref``; above, a change of ``mu_scale / gain_ref`` beyond twice the scale's sd at
-referencing is friction evidence of its own: it applies the friction with the gain cancelled (and the
-filter's characteristic at the highest evidence torque against the prior's touch point), not the touch
-point.
+``mu_slope_evidence_sd`` of its standard deviation. ``mu_scale`` follows the estimated facings above
+``mu_reference_max_degC``: the prediction adds ``k_fade d(theta_cm) / FADE_UNIT_K``, with the fade slope
+``k_fade`` a state (prior 0, sd ``mu_fade_sd``; its variance grows by ``mu_fade_walk_per_K`` per kelvin the
+facings heat), learned through its covariance with ``mu_scale``, so the friction falls while a launch heats
+the facings and recovers while they cool before the next (a random walk lags a launch behind); and
+``mu_scale``'s variance grows by ``mu_walk_per_K`` per kelvin of heating. Below that temperature the nominal
+mu is taken to hold: the torque the filter expects the engine control unit to report at the prior's
+position for :data:`FRICTION_TORQUE_NM`, over that torque (:meth:`ClutchEkf.ecu_ratio`, the ECU's gain,
+offset and the clutch's friction together), is referenced there (``ecu_ratio_ref``); above, its change
+(:meth:`ClutchEkf.friction_ratio`) beyond twice ``mu_scale``'s sd at referencing (at most ``mu_deadband``)
+is friction evidence of its own, and the friction applied is the prior's times that change, with the
+prior's touch point. Judging the friction by the filter's whole characteristic at one torque, not by
+``mu_scale`` alone, cancels the trade between the nearly collinear friction scale, touch point and ECU
+offset states (in ``fade`` the scale drifted 4 % below the ECU-view friction while the touch point and
+the offset took up the torque, and the old test applied it).
 
 **The nominal calibration as the prior** (what the TCU *applies*). The torque
 the EKF learns against is the engine control unit's estimate, whose stated
@@ -185,9 +193,9 @@ class EkfParams(Checked):
     ``mu_reference_max_degC``, 1/K (a facing's friction changes with its temperature, by an amount the
     calibration does not know: fade)"""
     mu_reference_max_degC: float = 80.0
-    """friction updates while the estimated facings are below this temperature (degC) learn the engine
-    torque estimate's gain (the nominal mu holds on cool facings); above, ``mu_scale`` relative to it is the
-    clutch's friction"""
+    """friction updates while the estimated facings are below this temperature (degC) reference the engine
+    torque estimate's gain and offset (the nominal mu holds on cool facings); above, the friction is judged
+    relative to that reference and follows the facings' temperature (``mu_fade_sd``)"""
     mu_slope_sd: float = 0.03
     """prior sd of the friction's slip-speed slope, 1 per 100 rad/s (0: mu does not depend on the slip)"""
     mu_slope_walk_per_s: float = 1e-7
@@ -425,8 +433,9 @@ class ClutchEkf:
 
     @property
     def mu_used(self) -> float:
-        """The friction scale the TCU applies: without evidence 1; with it ``mu_scale`` outside a dead band
-        of ``mu_deadband`` around 1.
+        """The friction scale the TCU applies: without evidence the prior's (1 or stored); with touch-point
+        evidence ``mu_scale`` over the referenced gain (before a reference: outside a dead band of
+        ``mu_deadband`` around 1); with friction evidence alone the prior's times :meth:`friction_ratio`.
 
         ``mu_scale`` is learned against the engine control unit's torque
         estimate, so it carries that estimate's gain error; a deviation within

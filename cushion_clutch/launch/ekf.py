@@ -361,9 +361,6 @@ class ClutchEkf:
         #: the friction has changed since the gain was referenced by more than its accuracy (applied), the
         #: ratio of that change to the accuracy, and the count of consecutive updates above it
         self.mu_evidence, self.mu_evidence_ratio, self._mu_over = False, 0.0, 0
-        #: the filter's torque over the prior's at the highest evidence torque (its touch point against the
-        #: prior's), 1: scales the friction applied on friction evidence alone
-        self._mu_dx_factor = 1.0
         #: the torque the filter expects the engine control unit to report at the prior's position for
         #: :data:`FRICTION_TORQUE_NM`, over that torque (gain, offset and friction together), as referenced on
         #: cool facings (None before), and the position cache behind it

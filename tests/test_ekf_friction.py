@@ -3,13 +3,15 @@ referenced to the engine torque estimate's gain learned on cool ones."""
 import numpy as np
 import pytest
 
-from cushion_clutch.launch.ekf import F1, F2, ClutchEkf, EkfParams, TcuNetworkParams
+from cushion_clutch.launch.ekf import F1, F2, IX_FADE, IX_MU, IX_OFF, IX_SLOPE, ClutchEkf, EkfParams, TcuNetworkParams
 from cushion_clutch.model import ClutchParameters, load_table, outputs, x_to_for_torque
 
 TA = 293.15
 #: the launch: torque demand (N.m) and slip speed (rad/s) falling from 300 rad/s to lock-up
 RAMP = np.concatenate([np.linspace(20.0, 180.0, 30), np.full(30, 180.0)])
 SLIP = np.linspace(300.0, 15.0, len(RAMP))
+#: a hill start's: the torque at 180 N.m within 0.3 s
+FAST_RAMP = np.concatenate([np.linspace(20.0, 180.0, 4), np.full(len(RAMP) - 4, 180.0)])
 
 
 @pytest.fixture(scope="module")
@@ -51,7 +53,7 @@ def test_a_slip_speed_dependent_friction_is_learned_and_applied(table):
     for _ in range(4):
         err = launch(with_slope, table, p, mu)
         err_scale = launch(scale_only, table, p, mu)
-    assert with_slope.s[-1] == pytest.approx(-0.04, abs=0.01) and with_slope.slope_used < -0.02
+    assert with_slope.s[IX_SLOPE] == pytest.approx(-0.04, abs=0.01) and with_slope.slope_used < -0.02
     assert scale_only.slope_used == 0.0
     assert err < 0.5 * err_scale                            # N.m, the last launch
 
@@ -91,3 +93,61 @@ def test_friction_parameters_are_checked():
     with pytest.raises(ParameterError) as err:
         EkfParams(mu_slope_sd=-0.1, mu_walk_per_K=2.0)
     assert "ekf.mu_slope_sd" in str(err.value) and "ekf.mu_walk_per_K" in str(err.value)
+
+
+def hot_launch(ekf, table, p, mu_of_theta, gain=0.04, offset=3.0, cool_s=240.0):
+    """One launch heated by its own slip power on a clutch whose friction (relative to nominal) fades with the
+    TCU's own estimated facing temperature (degC; the test isolates the friction, ``temperature_update``
+    off; the torque demand :data:`FAST_RAMP`), then ``cool_s`` of cooling with the clutch open. Returns the worst |believed - true| (N.m)."""
+    worst = 0.0
+    for t, w in zip(FAST_RAMP, SLIP):
+        ekf.set_slip(w)
+        th, tcm = ekf.theta_cs, ekf.theta_cm
+        x = x_to_for_torque(t / ekf.mu_applied, th, table, p, theta_cm=tcm) + ekf.dx_used
+        true = mu_of_theta(tcm - 273.15) * outputs(x, th, table, p, tcm).torque
+        worst = max(worst, abs(ekf.used_torque(x) - true))
+        ekf.accumulate(0.1, true * w)
+        ekf.predict(190.0, 190.0 - w, True)
+        ekf.correct((1.0 + gain) * true + offset, x, w, True)
+    for _ in range(int(cool_s)):
+        ekf.accumulate(1.0, 0.0)
+        ekf.predict(90.0, 0.0, False)
+    return worst
+
+
+def test_a_fade_with_the_facing_temperature_is_followed_through_heating_and_cooling(table):
+    """Friction that fades by 40 % per 100 K above 230 degC of the facings (the organic facing's steep
+    part), hill starts 4 min apart on facings near 300 degC: the friction's temperature slope is learned
+    (negative) and moves the friction with the estimated facings, within a launch and over the cooling
+    before the next; without it the friction applied at a launch's start is the previous launch's end."""
+    p = ClutchParameters()
+    fade = lambda th: 1.0 - 0.4 * max(th - 230.0, 0.0) / 100.0        # noqa: E731
+    worst = {}
+    for sd in (0.1, 0.0):
+        ekf = ClutchEkf(TcuNetworkParams(), EkfParams(temperature_update=False, mu_fade_sd=sd), table, p, TA, TA)
+        for _ in range(3):
+            launch(ekf, table, p, lambda w: 1.0, gain=0.04, offset=3.0)
+        heat_facings(ekf, 280.0)
+        errs = [hot_launch(ekf, table, p, fade) for _ in range(4)]
+        worst[sd] = max(errs[1:])                           # after the first hot launch (its evidence)
+        if sd > 0.0:
+            assert ekf.s[IX_FADE] < -0.1 and ekf.mu_evidence
+    assert worst[0.1] < 0.5 * worst[0.0]                     # N.m (measured 4.0 against 17.2)
+
+
+def test_a_trade_of_friction_touch_point_and_offset_is_no_friction_evidence(table):
+    """The filter's friction scale, touch point and the ECU offset state are nearly collinear: moving the
+    scale down 5 % while the offset state takes up its torque at 120 N.m leaves the torque the filter
+    expects from the ECU there, and with it the friction applied, unchanged (no friction evidence)."""
+    p = ClutchParameters()
+    ekf = ClutchEkf(TcuNetworkParams(), EkfParams(temperature_update=False), table, p, TA, TA)
+    for _ in range(3):
+        launch(ekf, table, p, lambda w: 1.0, gain=0.04, offset=3.0)
+    heat_facings(ekf, 150.0)
+    r0 = ekf.ecu_ratio()
+    ekf.s[IX_MU] -= 0.05
+    ekf.s[IX_OFF] += 0.05 * 120.0 * r0 / ekf.s[IX_MU]        # approximately the 6 N.m the scale gave there
+    assert ekf.ecu_ratio() == pytest.approx(r0, rel=0.01)
+    for _ in range(10):
+        ekf.update_evidence()
+    assert not ekf.mu_evidence and ekf.mu_used == 1.0

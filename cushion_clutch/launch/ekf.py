@@ -79,13 +79,21 @@ A torque residual larger than ``gate_sd`` standard deviations is rejected.
 **Friction that depends on slip speed and fades** (docs/explanation/production_tcu.md, section 5).
 The friction is ``mu_scale + slope (|slip| - SLIP_REF_RAD_S) / SLIP_UNIT_RAD_S`` at the measured slip:
 the slope is a state (prior 0, sd ``mu_slope_sd``), corrected with ``mu_scale`` and applied beyond
-``mu_slope_evidence_sd`` of its standard deviation. ``mu_scale``'s variance grows by ``mu_walk_per_K``
-per kelvin the estimated facings heat above ``mu_reference_max_degC``. Below that temperature the
-nominal mu is taken to hold, so ``mu_scale`` there (within 1 +- ``mu_deadband``) is the engine torque
-estimate's gain, ``gain_ref``; above, a change of ``mu_scale / gain_ref`` beyond twice the scale's sd at
-referencing is friction evidence of its own: it applies the friction with the gain cancelled (and the
-filter's characteristic at the highest evidence torque against the prior's touch point), not the touch
-point.
+``mu_slope_evidence_sd`` of its standard deviation. ``mu_scale`` follows the estimated facings above
+``mu_reference_max_degC``: the prediction adds ``k_fade d(theta_cm) / FADE_UNIT_K``, with the fade slope
+``k_fade`` a state (prior 0, sd ``mu_fade_sd``; its variance grows by ``mu_fade_walk_per_K`` per kelvin the
+facings heat), learned through its covariance with ``mu_scale``, so the friction falls while a launch heats
+the facings and recovers while they cool before the next (a random walk lags a launch behind); and
+``mu_scale``'s variance grows by ``mu_walk_per_K`` per kelvin of heating. Below that temperature the nominal
+mu is taken to hold: the torque the filter expects the engine control unit to report at the prior's
+position for :data:`FRICTION_TORQUE_NM`, over that torque (:meth:`ClutchEkf.ecu_ratio`, the ECU's gain,
+offset and the clutch's friction together), is referenced there (``ecu_ratio_ref``); above, its change
+(:meth:`ClutchEkf.friction_ratio`) beyond twice ``mu_scale``'s sd at referencing (at most ``mu_deadband``)
+is friction evidence of its own, and the friction applied is the prior's times that change, with the
+prior's touch point. Judging the friction by the filter's whole characteristic at one torque, not by
+``mu_scale`` alone, cancels the trade between the nearly collinear friction scale, touch point and ECU
+offset states (in ``fade`` the scale drifted 4 % below the ECU-view friction while the touch point and
+the offset took up the torque, and the old test applied it).
 
 **The nominal calibration as the prior** (what the TCU *applies*). The torque
 the EKF learns against is the engine control unit's estimate, whose stated
@@ -132,12 +140,19 @@ SPEED_BAND = 10.0
 IX_OFF = N_STATE
 #: the friction's slip-speed slope (per :data:`SLIP_UNIT_RAD_S` of slip, about :data:`SLIP_REF_RAD_S`): the last state
 IX_SLOPE = IX_OFF + 1
-N_STATE = IX_SLOPE + 1
+#: the friction's temperature slope (fade, per :data:`FADE_UNIT_K` of the estimated facings above
+#: ``mu_reference_max_degC``): the last state
+IX_FADE = IX_SLOPE + 1
+N_STATE = IX_FADE + 1
 #: slip speed about which the friction scale is stated, and the unit of the slope, rad/s
 SLIP_REF_RAD_S = 150.0
 SLIP_UNIT_RAD_S = 100.0
+#: the unit of the friction's temperature slope, K
+FADE_UNIT_K = 100.0
 #: nominal torques at which the learned characteristic is compared with the nominal one, N.m
 EVIDENCE_TORQUES_NM = (10.0, 20.0, 40.0, 80.0, 120.0)
+#: nominal torque at which the friction is referenced and judged (the top of the evidence torques), N.m
+FRICTION_TORQUE_NM = 120.0
 
 
 @dataclass(frozen=True)
@@ -178,15 +193,21 @@ class EkfParams(Checked):
     ``mu_reference_max_degC``, 1/K (a facing's friction changes with its temperature, by an amount the
     calibration does not know: fade)"""
     mu_reference_max_degC: float = 80.0
-    """friction updates while the estimated facings are below this temperature (degC) learn the engine
-    torque estimate's gain (the nominal mu holds on cool facings); above, ``mu_scale`` relative to it is the
-    clutch's friction"""
+    """friction updates while the estimated facings are below this temperature (degC) reference the engine
+    torque estimate's gain and offset (the nominal mu holds on cool facings); above, the friction is judged
+    relative to that reference and follows the facings' temperature (``mu_fade_sd``)"""
     mu_slope_sd: float = 0.03
     """prior sd of the friction's slip-speed slope, 1 per 100 rad/s (0: mu does not depend on the slip)"""
     mu_slope_walk_per_s: float = 1e-7
+    """random walk of the slip-speed slope, 1/s"""
     mu_slope_evidence_sd: float = 1.0
     """the slope is applied only beyond this many of its standard deviations (by the excess)"""
-    """random walk of the slip-speed slope, 1/s"""
+    mu_fade_sd: float = 0.1
+    """prior sd of the friction's temperature slope above ``mu_reference_max_degC``, 1 per 100 K of the
+    estimated facings (0: ``mu_scale`` does not follow the estimated facing temperature)"""
+    mu_fade_walk_per_K: float = 1e-3
+    """variance of the temperature slope's random walk per kelvin the estimated facings heat above
+    ``mu_reference_max_degC``, 1/(100 K)^2/K (a fade curve steepens as the facings heat)"""
     torque_sd_Nm: float = 8.0
     """measurement noise of the engine-side clutch torque"""
     slip_min_rad_s: float = 10.0
@@ -241,7 +262,8 @@ class EkfParams(Checked):
             "mu_sd": (0.0, 1.0), "mu_walk_per_s": (0.0, 1.0),
             "mu_walk_per_K": (0.0, 1.0), "mu_reference_max_degC": (-50.0, 1000.0), "mu_slope_sd": (0.0, 1.0),
             "mu_slope_walk_per_s": (0.0, 1.0),
-            "mu_slope_evidence_sd": (0.0, 100.0), "torque_sd_Nm": (1e-3, 1e3),
+            "mu_slope_evidence_sd": (0.0, 100.0), "mu_fade_sd": (0.0, 2.0), "mu_fade_walk_per_K": (0.0, 1.0),
+            "torque_sd_Nm": (1e-3, 1e3),
             "slip_min_rad_s": (0.0, 1e3), "touch_torque_min_Nm": (0.0, 1e4), "touch_torque_max_Nm": (0.0, 1e4),
             "mu_torque_min_Nm": (0.0, 1e4), "gate_sd": (1.0, 100.0, True),
             "mu_deadband": (0.0, 0.5), "torque_offset_accuracy_Nm": (0.0, 100.0),
@@ -310,6 +332,12 @@ class ClutchEkf:
         self.P = np.pad(self.P, (0, 1))
         self.P[IX_SLOPE, IX_SLOPE] = e.mu_slope_sd ** 2
         self.q_rw = np.append(self.q_rw, e.mu_slope_walk_per_s if e.mu_slope_sd > 0.0 else 0.0)
+        # the friction's temperature slope, appended: prior 0 (the nominal mu does not fade) with sd mu_fade_sd;
+        # its variance grows in predict() as the facings heat
+        self.s = np.append(self.s, 0.0)
+        self.P = np.pad(self.P, (0, 1))
+        self.P[IX_FADE, IX_FADE] = e.mu_fade_sd ** 2
+        self.q_rw = np.append(self.q_rw, 0.0)
         #: the measured slip speed the characteristic is evaluated at (:meth:`set_slip`), rad/s
         self.slip = SLIP_REF_RAD_S
         self.energy_J = 0.0
@@ -333,9 +361,11 @@ class ClutchEkf:
         #: the friction has changed since the gain was referenced by more than its accuracy (applied), the
         #: ratio of that change to the accuracy, and the count of consecutive updates above it
         self.mu_evidence, self.mu_evidence_ratio, self._mu_over = False, 0.0, 0
-        #: the filter's torque over the prior's at the highest evidence torque (its touch point against the
-        #: prior's), 1: scales the friction applied on friction evidence alone
-        self._mu_dx_factor = 1.0
+        #: the torque the filter expects the engine control unit to report at the prior's position for
+        #: :data:`FRICTION_TORQUE_NM`, over that torque (gain, offset and friction together), as referenced on
+        #: cool facings (None before), and the position cache behind it
+        self.ecu_ratio_ref: float | None = None
+        self._ecu_cache: dict = {}
         #: the friction scale's sd when the gain was last referenced, 1
         self.gain_ref_sd = e.mu_deadband
 
@@ -400,8 +430,9 @@ class ClutchEkf:
 
     @property
     def mu_used(self) -> float:
-        """The friction scale the TCU applies: without evidence 1; with it ``mu_scale`` outside a dead band
-        of ``mu_deadband`` around 1.
+        """The friction scale the TCU applies: without evidence the prior's (1 or stored); with touch-point
+        evidence ``mu_scale`` over the referenced gain (before a reference: outside a dead band of
+        ``mu_deadband`` around 1); with friction evidence alone the prior's times :meth:`friction_ratio`.
 
         ``mu_scale`` is learned against the engine control unit's torque
         estimate, so it carries that estimate's gain error; a deviation within
@@ -410,10 +441,48 @@ class ClutchEkf:
         band = self.e.mu_deadband
         if self.evidence and self.gain_ref is not None:
             return float(self.s[IX_MU]) / self.gain_ref
-        if self.mu_evidence:                    # with the prior's touch point: the filter's torque at the top
-            return float(self.s[IX_MU]) / self.gain_ref * self._mu_dx_factor       # evidence torque
+        if self.mu_evidence:                    # with the prior's touch point: the engine control unit's torque
+            return self.mu_prior * self.friction_ratio()    # the filter expects, over its cool reference
         d = (self.s[IX_MU] if self.evidence else self.mu_prior) - 1.0
         return 1.0 + (d - band if d > band else (d + band if d < -band else 0.0))
+
+    def ecu_ratio(self, s: np.ndarray | None = None) -> float:
+        """The torque the filter (state ``s``, default the estimate) expects the engine control unit to
+        report at the prior's position for :data:`FRICTION_TORQUE_NM` (nominal friction there), over that
+        torque, at the reference slip: ``(mu_scale T(x + dx_prior - dx_kiss) + b) / T(x)``, 1.
+
+        The gain, the offset and the friction enter it together, whatever share of them the filter's
+        nearly collinear touch point, friction scale and offset carry; NaN beyond the closed capacity.
+        """
+        s = self.s if s is None else s
+        th = min(max(float(s[IX_CS]), self.table.theta_min_K), self.table.theta_max_K)
+        theta_cm = float(0.5 * (s[F1] + s[F2]))
+        key = (round(th, 0), round(theta_cm, 0), round(float(s[IX_DX]) - self.dx_prior, 7))
+        hit = self._ecu_cache.get(key)
+        if hit is None:
+            try:
+                x = x_to_for_torque(FRICTION_TORQUE_NM, th, self.table, self.p, theta_cm=theta_cm)
+                t0 = outputs(x, th, self.table, self.p, theta_cm).torque
+                t1 = outputs(x + self.dx_prior - float(s[IX_DX]), th, self.table, self.p, theta_cm).torque
+                hit = (t0, t1) if t0 >= 0.9 * FRICTION_TORQUE_NM else (math.nan, math.nan)
+            except ValueError:
+                hit = (math.nan, math.nan)
+            if len(self._ecu_cache) > 4096:
+                self._ecu_cache.clear()
+            self._ecu_cache[key] = hit
+        t0, t1 = hit
+        return (float(s[IX_MU]) * t1 + float(s[IX_OFF])) / t0
+
+    def friction_ratio(self) -> float:
+        """The friction relative to the one on cool facings: :meth:`ecu_ratio` over its cool reference
+        (the gain and the offset of the engine control unit's torque cancel), 1 (1 before a reference)."""
+        r = self.ecu_ratio()
+        if self.ecu_ratio_ref is None or not math.isfinite(r):
+            return self._last_friction_ratio
+        self._last_friction_ratio = r / self.ecu_ratio_ref
+        return self._last_friction_ratio
+
+    _last_friction_ratio = 1.0
 
     @property
     def mu_applied(self) -> float:
@@ -502,13 +571,9 @@ class ClutchEkf:
         self.evidence_ratio = ratio
         self._over = self._over + 1 if ratio > e.evidence_threshold else 0
         self.evidence = self._over >= e.evidence_confirm or (self.evidence and ratio > e.evidence_release)
-        if self.gain_ref is not None:                   # a change of the friction since the gain was referenced
+        if self.ecu_ratio_ref is not None:              # a change of the friction since the gain was referenced
             g_res = min(e.mu_deadband, 2.0 * self.gain_ref_sd)
-            mu = float(s[IX_MU]) / self.gain_ref
-            if pts:                 # the filter's friction and touch point against the prior's touch point
-                x, t0 = pts[-1][0], pts[-1][1]
-                self._mu_dx_factor = outputs(x + dx0 - float(s[IX_DX]), th, self.table, self.p, theta_cm).torque / t0
-            mu *= self._mu_dx_factor
+            mu = mu0 * self.friction_ratio()
             r = abs(mu - mu0) / (mu0 * g_res) if g_res > 0.0 else math.inf
             self.mu_evidence_ratio = r
             self._mu_over = self._mu_over + 1 if r > e.evidence_threshold else 0
@@ -605,12 +670,24 @@ class ClutchEkf:
         f[:N_T, :N_T] = phi
         f[:N_T, IX_LOSS] = psi @ (a_sink * th + b_sink)
         f[:N_T, IX_HEAT] = psi @ q
+        ref = self.e.mu_reference_max_degC + 273.15      # the friction may change as the facings heat above it
+        cm_old, cm_new = 0.5 * float(s[F1] + s[F2]), 0.5 * float(s_new[F1] + s_new[F2])
+        d_cm = max(cm_new, ref) - max(cm_old, ref)
+        if self.e.mu_fade_sd > 0.0 and d_cm != 0.0:      # the friction follows the facings: mu += k d(theta_cm)
+            k_fade = float(s[IX_FADE])
+            s_new[IX_MU] += k_fade * d_cm / FADE_UNIT_K
+            f[IX_MU, IX_FADE] = d_cm / FADE_UNIT_K
+            dnew = 0.5 * (phi[F1] + phi[F2]) if cm_new > ref else np.zeros(N_T)
+            dold = np.zeros(N_T)
+            if cm_old > ref:
+                dold[F1] = dold[F2] = 0.5
+            f[IX_MU, :N_T] = k_fade * (dnew - dold) / FADE_UNIT_K
         self.s = s_new
         qn = self.q_rw * dt
         qn[:N_T] += (self.e.heat_share_sd * k_heat * q * dt) ** 2
-        ref = self.e.mu_reference_max_degC + 273.15      # the friction may change as the facings heat above it
-        d_cm = max(0.5 * float(s_new[F1] + s_new[F2]), ref) - max(0.5 * float(s[F1] + s[F2]), ref)
         qn[IX_MU] += self.e.mu_walk_per_K * max(d_cm, 0.0)
+        if self.e.mu_fade_sd > 0.0:
+            qn[IX_FADE] += self.e.mu_fade_walk_per_K * max(d_cm, 0.0)
         self.P = f @ self.P @ f.T + np.diag(qn)
         self.energy_J = self.t_acc = 0.0
 
@@ -634,6 +711,7 @@ class ClutchEkf:
         if h0 >= e.mu_torque_min_Nm:
             mask[IX_MU] = True
             mask[IX_SLOPE] = e.mu_slope_sd > 0.0
+            mask[IX_FADE] = e.mu_fade_sd > 0.0
         if not mask.any():
             return False
         mask[IX_OFF] = True
@@ -668,6 +746,9 @@ class ClutchEkf:
             band = e.mu_deadband
             self.gain_ref = min(max(self.mu_scale, 1.0 - band), 1.0 + band)
             self.gain_ref_sd = math.sqrt(max(float(self.P[IX_MU, IX_MU]), 0.0))
+            r_ref = self.ecu_ratio()
+            if math.isfinite(r_ref):
+                self.ecu_ratio_ref = r_ref
         if mask[IX_DX] or mask[IX_MU]:
             self.update_evidence()
         return True

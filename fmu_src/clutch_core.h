@@ -50,6 +50,11 @@ typedef struct {
     int n;
     double *x, *y, *d;
     double x_first; /* first contact: the last row still at the first force, m (spring_table.Curve.x_first) */
+    /* the interval locator's buckets: nb uniform buckets of width 1/inv_bw from x[0], each holding the interval
+       of its lower edge (a start only: cc_curve_locate corrects it, so it finds the binary search's interval) */
+    int nb;
+    double inv_bw;
+    unsigned short *bk;
 } Curve;
 
 /* F(u) at one temperature: curves c0 and c1 (weight w of c1; c1 = c0 where w = 0) blended on a common
@@ -143,7 +148,7 @@ double cc_table_force(const Table *tb, double u, double theta_degC);
 double cc_table_delta(const Table *tb, double theta_degC);
 /* the kiss shift of a bracket's temperature (the same number as cc_table_delta at that temperature), m */
 double cc_table_delta_at(const Table *tb, const TBracket *br);
-/* the interval i of x[0] < u < x[n-1]: x[i] <= u < x[i+1] (binary search) */
+/* the interval i of x[0] < u < x[n-1]: x[i] <= u < x[i+1] (the binary search's; found from a bucket) */
 int cc_curve_locate(const Curve *c, double u);
 double cc_table_mu(const Table *tb, double theta_degC, double omega);
 double cc_table_full(const Table *tb, double theta_degC);

@@ -55,6 +55,9 @@ typedef struct {
     int nb;
     double inv_bw;
     unsigned short *bk;
+    /* the cubic of interval i in t = (u - x[i]) / (x[i+1] - x[i]): F = y[i] + t (q0 + t (q1 + t q2)), and
+       q3 = 1 / (x[i+1] - x[i]); pc[4 i + k] = qk (the cover's solver: value, slope and curvature at once) */
+    double *pc;
 } Curve;
 
 /* F(u) at one temperature: curves c0 and c1 (weight w of c1; c1 = c0 where w = 0) blended on a common
@@ -88,10 +91,8 @@ typedef struct {
     double e, L_pp, L_b, kb, kp, fal; /* arms (m), bearing/pp travel per unit s, F_AL factor without E */
     double u_full_ref;                /* cushion full compression at the reference temperature, m */
     double xc;                        /* bearing-system constant X_c, m */
-    int hint[2], hint_k[2];           /* last table intervals (Newton; kiss and solid points) */
+    int hint[2], hint_k[2];           /* last intervals of the two curves, solver and kiss point (search starts) */
     int hint_t;                       /* last interval of the table temperatures (the frame's bracket) */
-    const Curve *memo_c[4];           /* frame_cushion: curve, u and F of the solid (0, 1) and kiss (2, 3) points */
-    double memo_u[4], memo_f[4];
     /* the frame of the last (theta_cs K, theta_cm K, wear m): bracket, E, positions and forces */
     double f_theta_cs, f_theta_cm, f_wear, f_e;
     TBracket f_br;
@@ -116,6 +117,7 @@ typedef struct {
     int range_warned; /* the validity of the last outputs (0, 1, 2): a warning is logged on each change to 1 or 2 */
     int terminated;   /* CS: the last step was refused (fmi2Terminated / terminateSimulation) */
     int logging_on;
+    double decay_arg, decay; /* the Co-Simulation step's exp(decay_arg) (decay_arg NaN: none yet) */
     Table table;
     CcCover cover;
     int cover_ok;     /* cover prepared from the current parameters */

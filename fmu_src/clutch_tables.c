@@ -83,6 +83,15 @@ static int curve_buckets(Curve *c) {
         double e = c->x[0] + bw * j;
         c->bk[j] = (unsigned short)(e <= c->x[0] ? 0 : e >= c->x[c->n - 1] ? c->n - 2 : curve_bsearch(c, e));
     }
+    c->pc = (double *)malloc(sizeof(double) * 4 * (c->n - 1));
+    if (!c->pc) return -1;
+    for (j = 0; j < c->n - 1; ++j) { /* the Hermite cubic of curve_eval in powers of t */
+        double h = c->x[j + 1] - c->x[j], a = c->y[j], b = h * c->d[j], e = c->y[j + 1], f = h * c->d[j + 1];
+        c->pc[4 * j] = b;
+        c->pc[4 * j + 1] = 3.0 * (e - a) - 2.0 * b - f;
+        c->pc[4 * j + 2] = 2.0 * (a - e) + b + f;
+        c->pc[4 * j + 3] = 1.0 / h;
+    }
     return 0;
 }
 
@@ -220,7 +229,7 @@ void cc_table_free(Table *tb) {
     int k;
     if (tb->curves)
         for (k = 0; k < tb->nt; ++k) {
-            free(tb->curves[k].x); free(tb->curves[k].y); free(tb->curves[k].d); free(tb->curves[k].bk);
+            free(tb->curves[k].x); free(tb->curves[k].y); free(tb->curves[k].d); free(tb->curves[k].bk); free(tb->curves[k].pc);
         }
     free(tb->curves); free(tb->theta); free(tb->delta);
     free(tb->f_theta); free(tb->f_omega); free(tb->f_mu);

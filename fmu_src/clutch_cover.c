@@ -109,41 +109,47 @@ static double cushion_value(const TBracket *b, double u, int *hint) {
     return cushion(b, u, hint, &d1, &d2);
 }
 
+/* the frame: everything that depends on temperature and wear, not on x_to */
+static void frame(CcCover *cv, const Table *tb, double theta_cs, double theta_cm, double wear) {
+    const double *p = cv->p;
+    double kb = cv->kb, kp = cv->kp, comp = p[CV_C];
+    double stack, m_solid, e_mod, fk;
+    TBracket b;
+    e_mod = youngs(cv, theta_cs);
+    cc_table_bracket_hint(tb, theta_cs - KELVIN, &b, &cv->hint_t);
+    stack = cc_table_delta_at(tb, &b) +
+            (p[CV_TF] * p[CV_AF] + p[CV_TPP] * p[CV_APP] + p[CV_LFW] * p[CV_AFW]) * (theta_cm - p[CV_TREF]);
+    cv->f_e = e_mod;
+    cv->f_br = b;
+    cv->s_kiss = p[CV_SINST] + (cv->u_full_ref + stack - wear) / kp;
+    cv->s_solid = cv->s_kiss - b.full / kp;
+    /* the full compression: each curve at its last row, (1 - w) y0 + w y1 (Bracket.force there up to the
+       rounding of u_full and the curves' argument, an ulp or two of u, where dF/du is finite) */
+    {
+        const Curve *c0 = b.c0, *c1 = b.c1;
+        cv->fc_solid = b.w == 0.0 ? c0->y[c0->n - 1] : (1.0 - b.w) * c0->y[c0->n - 1] + b.w * c1->y[c1->n - 1];
+    }
+    m_solid = moment(cv, cv->s_solid, e_mod);
+    cv->m_solid = m_solid;
+    cv->fto_solid = (m_solid - cv->fc_solid * cv->L_pp) / cv->L_b;
+    cv->x_solid = cv->xc - kb * cv->s_solid - comp * cv->fto_solid;
+    fk = cushion_value(&b, 0.0, cv->hint_k);
+    cv->fto_kiss = (moment(cv, cv->s_kiss, e_mod) - fk * cv->L_pp) / cv->L_b;
+    cv->x_kiss = cv->xc - kb * cv->s_kiss - comp * cv->fto_kiss;
+    cv->f_theta_cs = theta_cs;
+    cv->f_theta_cm = theta_cm;
+    cv->f_wear = wear;
+}
+
+
 int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, double theta_cm, double wear,
                    CcCoverState *out) {
     const double *p = cv->p;
     double kb = cv->kb, kp = cv->kp, comp = p[CV_C];
     double lo, hi, s, r, fc, fto, dfc, d2fc;
     int k;
-    if (!(theta_cs == cv->f_theta_cs && theta_cm == cv->f_theta_cm && wear == cv->f_wear)) {
-        /* the frame: everything that depends on temperature and wear, not on x_to */
-        double stack, m_solid, e_mod, fk;
-        TBracket b;
-        e_mod = youngs(cv, theta_cs);
-        cc_table_bracket_hint(tb, theta_cs - KELVIN, &b, &cv->hint_t);
-        stack = cc_table_delta_at(tb, &b) +
-                (p[CV_TF] * p[CV_AF] + p[CV_TPP] * p[CV_APP] + p[CV_LFW] * p[CV_AFW]) * (theta_cm - p[CV_TREF]);
-        cv->f_e = e_mod;
-        cv->f_br = b;
-        cv->s_kiss = p[CV_SINST] + (cv->u_full_ref + stack - wear) / kp;
-        cv->s_solid = cv->s_kiss - b.full / kp;
-        /* the full compression: each curve at its last row, (1 - w) y0 + w y1 (Bracket.force there up to the
-           rounding of u_full and the curves' argument, an ulp or two of u, where dF/du is finite) */
-        {
-            const Curve *c0 = b.c0, *c1 = b.c1;
-            cv->fc_solid = b.w == 0.0 ? c0->y[c0->n - 1] : (1.0 - b.w) * c0->y[c0->n - 1] + b.w * c1->y[c1->n - 1];
-        }
-        m_solid = moment(cv, cv->s_solid, e_mod);
-        cv->m_solid = m_solid;
-        cv->fto_solid = (m_solid - cv->fc_solid * cv->L_pp) / cv->L_b;
-        cv->x_solid = cv->xc - kb * cv->s_solid - comp * cv->fto_solid;
-        fk = cushion_value(&b, 0.0, cv->hint_k);
-        cv->fto_kiss = (moment(cv, cv->s_kiss, e_mod) - fk * cv->L_pp) / cv->L_b;
-        cv->x_kiss = cv->xc - kb * cv->s_kiss - comp * cv->fto_kiss;
-        cv->f_theta_cs = theta_cs;
-        cv->f_theta_cm = theta_cm;
-        cv->f_wear = wear;
-    }
+    if (!(theta_cs == cv->f_theta_cs && theta_cm == cv->f_theta_cm && wear == cv->f_wear))
+        frame(cv, tb, theta_cs, theta_cm, wear);
     out->x_solid = cv->x_solid;
     out->x_lift = cv->x_solid + comp * (cv->fto_solid > 0.0 ? cv->fto_solid : 0.0);
     out->x_kiss = cv->x_kiss;

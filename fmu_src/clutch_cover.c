@@ -73,40 +73,63 @@ double cc_cover_slope_bound(const CcCover *cv) {
 #define CC_INLINE static inline
 #endif
 
+/* a point of one curve where F was evaluated: its interval's cubic (NULL beyond either end, where F is clamped
+   and dF/du = 0) and t */
+typedef struct {
+    const double *q;
+    double t;
+} CurvePt;
+
 /* F(u) of one curve (PCHIP, the cubic of its interval in powers of t: the value of clutch_tables.c's Hermite form
-   to a few ulps), with dF/du in *d1 and d2F/du2 in *d2 (0 beyond the ends, where F is clamped); *hint: the last
-   interval, a start for the search only (the interval of u is unique) */
-CC_INLINE double curve_vdd(const Curve *c, double u, int *hint, double *d1, double *d2) {
+   to a few ulps); the point in *pt for curve_deriv; *hint: the last interval, a start for the search only (the
+   interval of u is unique) */
+CC_INLINE double curve_value(const Curve *c, double u, int *hint, CurvePt *pt) {
     const double *x = c->x, *q;
     int n = c->n, i = *hint;
     double t;
-    if (u <= x[0]) { *d1 = *d2 = 0.0; return c->y[0]; }
-    if (u >= x[n - 1]) { *d1 = *d2 = 0.0; return c->y[n - 1]; }
+    if (u <= x[0]) { pt->q = NULL; return c->y[0]; }
+    if (u >= x[n - 1]) { pt->q = NULL; return c->y[n - 1]; }
     if (!((unsigned)i < (unsigned)(n - 1) && x[i] <= u && u < x[i + 1])) i = *hint = cc_curve_locate(c, u);
     q = c->pc + 4 * i;
     t = (u - x[i]) * q[3];
-    *d1 = (q[0] + t * (2.0 * q[1] + 3.0 * t * q[2])) * q[3];
-    *d2 = (2.0 * q[1] + 6.0 * t * q[2]) * (q[3] * q[3]);
+    pt->q = q;
+    pt->t = t;
     return c->y[i] + t * (q[0] + t * (q[1] + t * q[2]));
 }
 
-/* the cushion force F_c(u) at the bracket's temperature (spring_table.Bracket.force), dF_c/du in *d1 and
-   d2F_c/du2 in *d2 */
-CC_INLINE double cushion(const TBracket *b, double u, int *hint, double *d1, double *d2) {
-    double f0, f1, a0, a1, c0, c1, v;
-    if (b->w == 0.0) return curve_vdd(b->c0, u, &hint[0], d1, d2);
+/* dF/du in *d1 and d2F/du2 in *d2 at a point of curve_value (only where the solver takes a step) */
+CC_INLINE void curve_deriv(const CurvePt *pt, double *d1, double *d2) {
+    const double *q = pt->q;
+    double t = pt->t;
+    if (!q) { *d1 = *d2 = 0.0; return; }
+    *d1 = (q[0] + t * (2.0 * q[1] + 3.0 * t * q[2])) * q[3];
+    *d2 = (2.0 * q[1] + 6.0 * t * q[2]) * (q[3] * q[3]);
+}
+
+/* the cushion force F_c(u) at the bracket's temperature (spring_table.Bracket.force); its curves' points in pt */
+CC_INLINE double cushion(const TBracket *b, double u, int *hint, CurvePt *pt) {
+    double f0, f1, v;
+    if (b->w == 0.0) return curve_value(b->c0, u, &hint[0], &pt[0]);
     v = u - b->first;
-    f0 = curve_vdd(b->c0, b->c0->x_first + v * b->r0, &hint[0], &a0, &c0);
-    f1 = curve_vdd(b->c1, b->c1->x_first + v * b->r1, &hint[1], &a1, &c1);
+    f0 = curve_value(b->c0, b->c0->x_first + v * b->r0, &hint[0], &pt[0]);
+    f1 = curve_value(b->c1, b->c1->x_first + v * b->r1, &hint[1], &pt[1]);
+    return (1.0 - b->w) * f0 + b->w * f1;
+}
+
+/* dF_c/du in *d1 and d2F_c/du2 in *d2 at the points of the last cushion() call */
+CC_INLINE void cushion_deriv(const TBracket *b, const CurvePt *pt, double *d1, double *d2) {
+    double a0, a1, c0, c1;
+    curve_deriv(&pt[0], &a0, &c0);
+    if (b->w == 0.0) { *d1 = a0; *d2 = c0; return; }
+    curve_deriv(&pt[1], &a1, &c1);
     *d1 = (1.0 - b->w) * a0 * b->r0 + b->w * a1 * b->r1;
     *d2 = (1.0 - b->w) * c0 * (b->r0 * b->r0) + b->w * c1 * (b->r1 * b->r1);
-    return (1.0 - b->w) * f0 + b->w * f1;
 }
 
 /* the cushion force alone (the frame's points); *hint as in curve_vdd */
 static double cushion_value(const TBracket *b, double u, int *hint) {
-    double d1, d2;
-    return cushion(b, u, hint, &d1, &d2);
+    CurvePt pt[2];
+    return cushion(b, u, hint, pt);
 }
 
 /* the frame: everything that depends on temperature and wear, not on x_to */
@@ -147,6 +170,7 @@ int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
     const double *p = cv->p;
     double kb = cv->kb, kp = cv->kp, comp = p[CV_C];
     double lo, hi, s, r, fc, fto, dfc, d2fc;
+    CurvePt pt[2];
     int k;
     if (!(theta_cs == cv->f_theta_cs && theta_cm == cv->f_theta_cm && wear == cv->f_wear))
         frame(cv, tb, theta_cs, theta_cm, wear);
@@ -165,11 +189,14 @@ int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
         return 0;
     }
     {
-        /* the frame's constants in locals (M(s) and its derivatives as moment() and moment_slope()) */
+        /* the residual r(s) = x_to(s) - x_to = P(s) + ck L_pp F_c(u(s)), P(s) = X_c - x_to - kb s - ck M(s) a cubic
+           (ck = c / L_b; M(s) = F_AL(s) e expanded in powers of s): r, dr/ds and d2r/ds2 by Horner */
         const TBracket b = cv->f_br;
         const double s_kiss = cv->s_kiss, xc = cv->xc, L_pp = cv->L_pp, L_b = cv->L_b, e = cv->e;
-        const double t = p[CV_T], h = p[CV_H], tt = t * t, h15 = 1.5 * h, fe = cv->fal * cv->f_e, fe_t = fe / t;
-        const double tol_r = 1e-15 * (1.0 + fabs(x_to)), ck = comp / L_b, ckp = ck * kp * L_pp;
+        const double t = p[CV_T], h = p[CV_H], tt = t * t;
+        const double tol_r = 1e-15 * (1.0 + fabs(x_to)), ck = comp / L_b, ckl = ck * L_pp, ckp = ckl * kp;
+        const double km = ck * cv->fal * cv->f_e * e / t;
+        const double p0 = xc - x_to, p1 = -kb - km * (1.0 + h * h / tt), p2 = km * 1.5 * h / tt, p3 = -km * 0.5 / tt;
         int hint[2];
         hint[0] = cv->hint[0];
         hint[1] = cv->hint[1];
@@ -182,26 +209,27 @@ int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
             s = cv->s_solid + (s_kiss - cv->s_solid) * (cv->x_solid - x_to) / (cv->x_solid - cv->x_kiss);
         else s = (xc - x_to - comp * cv->fto_kiss) / kb;
         if (!(s > lo && s < hi)) s = hi;
-        fc = cushion(&b, (s_kiss - s) * kp, hint, &dfc, &d2fc);
-        fto = (fe * (s / t) * ((h - s) * (h - 0.5 * s) / tt + 1.0) * e - fc * L_pp) / L_b;
-        r = xc - kb * s - comp * fto - x_to;
+        fc = cushion(&b, (s_kiss - s) * kp, hint, pt);
+        r = p0 + s * (p1 + s * (p2 + s * p3)) + ckl * fc;
         for (k = 0; k < 100; ++k) {
             double slope, s_new;
             if (fabs(r) <= tol_r || hi - lo <= 1e-15 * (1.0 + hi)) break;
             if (r > 0.0) lo = s; else hi = s;
-            slope = -kb - ck * fe_t * ((h - s) * (h - 0.5 * s) / tt + 1.0 - s * (h15 - s) / tt) * e - ckp * dfc;
+            cushion_deriv(&b, pt, &dfc, &d2fc);
+            slope = p1 + s * (2.0 * p2 + 3.0 * p3 * s) - ckp * dfc;
             if (slope < 0.0) {
                 /* Halley's step (third order where x(s) is smooth; Newton's where the correction is large) */
                 double step = r / slope;
-                double curv = -ck * fe_t * e * 3.0 * (s - h) / tt + ckp * kp * d2fc;
+                double curv = 2.0 * p2 + 6.0 * p3 * s + ckp * kp * d2fc;
                 double q = 1.0 - 0.5 * step * curv / slope;
                 s_new = s - (q > 0.5 && q < 2.0 ? step / q : step);
             } else s_new = 0.5 * (lo + hi);
             s = (s_new > lo && s_new < hi) ? s_new : 0.5 * (lo + hi);
-            fc = cushion(&b, (s_kiss - s) * kp, hint, &dfc, &d2fc);
-            fto = (fe * (s / t) * ((h - s) * (h - 0.5 * s) / tt + 1.0) * e - fc * L_pp) / L_b;
-            r = xc - kb * s - comp * fto - x_to;
+            fc = cushion(&b, (s_kiss - s) * kp, hint, pt);
+            r = p0 + s * (p1 + s * (p2 + s * p3)) + ckl * fc;
         }
+        /* the bearing force at the answer as cover.py writes it */
+        fto = (moment(cv, s, cv->f_e) - fc * L_pp) / L_b;
         cv->hint[0] = hint[0];
         cv->hint[1] = hint[1];
         out->clamp = fc;

@@ -152,6 +152,20 @@ double cc_table_delta(const Table *tb, double theta_degC);
 double cc_table_delta_at(const Table *tb, const TBracket *br);
 /* the interval i of x[0] < u < x[n-1]: x[i] <= u < x[i+1] (the binary search's; found from a bucket) */
 int cc_curve_locate(const Curve *c, double u);
+/* the same, inline (the cover's solver): the interval from the bucket of u, corrected until x[i] <= u < x[i+1]
+   holds, so it is the one interval the binary search finds whatever the rounding of the bucket index (buckets
+   are no wider than the narrowest interval: at most one step up from the bucket's start in exact arithmetic) */
+static inline int cc_curve_locate_inline(const Curve *c, double u) {
+    const double *x = c->x;
+    int k = (int)((u - x[0]) * c->inv_bw), i;
+    if (k > c->nb - 1) k = c->nb - 1;
+    if (k < 0) k = 0;
+    i = c->bk[k];
+    i += u >= x[i + 1];
+    while (u < x[i]) --i;
+    while (u >= x[i + 1]) ++i;
+    return i;
+}
 double cc_table_mu(const Table *tb, double theta_degC, double omega);
 double cc_table_full(const Table *tb, double theta_degC);
 /* table temperatures i and i+1 around theta with weight w of i+1 (clamped: w = 0 or 1) */

@@ -89,7 +89,7 @@ CC_INLINE double curve_value(const Curve *c, double u, int *hint, CurvePt *pt) {
     double t;
     if (u <= x[0]) { pt->q = NULL; return c->y[0]; }
     if (u >= x[n - 1]) { pt->q = NULL; return c->y[n - 1]; }
-    if (!((unsigned)i < (unsigned)(n - 1) && x[i] <= u && u < x[i + 1])) i = *hint = cc_curve_locate(c, u);
+    if (!((unsigned)i < (unsigned)(n - 1) && x[i] <= u && u < x[i + 1])) i = *hint = cc_curve_locate_inline(c, u);
     q = c->pc + 4 * i;
     t = (u - x[i]) * q[3];
     pt->q = q;

@@ -50,20 +50,7 @@ static int curve_bsearch(const Curve *c, double u) {
     return lo;
 }
 
-/* the interval from the bucket of u, corrected until x[i] <= u < x[i+1] holds: the one interval the binary
-   search finds, whatever the rounding of the bucket index (buckets no wider than the narrowest interval:
-   at most one step up from the bucket's start in exact arithmetic) */
-int cc_curve_locate(const Curve *c, double u) {
-    const double *x = c->x;
-    int k = (int)((u - x[0]) * c->inv_bw), i;
-    if (k > c->nb - 1) k = c->nb - 1;
-    if (k < 0) k = 0;
-    i = c->bk[k];
-    i += u >= x[i + 1];
-    while (u < x[i]) --i;
-    while (u >= x[i + 1]) ++i;
-    return i;
-}
+int cc_curve_locate(const Curve *c, double u) { return cc_curve_locate_inline(c, u); }
 
 /* the buckets of a loaded curve (n >= 2, x increasing); -1 if out of memory */
 static int curve_buckets(Curve *c) {

@@ -218,11 +218,11 @@ int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
             cushion_deriv(&b, pt, &dfc, &d2fc);
             slope = p1 + s * (2.0 * p2 + 3.0 * p3 * s) - ckp * dfc;
             if (slope < 0.0) {
-                /* Halley's step (third order where x(s) is smooth; Newton's where the correction is large) */
-                double step = r / slope;
-                double curv = 2.0 * p2 + 6.0 * p3 * s + ckp * kp * d2fc;
-                double q = 1.0 - 0.5 * step * curv / slope;
-                s_new = s - (q > 0.5 && q < 2.0 ? step / q : step);
+                /* Halley's step 2 r r' / (2 r'^2 - r r'') (third order where x(s) is smooth; one division), or
+                   Newton's where it would change the Newton step by more than a factor 2 */
+                double curv = 2.0 * p2 + 6.0 * p3 * s + ckp * kp * d2fc, s2 = slope * slope;
+                double den = 2.0 * s2 - r * curv;
+                s_new = den > s2 && den < 4.0 * s2 ? s - 2.0 * r * slope / den : s - r / slope;
             } else s_new = 0.5 * (lo + hi);
             s = (s_new > lo && s_new < hi) ? s_new : 0.5 * (lo + hi);
             fc = cushion(&b, (s_kiss - s) * kp, hint, pt);

@@ -401,7 +401,7 @@ int cc_do_step(CcModel *m, double t, double h, const char *fn) {
     double g, theta_inf, theta_old, *r = m->r;
     int status = CC_OK;
     if (!cc_allowed(m, PH_STEP, fn)) return CC_ERROR;
-    if (!(isfinite(h) && h >= 0.0 && isfinite(t))) {
+    if (!(h >= 0.0 && h < INFINITY && fabs(t) < INFINITY)) { /* finite, h >= 0 (false for NaN): two compares */
         cc_log(m, CC_DISCARD, "%s: t = %g s: step size %g s must be finite and >= 0; step refused", fn, t, h);
         m->terminated = 1;
         return CC_DISCARD;

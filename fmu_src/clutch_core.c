@@ -347,14 +347,25 @@ int cc_set_real(CcModel *m, const unsigned int vr[], size_t n, const double v[],
     return CC_OK;
 }
 
+#if defined(__GNUC__)
+__attribute__((noinline))
+#endif
+static int get_real_checked(CcModel *m, const unsigned int vr[], size_t n, double v[], const char *fn);
+
 int cc_get_real(CcModel *m, const unsigned int vr[], size_t n, double v[], const char *fn) {
-    size_t k;
-    if (!cc_allowed(m, PH_ANY & ~PH_INSTANTIATED, fn)) return CC_ERROR;
-    if (n && (!vr || !v)) { cc_log(m, CC_ERROR, "%s: NULL value reference or value array", fn); return CC_ERROR; }
-    if (!m->dirty) { /* the usual call after a step: every reference known, outputs up to date */
+    if ((m->phase & (PH_ANY & ~PH_INSTANTIATED)) && !m->dirty && vr && v) {
+        /* the usual call after a step: every reference known, outputs up to date (what the checks below allow) */
+        size_t k;
         for (k = 0; k < n && vr[k] < CC_NVARS; ++k) v[k] = m->r[vr[k]];
         if (k == n) return CC_OK;
     }
+    return get_real_checked(m, vr, n, v, fn);
+}
+
+static int get_real_checked(CcModel *m, const unsigned int vr[], size_t n, double v[], const char *fn) {
+    size_t k;
+    if (!cc_allowed(m, PH_ANY & ~PH_INSTANTIATED, fn)) return CC_ERROR;
+    if (n && (!vr || !v)) { cc_log(m, CC_ERROR, "%s: NULL value reference or value array", fn); return CC_ERROR; }
     for (k = 0; k < n; ++k)
         if (vr[k] >= CC_NVARS) {
             cc_log(m, CC_ERROR, "%s: unknown value reference %u", fn, vr[k]);

@@ -128,7 +128,7 @@ CC_INLINE void cushion_deriv(const TBracket *b, const CurvePt *pt, double *d1, d
 
 /* the cushion force alone (the frame's points); *hint as in curve_vdd */
 static double cushion_value(const TBracket *b, double u, int *hint) {
-    CurvePt pt[2];
+    CurvePt pt[2] = {{NULL, 0.0}, {NULL, 0.0}};
     return cushion(b, u, hint, pt);
 }
 
@@ -170,7 +170,7 @@ int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
     const double *p = cv->p;
     double kb = cv->kb, kp = cv->kp, comp = p[CV_C];
     double lo, hi, s, r, fc, fto, dfc, d2fc;
-    CurvePt pt[2];
+    CurvePt pt[2] = {{NULL, 0.0}, {NULL, 0.0}}; /* pt[1]: used only where w != 0, which sets it */
     int k;
     if (!(theta_cs == cv->f_theta_cs && theta_cm == cv->f_theta_cm && wear == cv->f_wear))
         frame(cv, tb, theta_cs, theta_cm, wear);

@@ -71,6 +71,7 @@ int cc_instantiate(CcModel *m, const char *dir, int me, CcLogger logger, void *c
     set_starts(m->r);
     m->phase = PH_INSTANTIATED;
     m->dirty = 1;
+    m->decay_arg = NAN;
     m->table_ok = cc_table_load(&m->table, dir, m->table_error, sizeof m->table_error) == 0;
     if (!m->table_ok) cc_log(m, CC_ERROR, "cannot load the F(u, theta) tables: %s", m->table_error);
     return m->table_ok ? 0 : -1;
@@ -307,6 +308,12 @@ int cc_set_real(CcModel *m, const unsigned int vr[], size_t n, const double v[],
     if (n && (!vr || !v)) { cc_log(m, CC_ERROR, "%s: NULL value reference or value array", fn); return CC_ERROR; }
 #if !CC_THERMAL
     /* the step's usual call: inputs only (what the checks below allow in every phase) */
+    if (n == 2 && vr[0] == VR_X_TO && vr[1] == VR_THETA_CM) { /* the usual pair, as the loop below does it */
+        m->r[VR_X_TO] = v[0];
+        m->r[VR_THETA_CM] = v[1];
+        m->dirty = 1;
+        return CC_OK;
+    }
     for (k = 0; k < n && vr[k] < CC_NVARS && CC_VARIABLES[vr[k]].causality == CC_INPUT; ++k) {}
     if (k == n && n) {
         for (k = 0; k < n; ++k) m->r[vr[k]] = v[k];
@@ -340,17 +347,25 @@ int cc_set_real(CcModel *m, const unsigned int vr[], size_t n, const double v[],
     return CC_OK;
 }
 
+#if defined(__GNUC__)
+__attribute__((noinline))
+#endif
+static int get_real_checked(CcModel *m, const unsigned int vr[], size_t n, double v[], const char *fn);
+
 int cc_get_real(CcModel *m, const unsigned int vr[], size_t n, double v[], const char *fn) {
+    if ((m->phase & (PH_ANY & ~PH_INSTANTIATED)) && !m->dirty && vr && v) {
+        /* the usual call after a step: every reference known, outputs up to date (what the checks below allow) */
+        size_t k;
+        for (k = 0; k < n && vr[k] < CC_NVARS; ++k) v[k] = m->r[vr[k]];
+        if (k == n) return CC_OK;
+    }
+    return get_real_checked(m, vr, n, v, fn);
+}
+
+static int get_real_checked(CcModel *m, const unsigned int vr[], size_t n, double v[], const char *fn) {
     size_t k;
     if (!cc_allowed(m, PH_ANY & ~PH_INSTANTIATED, fn)) return CC_ERROR;
     if (n && (!vr || !v)) { cc_log(m, CC_ERROR, "%s: NULL value reference or value array", fn); return CC_ERROR; }
-    if (!m->dirty) { /* the usual call after a step: every reference known, outputs up to date */
-        for (k = 0; k < n && vr[k] < CC_NVARS; ++k) {}
-        if (k == n) {
-            for (k = 0; k < n; ++k) v[k] = m->r[vr[k]];
-            return CC_OK;
-        }
-    }
     for (k = 0; k < n; ++k)
         if (vr[k] >= CC_NVARS) {
             cc_log(m, CC_ERROR, "%s: unknown value reference %u", fn, vr[k]);
@@ -397,7 +412,7 @@ int cc_do_step(CcModel *m, double t, double h, const char *fn) {
     double g, theta_inf, theta_old, *r = m->r;
     int status = CC_OK;
     if (!cc_allowed(m, PH_STEP, fn)) return CC_ERROR;
-    if (!(isfinite(h) && h >= 0.0 && isfinite(t))) {
+    if (!(h >= 0.0 && h < INFINITY && fabs(t) < INFINITY)) { /* finite, h >= 0 (false for NaN): two compares */
         cc_log(m, CC_DISCARD, "%s: t = %g s: step size %g s must be finite and >= 0; step refused", fn, t, h);
         m->terminated = 1;
         return CC_DISCARD;
@@ -421,7 +436,14 @@ int cc_do_step(CcModel *m, double t, double h, const char *fn) {
     g = r[VR_U] + r[VR_H];
     theta_inf = (r[VR_U] * r[VR_THETA_CM] + r[VR_H] * r[VR_THETA_A]) / g;
     theta_old = r[VR_THETA_CS];
-    r[VR_THETA_CS] = theta_inf + (r[VR_THETA_CS] - theta_inf) * exp(-h * g / r[VR_C]);
+    {   /* exp(-h g / C): kept with its argument (a pure function of it: the same bits as computing it) */
+        double a = -h * g / r[VR_C];
+        if (!(a == m->decay_arg)) {
+            m->decay_arg = a;
+            m->decay = exp(a);
+        }
+        r[VR_THETA_CS] = theta_inf + (r[VR_THETA_CS] - theta_inf) * m->decay;
+    }
     if (update_outputs(m) != CC_OK) { /* a discarded step leaves state and time where they were */
         r[VR_THETA_CS] = theta_old;
         r[CC_VR_DER_THETA_CS] = (r[VR_U] * r[VR_THETA_CM] + r[VR_H] * r[VR_THETA_A] - g * theta_old) / r[VR_C];

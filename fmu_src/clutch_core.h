@@ -50,6 +50,14 @@ typedef struct {
     int n;
     double *x, *y, *d;
     double x_first; /* first contact: the last row still at the first force, m (spring_table.Curve.x_first) */
+    /* the interval locator's buckets: nb uniform buckets of width 1/inv_bw from x[0], each holding the interval
+       of its lower edge (a start only: cc_curve_locate corrects it, so it finds the binary search's interval) */
+    int nb;
+    double inv_bw;
+    unsigned short *bk;
+    /* the cubic of interval i in t = (u - x[i]) / (x[i+1] - x[i]): F = y[i] + t (q0 + t (q1 + t q2)), and
+       q3 = 1 / (x[i+1] - x[i]); pc[4 i + k] = qk (the cover's solver: value, slope and curvature at once) */
+    double *pc;
 } Curve;
 
 /* F(u) at one temperature: curves c0 and c1 (weight w of c1; c1 = c0 where w = 0) blended on a common
@@ -83,10 +91,8 @@ typedef struct {
     double e, L_pp, L_b, kb, kp, fal; /* arms (m), bearing/pp travel per unit s, F_AL factor without E */
     double u_full_ref;                /* cushion full compression at the reference temperature, m */
     double xc;                        /* bearing-system constant X_c, m */
-    int hint[2], hint_k[2];           /* last table intervals (Newton; kiss and solid points) */
+    int hint[2], hint_k[2];           /* last intervals of the two curves, solver and kiss point (search starts) */
     int hint_t;                       /* last interval of the table temperatures (the frame's bracket) */
-    const Curve *memo_c[4];           /* frame_cushion: curve, u and F of the solid (0, 1) and kiss (2, 3) points */
-    double memo_u[4], memo_f[4];
     /* the frame of the last (theta_cs K, theta_cm K, wear m): bracket, E, positions and forces */
     double f_theta_cs, f_theta_cm, f_wear, f_e;
     TBracket f_br;
@@ -111,6 +117,7 @@ typedef struct {
     int range_warned; /* the validity of the last outputs (0, 1, 2): a warning is logged on each change to 1 or 2 */
     int terminated;   /* CS: the last step was refused (fmi2Terminated / terminateSimulation) */
     int logging_on;
+    double decay_arg, decay; /* the Co-Simulation step's exp(decay_arg) (decay_arg NaN: none yet) */
     Table table;
     CcCover cover;
     int cover_ok;     /* cover prepared from the current parameters */
@@ -143,8 +150,22 @@ double cc_table_force(const Table *tb, double u, double theta_degC);
 double cc_table_delta(const Table *tb, double theta_degC);
 /* the kiss shift of a bracket's temperature (the same number as cc_table_delta at that temperature), m */
 double cc_table_delta_at(const Table *tb, const TBracket *br);
-/* the interval i of x[0] < u < x[n-1]: x[i] <= u < x[i+1] (binary search) */
+/* the interval i of x[0] < u < x[n-1]: x[i] <= u < x[i+1] (the binary search's; found from a bucket) */
 int cc_curve_locate(const Curve *c, double u);
+/* the same, inline (the cover's solver): the interval from the bucket of u, corrected until x[i] <= u < x[i+1]
+   holds, so it is the one interval the binary search finds whatever the rounding of the bucket index (buckets
+   are no wider than the narrowest interval: at most one step up from the bucket's start in exact arithmetic) */
+static inline int cc_curve_locate_inline(const Curve *c, double u) {
+    const double *x = c->x;
+    int k = (int)((u - x[0]) * c->inv_bw), i;
+    if (k > c->nb - 1) k = c->nb - 1;
+    if (k < 0) k = 0;
+    i = c->bk[k];
+    i += u >= x[i + 1];
+    while (u < x[i]) --i;
+    while (u >= x[i + 1]) ++i;
+    return i;
+}
 double cc_table_mu(const Table *tb, double theta_degC, double omega);
 double cc_table_full(const Table *tb, double theta_degC);
 /* table temperatures i and i+1 around theta with weight w of i+1 (clamped: w = 0 or 1) */

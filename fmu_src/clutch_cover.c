@@ -58,7 +58,6 @@ void cc_cover_prepare(CcCover *cv, const double *par, double lever_ratio, double
     cv->xc = x_kiss_ref + cv->kb * s_k0 + par[CV_C] * f_to;
     cv->f_theta_cs = NAN; /* no frame yet */
     cv->hint[0] = cv->hint[1] = cv->hint_k[0] = cv->hint_k[1] = cv->hint_t = 0;
-    memset(cv->memo_c, 0, sizeof cv->memo_c);
 }
 
 /* -(dx_to/ds) at its smallest (open phase, s = h) at the largest E: > 0 means no snap-through */
@@ -67,48 +66,47 @@ double cc_cover_slope_bound(const CcCover *cv) {
     return cv->kb + cv->p[CV_C] * moment_slope(cv, cv->p[CV_H], e_max) / cv->L_b;
 }
 
-/* the Newton loop's curve functions are inlined (the loop's constants stay in registers) */
+/* the solver's curve functions are inlined (the loop's constants stay in registers) */
 #if defined(__GNUC__)
 #define CC_INLINE static inline __attribute__((always_inline))
 #else
 #define CC_INLINE static inline
 #endif
 
-/* a point of one curve where F was evaluated: its interval i (-1: beyond either end, dF/du = 0), t, t^2, h */
+/* a point of one curve where F was evaluated: its interval's cubic (NULL beyond either end, where F is clamped
+   and dF/du = 0) and t */
 typedef struct {
-    int i;
-    double t, t2, h;
+    const double *q;
+    double t;
 } CurvePt;
 
-/* F(u) of one curve (PCHIP, as clutch_tables.c); *hint: the last interval, checked before use; the point is
-   kept in *pt for curve_slope */
+/* F(u) of one curve (PCHIP, the cubic of its interval in powers of t: the value of clutch_tables.c's Hermite form
+   to a few ulps); the point in *pt for curve_deriv; *hint: the last interval, a start for the search only (the
+   interval of u is unique) */
 CC_INLINE double curve_value(const Curve *c, double u, int *hint, CurvePt *pt) {
+    const double *x = c->x, *q;
     int n = c->n, i = *hint;
-    double h, t, t2;
-    if (u <= c->x[0]) { pt->i = -1; return c->y[0]; }
-    if (u >= c->x[n - 1]) { pt->i = -1; return c->y[n - 1]; }
-    if (!(i >= 0 && i < n - 1 && c->x[i] <= u && u < c->x[i + 1])) i = *hint = cc_curve_locate(c, u);
-    h = c->x[i + 1] - c->x[i];
-    t = (u - c->x[i]) / h;
-    t2 = t * t;
-    pt->i = i;
+    double t;
+    if (u <= x[0]) { pt->q = NULL; return c->y[0]; }
+    if (u >= x[n - 1]) { pt->q = NULL; return c->y[n - 1]; }
+    if (!((unsigned)i < (unsigned)(n - 1) && x[i] <= u && u < x[i + 1])) i = *hint = cc_curve_locate_inline(c, u);
+    q = c->pc + 4 * i;
+    t = (u - x[i]) * q[3];
+    pt->q = q;
     pt->t = t;
-    pt->t2 = t2;
-    pt->h = h;
-    return (2 * t2 * t - 3 * t2 + 1) * c->y[i] + (t2 * t - 2 * t2 + t) * h * c->d[i] + (-2 * t2 * t + 3 * t2) *
-           c->y[i + 1] + (t2 * t - t2) * h * c->d[i + 1];
+    return c->y[i] + t * (q[0] + t * (q[1] + t * q[2]));
 }
 
-/* dF/du of one curve at a point of curve_value (computed only where Newton needs it) */
-CC_INLINE double curve_slope(const Curve *c, const CurvePt *pt) {
-    int i = pt->i;
-    double t = pt->t, t2 = pt->t2, h = pt->h;
-    if (i < 0) return 0.0;
-    return (6 * t2 - 6 * t) * (c->y[i] - c->y[i + 1]) / h + (3 * t2 - 4 * t + 1) * c->d[i] +
-           (3 * t2 - 2 * t) * c->d[i + 1];
+/* dF/du in *d1 and d2F/du2 in *d2 at a point of curve_value (only where the solver takes a step) */
+CC_INLINE void curve_deriv(const CurvePt *pt, double *d1, double *d2) {
+    const double *q = pt->q;
+    double t = pt->t;
+    if (!q) { *d1 = *d2 = 0.0; return; }
+    *d1 = (q[0] + t * (2.0 * q[1] + 3.0 * t * q[2])) * q[3];
+    *d2 = (2.0 * q[1] + 6.0 * t * q[2]) * (q[3] * q[3]);
 }
 
-/* the cushion force at one temperature (as spring_table.Bracket.force); the points in pt[0..1] */
+/* the cushion force F_c(u) at the bracket's temperature (spring_table.Bracket.force); its curves' points in pt */
 CC_INLINE double cushion(const TBracket *b, double u, int *hint, CurvePt *pt) {
     double f0, f1, v;
     if (b->w == 0.0) return curve_value(b->c0, u, &hint[0], &pt[0]);
@@ -118,67 +116,64 @@ CC_INLINE double cushion(const TBracket *b, double u, int *hint, CurvePt *pt) {
     return (1.0 - b->w) * f0 + b->w * f1;
 }
 
-/* its slope at the points of the last cushion() call (as spring_table.Bracket.slope) */
-CC_INLINE double cushion_slope(const TBracket *b, const CurvePt *pt) {
-    if (b->w == 0.0) return curve_slope(b->c0, &pt[0]);
-    return (1.0 - b->w) * curve_slope(b->c0, &pt[0]) * b->r0 + b->w * curve_slope(b->c1, &pt[1]) * b->r1;
+/* dF_c/du in *d1 and d2F_c/du2 in *d2 at the points of the last cushion() call */
+CC_INLINE void cushion_deriv(const TBracket *b, const CurvePt *pt, double *d1, double *d2) {
+    double a0, a1, c0, c1;
+    curve_deriv(&pt[0], &a0, &c0);
+    if (b->w == 0.0) { *d1 = a0; *d2 = c0; return; }
+    curve_deriv(&pt[1], &a1, &c1);
+    *d1 = (1.0 - b->w) * a0 * b->r0 + b->w * a1 * b->r1;
+    *d2 = (1.0 - b->w) * c0 * (b->r0 * b->r0) + b->w * c1 * (b->r1 * b->r1);
 }
 
-/* the frame's cushion force at u (the full compression or the kiss point, slot 0 or 1): the curves' values
-   are kept per curve and the curve's own compression, so a new temperature that reads a curve at the same
-   point costs no curve evaluation (exact: the same numbers as cushion()) */
-/* F of curve c at uk through memo slot j (exact: the value curve_value gives) */
-static inline double memo_value(CcCover *cv, int j, const Curve *c, double uk, int *hint) {
-    CurvePt pt;
-    if (!(cv->memo_c[j] == c && cv->memo_u[j] == uk)) {
-        cv->memo_c[j] = c;
-        cv->memo_u[j] = uk;
-        cv->memo_f[j] = curve_value(c, uk, hint, &pt);
+/* the cushion force alone (the frame's points); *hint as in curve_vdd */
+static double cushion_value(const TBracket *b, double u, int *hint) {
+    CurvePt pt[2] = {{NULL, 0.0}, {NULL, 0.0}};
+    return cushion(b, u, hint, pt);
+}
+
+/* the frame: everything that depends on temperature and wear, not on x_to */
+static void frame(CcCover *cv, const Table *tb, double theta_cs, double theta_cm, double wear) {
+    const double *p = cv->p;
+    double kb = cv->kb, kp = cv->kp, comp = p[CV_C];
+    double stack, m_solid, e_mod, fk;
+    TBracket b;
+    e_mod = youngs(cv, theta_cs);
+    cc_table_bracket_hint(tb, theta_cs - KELVIN, &b, &cv->hint_t);
+    stack = cc_table_delta_at(tb, &b) +
+            (p[CV_TF] * p[CV_AF] + p[CV_TPP] * p[CV_APP] + p[CV_LFW] * p[CV_AFW]) * (theta_cm - p[CV_TREF]);
+    cv->f_e = e_mod;
+    cv->f_br = b;
+    cv->s_kiss = p[CV_SINST] + (cv->u_full_ref + stack - wear) / kp;
+    cv->s_solid = cv->s_kiss - b.full / kp;
+    /* the full compression: each curve at its last row, (1 - w) y0 + w y1 (Bracket.force there up to the
+       rounding of u_full and the curves' argument, an ulp or two of u, where dF/du is finite) */
+    {
+        const Curve *c0 = b.c0, *c1 = b.c1;
+        cv->fc_solid = b.w == 0.0 ? c0->y[c0->n - 1] : (1.0 - b.w) * c0->y[c0->n - 1] + b.w * c1->y[c1->n - 1];
     }
-    return cv->memo_f[j];
+    m_solid = moment(cv, cv->s_solid, e_mod);
+    cv->m_solid = m_solid;
+    cv->fto_solid = (m_solid - cv->fc_solid * cv->L_pp) / cv->L_b;
+    cv->x_solid = cv->xc - kb * cv->s_solid - comp * cv->fto_solid;
+    fk = cushion_value(&b, 0.0, cv->hint_k);
+    cv->fto_kiss = (moment(cv, cv->s_kiss, e_mod) - fk * cv->L_pp) / cv->L_b;
+    cv->x_kiss = cv->xc - kb * cv->s_kiss - comp * cv->fto_kiss;
+    cv->f_theta_cs = theta_cs;
+    cv->f_theta_cm = theta_cm;
+    cv->f_wear = wear;
 }
 
-static double frame_cushion(CcCover *cv, const TBracket *b, double u, int slot) {
-    double f0, f1, v;
-    if (b->w == 0.0) return memo_value(cv, 2 * slot, b->c0, u, &cv->hint_k[0]);
-    v = u - b->first;
-    f0 = memo_value(cv, 2 * slot, b->c0, b->c0->x_first + v * b->r0, &cv->hint_k[0]);
-    f1 = memo_value(cv, 2 * slot + 1, b->c1, b->c1->x_first + v * b->r1, &cv->hint_k[1]);
-    return (1.0 - b->w) * f0 + b->w * f1;
-}
 
 int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, double theta_cm, double wear,
                    CcCoverState *out) {
     const double *p = cv->p;
-    double th = theta_cs - KELVIN, kb = cv->kb, kp = cv->kp, comp = p[CV_C];
-    double lo, hi, s, r, fc, fto, dfc, e_mod;
-    CurvePt pt[2] = {{-1, 0.0, 0.0, 0.0}, {-1, 0.0, 0.0, 0.0}}; /* pt[1]: used only where w != 0 */
+    double kb = cv->kb, kp = cv->kp, comp = p[CV_C];
+    double lo, hi, s, r, fc, fto, dfc, d2fc;
+    CurvePt pt[2] = {{NULL, 0.0}, {NULL, 0.0}}; /* pt[1]: used only where w != 0, which sets it */
     int k;
-    if (!(theta_cs == cv->f_theta_cs && theta_cm == cv->f_theta_cm && wear == cv->f_wear)) {
-        /* the frame: everything that depends on temperature and wear, not on x_to */
-        double stack, m_solid;
-        TBracket b;
-        e_mod = youngs(cv, theta_cs);
-        cc_table_bracket_hint(tb, th, &b, &cv->hint_t);
-        stack = cc_table_delta_at(tb, &b) +
-                (p[CV_TF] * p[CV_AF] + p[CV_TPP] * p[CV_APP] + p[CV_LFW] * p[CV_AFW]) * (theta_cm - p[CV_TREF]);
-        cv->f_e = e_mod;
-        cv->f_br = b;
-        cv->s_kiss = p[CV_SINST] + (cv->u_full_ref + stack - wear) / kp;
-        cv->s_solid = cv->s_kiss - b.full / kp;
-        cv->fc_solid = frame_cushion(cv, &b, (cv->s_kiss - cv->s_solid) * kp, 0);
-        m_solid = moment(cv, cv->s_solid, e_mod);
-        cv->m_solid = m_solid;
-        cv->fto_solid = (m_solid - cv->fc_solid * cv->L_pp) / cv->L_b;
-        cv->x_solid = cv->xc - kb * cv->s_solid - comp * cv->fto_solid;
-        fc = frame_cushion(cv, &b, 0.0, 1);
-        cv->fto_kiss = (moment(cv, cv->s_kiss, e_mod) - fc * cv->L_pp) / cv->L_b;
-        cv->x_kiss = cv->xc - kb * cv->s_kiss - comp * cv->fto_kiss;
-        cv->f_theta_cs = theta_cs;
-        cv->f_theta_cm = theta_cm;
-        cv->f_wear = wear;
-    }
-    e_mod = cv->f_e;
+    if (!(theta_cs == cv->f_theta_cs && theta_cm == cv->f_theta_cm && wear == cv->f_wear))
+        frame(cv, tb, theta_cs, theta_cm, wear);
     out->x_solid = cv->x_solid;
     out->x_lift = cv->x_solid + comp * (cv->fto_solid > 0.0 ? cv->fto_solid : 0.0);
     out->x_kiss = cv->x_kiss;
@@ -194,12 +189,14 @@ int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
         return 0;
     }
     {
-        /* the frame's constants in locals (the same operations as moment() and moment_slope(), in the same
-           order: (fal E) (s/t) (...) e and ((fal E)/t) (...) e; only loads are saved) */
+        /* the residual r(s) = x_to(s) - x_to = P(s) + ck L_pp F_c(u(s)), P(s) = X_c - x_to - kb s - ck M(s) a cubic
+           (ck = c / L_b; M(s) = F_AL(s) e expanded in powers of s): r, dr/ds and d2r/ds2 by Horner */
         const TBracket b = cv->f_br;
         const double s_kiss = cv->s_kiss, xc = cv->xc, L_pp = cv->L_pp, L_b = cv->L_b, e = cv->e;
-        const double t = p[CV_T], h = p[CV_H], tt = t * t, h15 = 1.5 * h, fe = cv->fal * e_mod, fe_t = fe / t;
-        const double tol_r = 1e-15 * (1.0 + fabs(x_to));
+        const double t = p[CV_T], h = p[CV_H], tt = t * t;
+        const double tol_r = 1e-15 * (1.0 + fabs(x_to)), ck = comp / L_b, ckl = ck * L_pp, ckp = ckl * kp;
+        const double km = ck * cv->fal * cv->f_e * e / t;
+        const double p0 = xc - x_to, p1 = -kb - km * (1.0 + h * h / tt), p2 = km * 1.5 * h / tt, p3 = -km * 0.5 / tt;
         int hint[2];
         hint[0] = cv->hint[0];
         hint[1] = cv->hint[1];
@@ -209,25 +206,30 @@ int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
            x(s) between the solid and kiss points (cushion phase) or the rigid lever shifted by the
            kiss-point compliance (open) */
         if (x_to >= cv->x_kiss)
-            s = cv->s_solid + (cv->s_kiss - cv->s_solid) * (cv->x_solid - x_to) / (cv->x_solid - cv->x_kiss);
+            s = cv->s_solid + (s_kiss - cv->s_solid) * (cv->x_solid - x_to) / (cv->x_solid - cv->x_kiss);
         else s = (xc - x_to - comp * cv->fto_kiss) / kb;
         if (!(s > lo && s < hi)) s = hi;
         fc = cushion(&b, (s_kiss - s) * kp, hint, pt);
-        fto = (fe * (s / t) * ((h - s) * (h - 0.5 * s) / tt + 1.0) * e - fc * L_pp) / L_b;
-        r = xc - kb * s - comp * fto - x_to;
+        r = p0 + s * (p1 + s * (p2 + s * p3)) + ckl * fc;
         for (k = 0; k < 100; ++k) {
-            double slope, s_new, m_s;
+            double slope, s_new;
             if (fabs(r) <= tol_r || hi - lo <= 1e-15 * (1.0 + hi)) break;
             if (r > 0.0) lo = s; else hi = s;
-            dfc = cushion_slope(&b, pt);
-            m_s = fe_t * ((h - s) * (h - 0.5 * s) / tt + 1.0 - s * (h15 - s) / tt) * e;
-            slope = -kb - comp * (m_s + dfc * kp * L_pp) / L_b;
-            s_new = slope < 0.0 ? s - r / slope : 0.5 * (lo + hi);
+            cushion_deriv(&b, pt, &dfc, &d2fc);
+            slope = p1 + s * (2.0 * p2 + 3.0 * p3 * s) - ckp * dfc;
+            if (slope < 0.0) {
+                /* Halley's step 2 r r' / (2 r'^2 - r r'') (third order where x(s) is smooth; one division), or
+                   Newton's where it would change the Newton step by more than a factor 2 */
+                double curv = 2.0 * p2 + 6.0 * p3 * s + ckp * kp * d2fc, s2 = slope * slope;
+                double den = 2.0 * s2 - r * curv;
+                s_new = den > s2 && den < 4.0 * s2 ? s - 2.0 * r * slope / den : s - r / slope;
+            } else s_new = 0.5 * (lo + hi);
             s = (s_new > lo && s_new < hi) ? s_new : 0.5 * (lo + hi);
             fc = cushion(&b, (s_kiss - s) * kp, hint, pt);
-            fto = (fe * (s / t) * ((h - s) * (h - 0.5 * s) / tt + 1.0) * e - fc * L_pp) / L_b;
-            r = xc - kb * s - comp * fto - x_to;
+            r = p0 + s * (p1 + s * (p2 + s * p3)) + ckl * fc;
         }
+        /* the bearing force at the answer as cover.py writes it */
+        fto = (moment(cv, s, cv->f_e) - fc * L_pp) / L_b;
         cv->hint[0] = hint[0];
         cv->hint[1] = hint[1];
         out->clamp = fc;

@@ -40,14 +40,46 @@ static void pchip_slopes(const double *x, const double *y, double *d, int n) {
                          (y[n - 2] - y[n - 3]) / (x[n - 2] - x[n - 3]));
 }
 
-int cc_curve_locate(const Curve *c, double u) {
+/* the binary search for x[lo] <= u < x[lo + 1] (x[0] < u < x[n-1]) */
+static int curve_bsearch(const Curve *c, double u) {
     int lo = 0, hi = c->n - 1;
-    while (hi - lo > 1) { /* x[lo] <= u < x[hi]; written for conditional moves (no mispredicted branches) */
-        int mid = (lo + hi) / 2, le = c->x[mid] <= u;
-        lo = le ? mid : lo;
-        hi = le ? hi : mid;
+    while (hi - lo > 1) {
+        int mid = (lo + hi) / 2;
+        if (c->x[mid] <= u) lo = mid; else hi = mid;
     }
     return lo;
+}
+
+int cc_curve_locate(const Curve *c, double u) { return cc_curve_locate_inline(c, u); }
+
+/* the buckets of a loaded curve (n >= 2, x increasing); -1 if out of memory */
+static int curve_buckets(Curve *c) {
+    double span = c->x[c->n - 1] - c->x[0], dmin = span, bw;
+    int j, nb;
+    for (j = 1; j < c->n; ++j)
+        if (c->x[j] - c->x[j - 1] < dmin) dmin = c->x[j] - c->x[j - 1];
+    nb = dmin > 0.0 && span / dmin < 4095.0 ? (int)ceil(span / dmin) : 4096;
+    if (nb < 1) nb = 1;
+    bw = span / nb;
+    c->nb = nb;
+    c->inv_bw = 1.0 / bw;
+    if (c->n > 65535) return -1;
+    c->bk = (unsigned short *)malloc(sizeof(unsigned short) * nb);
+    if (!c->bk) return -1;
+    for (j = 0; j < nb; ++j) {
+        double e = c->x[0] + bw * j;
+        c->bk[j] = (unsigned short)(e <= c->x[0] ? 0 : e >= c->x[c->n - 1] ? c->n - 2 : curve_bsearch(c, e));
+    }
+    c->pc = (double *)malloc(sizeof(double) * 4 * (c->n - 1));
+    if (!c->pc) return -1;
+    for (j = 0; j < c->n - 1; ++j) { /* the Hermite cubic of curve_eval in powers of t */
+        double h = c->x[j + 1] - c->x[j], a = c->y[j], b = h * c->d[j], e = c->y[j + 1], f = h * c->d[j + 1];
+        c->pc[4 * j] = b;
+        c->pc[4 * j + 1] = 3.0 * (e - a) - 2.0 * b - f;
+        c->pc[4 * j + 2] = 2.0 * (a - e) + b + f;
+        c->pc[4 * j + 3] = 1.0 / h;
+    }
+    return 0;
 }
 
 static double curve_eval(const Curve *c, double u) {
@@ -184,7 +216,7 @@ void cc_table_free(Table *tb) {
     int k;
     if (tb->curves)
         for (k = 0; k < tb->nt; ++k) {
-            free(tb->curves[k].x); free(tb->curves[k].y); free(tb->curves[k].d);
+            free(tb->curves[k].x); free(tb->curves[k].y); free(tb->curves[k].d); free(tb->curves[k].bk); free(tb->curves[k].pc);
         }
     free(tb->curves); free(tb->theta); free(tb->delta);
     free(tb->f_theta); free(tb->f_omega); free(tb->f_mu);
@@ -356,6 +388,7 @@ int cc_table_load(Table *tb, const char *dir, char *err, size_t errlen) {
             goto fail;
         }
         pchip_slopes(c->x, c->y, c->d, n);
+        if (curve_buckets(c) != 0) { snprintf(err, errlen, "out of memory (or more than 65535 rows per curve)"); goto fail; }
         for (j = 0, c->x_first = c->x[0]; j < n; ++j)
             if (c->y[j] == c->y[0]) c->x_first = c->x[j];
     }

@@ -159,3 +159,147 @@ def test_c_host_checksum_is_deterministic_and_independent_of_the_compiler(tmp_pa
                               "checksum"], capture_output=True, text=True, check=True).stdout
         sums.append(next(ln.split()[1] for ln in out.splitlines() if ln.startswith("checksum")))
     assert len(sums[0]) == 16 and sums[0] == sums[1] == sums[2]
+
+
+SCAN_DRIVER = r"""
+#define CC_DEFINE_VARIABLE_TABLE
+#include "clutch_core.h"
+#include <stdlib.h>
+#include <string.h>
+
+/* stdin: lines "x_to theta_cs theta_cm wear" (C99 hex floats); stdout: one line per input, in input order,
+   of the cover's answer (hex floats: bit for bit) from one warm cover called in the order of argv[2] (a
+   permutation file: one input index per line), or a freshly prepared cover per call ("cold") */
+int main(int argc, char **argv) {
+    Table tb;
+    char err[600];
+    double r[CC_NVARS], (*in)[4];
+    int n = 0, cap = 1 << 16, k, *order, (*stat);
+    CcCoverState *res;
+    CcCover cv;
+    FILE *f;
+    if (argc != 3 || cc_table_load(&tb, argv[1], err, sizeof err) != 0) { printf("load failed %s\n", err); return 2; }
+    for (k = 0; k < CC_NVARS; ++k) r[k] = CC_VARIABLES[k].start;
+    in = malloc(sizeof *in * cap); order = malloc(sizeof *order * cap); res = malloc(sizeof *res * cap);
+    stat = malloc(sizeof *stat * cap);
+    while (n < cap && scanf("%la %la %la %la", &in[n][0], &in[n][1], &in[n][2], &in[n][3]) == 4) ++n;
+    if (strcmp(argv[2], "cold") != 0) {
+        f = fopen(argv[2], "r");
+        for (k = 0; k < n; ++k) if (fscanf(f, "%d", &order[k]) != 1) return 3;
+        fclose(f);
+    }
+    cc_cover_prepare(&cv, r + VR_DIAPHRAGM_OUTER_RADIUS_M, r[VR_LEVER_RATIO], r[VR_X_KISS_REF], &tb);
+    for (k = 0; k < n; ++k) {
+        int j = strcmp(argv[2], "cold") ? order[k] : k;
+        if (!strcmp(argv[2], "cold"))
+            cc_cover_prepare(&cv, r + VR_DIAPHRAGM_OUTER_RADIUS_M, r[VR_LEVER_RATIO], r[VR_X_KISS_REF], &tb);
+        memset(&res[j], 0, sizeof res[j]);
+        stat[j] = cc_cover_state(&cv, &tb, in[j][0], in[j][1], in[j][2], in[j][3], &res[j]);
+    }
+    printf("x_kiss_ref %a\n", r[VR_X_KISS_REF]);
+    for (k = 0; k < n; ++k)
+        printf("%d %a %a %a %a %a %a\n", stat[k], res[k].clamp, res[k].bearing, res[k].cushion, res[k].u, res[k].s,
+               res[k].x_kiss);
+    cc_table_free(&tb);
+    return 0;
+}
+"""
+
+
+@pytest.fixture(scope="module")
+def scan_driver(tmp_path_factory):
+    cc = shutil.which("gcc")
+    if cc is None:
+        pytest.skip("gcc not installed")
+    tmp = tmp_path_factory.mktemp("scan")
+    src = tmp / "src"
+    stage_sources(src, "{00000000-0000-0000-0000-000000000000}", 2, table_set_x_kiss_ref(DEFAULT_TABLES))
+    (src / "driver.c").write_text(SCAN_DRIVER)
+    res_dir = tmp / "res"
+    res_dir.mkdir()
+    (res_dir / "tables").symlink_to(DEFAULT_TABLES)
+    exe = tmp / "driver"
+    subprocess.run([cc, "-std=c99", "-O2", "-Wall", f"-I{src}", *(str(src / f) for f in
+                    ("driver.c", "clutch_tables.c", "clutch_cover.c", "resource_uri.c")), "-o", str(exe), "-lm"],
+                   check=True)
+
+    def run(inputs, order):
+        text = "".join(" ".join(float(v).hex() for v in row) + "\n" for row in inputs)
+        arg = "cold"
+        if order is not None:
+            arg = str(tmp / "order.txt")
+            (tmp / "order.txt").write_text("".join(f"{j}\n" for j in order))
+        out = subprocess.run([str(exe), str(res_dir), arg], input=text, capture_output=True, text=True,
+                             check=True, timeout=120).stdout.splitlines()
+        return float.fromhex(out[0].split()[1]), out[1:]
+    return run
+
+
+def _scan_inputs(wear_limit_m: float):
+    """The whole input domain: x_to -2...25 mm (every 0.5 mm, and around the kiss point), theta_cs and theta_cm
+    200...800 K (the table temperatures, between and beyond them), facing wear 0...its limit (and 1.5 times it, where
+    some temperatures cannot be held); plus random points."""
+    import numpy as np
+    rng = np.random.default_rng(28)
+    xs = [*np.arange(-0.002, 0.02501, 0.0005), *np.linspace(0.0030, 0.0046, 17)]
+    thetas = [200.0, 293.15, 320.0, 353.15, 410.0, 468.15, 500.0, 523.15, 573.15, 640.0, 800.0]
+    rows = [(x, tcs, tcm, w) for w in (0.0, 0.5 * wear_limit_m, 0.999 * wear_limit_m, 1.5 * wear_limit_m)
+            for tcs in thetas for tcm in (200.0, 353.15, 600.0, 800.0) for x in xs]
+    for _ in range(3000):
+        rows.append((rng.uniform(-0.002, 0.025), rng.uniform(200.0, 800.0), rng.uniform(200.0, 800.0),
+                     rng.uniform(0.0, wear_limit_m)))
+    return rows
+
+
+def test_native_cover_matches_the_python_model_over_the_domain(scan_driver):
+    """The C cover (Halley steps, per-interval cubics, bucket search) against cushion_clutch.model.cover (Newton,
+    Hermite form): both converge to |x(s) - x_to| <= 1e-15 (1 + |x_to|) m, so forces agree to round-off of that
+    residual: 1e-11 relative or 1e-9 N, positions to 4e-15 m (two residuals of 1e-15 m apart through
+    |dx_to/ds| >= L_b/e), the same refusals (bearing force < 0)."""
+    from dataclasses import replace
+
+    from cushion_clutch.model import ClutchParameters, load_table
+    from cushion_clutch.model.clutch_model import THETA_MAX_K, THETA_MIN_K, cover_frame
+    from cushion_clutch.model.cover import wear_limit
+
+    table, p = load_table(), ClutchParameters()
+    limit = wear_limit(p.cover, p.lever_ratio, table, p.x_kiss_ref, THETA_MIN_K, THETA_MAX_K)
+    assert limit > 1e-3
+    rows = _scan_inputs(limit)
+    x_kiss_ref, lines = scan_driver(rows, None)
+    p = replace(p, x_kiss_ref=x_kiss_ref)
+    worst = {"force": 0.0, "position": 0.0}
+    phases = {"open": 0, "cushion": 0, "solid": 0, "refused": 0}
+    for (x, tcs, tcm, w), line in zip(rows, lines, strict=True):
+        stat, *vals = line.split()
+        clamp, bearing, cushion, u, s, x_kiss = (float.fromhex(v) for v in vals)
+        try:
+            fr = cover_frame(table, replace(p, facing_wear=w), tcs, tcm)
+            st = fr.state(x)
+        except ValueError:
+            assert stat == "-1", (x, tcs, tcm, w)
+            phases["refused"] += 1
+            continue
+        assert stat == "0", (x, tcs, tcm, w)
+        phases["open" if x < fr.x_kiss else "solid" if x >= fr.x_solid else "cushion"] += 1
+        for got, ref in ((clamp, st.clamp_force), (bearing, st.bearing_force), (cushion, st.cushion_force)):
+            err = abs(got - ref) / max(abs(ref) * 1e-11, 1e-9)
+            worst["force"] = max(worst["force"], err)
+            assert err <= 1.0, (x, tcs, tcm, w, got, ref)
+        for got, ref in ((u, st.u), (s, st.s), (x_kiss, st.x_kiss)):
+            worst["position"] = max(worst["position"], abs(got - ref) / 4e-15)
+            assert abs(got - ref) <= 4e-15, (x, tcs, tcm, w, got, ref)
+    assert min(phases.values()) > 50, phases          # every phase and refusals are covered
+    print(phases, "worst error / tolerance:", worst)
+
+
+def test_native_cover_answer_is_independent_of_the_call_history(scan_driver):
+    """One warm cover (frame cache, interval hints, kept exp) answers each input with the same bits whatever came
+    before: forward, reversed and shuffled orders and a freshly prepared cover per call agree bit for bit."""
+    import numpy as np
+
+    rows = _scan_inputs(1.5e-3)
+    n = len(rows)
+    runs = [scan_driver(rows, order)[1] for order in
+            (None, list(range(n)), list(range(n))[::-1], list(np.random.default_rng(5).permutation(n)))]
+    assert all(r == runs[0] for r in runs[1:])

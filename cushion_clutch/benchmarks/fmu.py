@@ -1,7 +1,8 @@
 """Benchmark: time per step of the CushionClutch FMUs (pythonfmu and native C), and the native build time.
 
 Through fmpy (FMU2Slave: set 2 inputs, doStep, get 5 outputs), in our small C
-host (fmu_src/hosts/fmi2_host.c, dlopen), and the Python model alone; the time
+host (fmu_src/hosts/fmi2_host.c, dlopen; with valgrind also the native step's instructions, callgrind, which
+do not depend on the machine's load), and the Python model alone; the time
 to build the native FMU with the binaries of every platform (FMI 2.0: 3, FMI 3.0: 5),
 with zig's cache warm, and with ``--cold`` also from an empty zig cache.
 
@@ -90,6 +91,20 @@ def time_c_host(host: Path, fmu: Path, n: int, python: bool, workdir: Path) -> t
         if line.startswith("us_per_step"):
             us = float(line.split()[1])
     return us, res.returncode, res.stderr.strip()[-200:]
+
+
+def native_instructions(host: Path, fmu: Path, workdir: Path) -> float | None:
+    """Instructions per set+doStep+get of the native FMU in the C host (callgrind: 120 000 steps minus 20 000, so
+    start-up cancels; independent of the machine's load), or None without valgrind. ``fmu`` must have been
+    extracted into ``workdir`` by :func:`time_c_host`."""
+    from fmpy import read_model_description
+
+    if not shutil.which("valgrind"):
+        return None
+    unzip = workdir / fmu.stem
+    cmd = [str(host), str(unzip / "binaries/linux64/CushionClutch.so"), (unzip / "resources").as_uri(),
+           read_model_description(str(fmu)).guid]
+    return (_callgrind_ir(cmd + ["120000", "0.001"]) - _callgrind_ir(cmd + ["20000", "0.001"])) / 100_000
 
 
 def time_thermal(tmp: Path, n: int, repeats: int = 5) -> tuple[float, float]:
@@ -272,6 +287,9 @@ def _run(args, build_fmu, DEFAULT_TABLES, ClutchParameters, load_table, outputs,
             ch[b] = time_c_host(host, path, n * (10 if b == "native" else 1), b == "python", tmp)
             note = "" if ch[b][1] == 0 else f"  (host exit code {ch[b][1]}: {ch[b][2]!r})"
             print(f"C host, {b:>6} FMU: set+doStep+get {ch[b][0]:8.3f} us/step{note}")
+        ir = native_instructions(host, fmus["native"], tmp)
+        if ir is not None:
+            print(f"C host, native FMU: {ir:8.0f} instructions per set+doStep+get (callgrind; load-independent)")
         print(f"native speed-up: {ch['python'][0] / ch['native'][0]:.0f}x in the C host, "
               f"{fm['python'][0] / fm['native'][0]:.1f}x through fmpy")
         # the duty slips at 100 rad/s without a pause: by about 840 s the thermal FMU's facings leave the 800 K

@@ -14,7 +14,7 @@ from cushion_clutch.data import fmu_sources
 from cushion_clutch.fmu.descriptions import sources
 from cushion_clutch.fmu.native import fmi_header_dir
 from conftest import WINE
-from native_builds import model_final, native_fmus
+from native_builds import assert_final_matches_model, native_fmus
 
 pytestmark = pytest.mark.fmu
 
@@ -82,7 +82,6 @@ def test_win64_binary_runs_under_wine_with_windows_resource_uris(tmp_path, wine_
     host = _windows_host(tmp_path, 2)
     fmu = native_fmus()[2]
     guid = read_model_description(str(fmu)).guid
-    expected = model_final(3000, 0.01)
     plain = tmp_path / "plain"
     spaced = tmp_path / "r\u00e9s dir"                      # space and non-ASCII: percent-encoded in the URI
     for folder in (plain, spaced):
@@ -93,7 +92,7 @@ def test_win64_binary_runs_under_wine_with_windows_resource_uris(tmp_path, wine_
         res = subprocess.run([str(WINE), str(host), "Z:" + str(dll).replace("/", "\\"), uri, guid, "3000", "0.01"],
                              env=wine_env, capture_output=True, text=True, timeout=120)
         assert res.returncode == 0, (uri, res.stdout, res.stderr[-2000:])
-        assert _final_outputs(res.stdout) == pytest.approx(expected, rel=1e-12, abs=1e-15), uri
+        assert_final_matches_model(_final_outputs(res.stdout), 3000, 0.01, uri)
     assert "%C3%A9s%20dir" in (spaced / "resources").as_uri()
 
 
@@ -108,7 +107,7 @@ def test_fmi3_windows_binary_runs_under_wine(tmp_path, wine_env):
                           win(unzip / "resources") + "\\", token, "3000", "0.01"],
                          env=wine_env, capture_output=True, text=True, timeout=120)
     assert res.returncode == 0, (res.stdout, res.stderr[-2000:])
-    assert _final_outputs(res.stdout) == pytest.approx(model_final(3000, 0.01), rel=1e-12, abs=1e-15)
+    assert_final_matches_model(_final_outputs(res.stdout), 3000, 0.01)
 
 
 def test_fmi3_c_host_under_address_sanitizer_matches_the_model(tmp_path):
@@ -130,4 +129,4 @@ def test_fmi3_c_host_under_address_sanitizer_matches_the_model(tmp_path):
                               "PATH": "/usr/bin:/bin"})
     assert res.returncode == 0, res.stderr[-3000:]
     assert "runtime error" not in res.stderr
-    assert _final_outputs(res.stdout) == pytest.approx(model_final(3000, 0.01), rel=1e-12, abs=1e-15)
+    assert_final_matches_model(_final_outputs(res.stdout), 3000, 0.01)

@@ -183,8 +183,8 @@ def test_c_host_drives_a_simulation(fmus, tmp_path):
     cmd = _host(tmp_path, fmus)
     out = subprocess.run(cmd + ["20000", "0.01"], capture_output=True, text=True, check=True).stdout
     got = [float(v) for v in out.splitlines()[0].split()[1:]]
-    # the C and Python Newton solves start differently (chord vs rigid lever) and stop at their own
-    # 1e-15 tolerance in s; near the kiss point (a few N.m) that leaves ~1e-12 relative
+    # the C (Halley) and Python (Newton) cover solves stop at their own 1e-15 m residual: the helper's
+    # tolerances say what that leaves
     assert_final_matches_model(got, 20000, 0.01)
 
 

@@ -479,7 +479,9 @@ class _Frame:
         # root is probed, so the bracket, not the step, ends the search
         tol = tol_m / g.i
         half = 0.5 * tol
-        u = 0.5 * (lo + hi)
+        u = self._b.u_start(force)                   # from the curves' own inverses (inputs only)
+        if not lo < u < hi:
+            u = 0.5 * (lo + hi)
         while hi - lo > tol:
             f, d = fs(u)
             r = f - force

@@ -20,7 +20,7 @@ every table temperature.) Temperatures outside the table are clamped.
 from __future__ import annotations
 
 import math
-from bisect import bisect_right
+from bisect import bisect_left, bisect_right
 from pathlib import Path
 
 import numpy as np
@@ -113,6 +113,27 @@ class Curve:
         t = (u - x[i]) * k
         c0, c1, c2, c3 = self.coef[i]
         return c0 + t * (c1 + t * (c2 + t * c3)), (c1 + t * (2.0 * c2 + 3.0 * t * c3)) * k
+
+    def u_at(self, force: float) -> float:
+        """The compression where F reaches ``force`` (N), m: ``x_first`` at or below the first force, ``x_max``
+        above the last; in between the cubic of the interval where it is reached, solved by three Newton steps
+        in t from the chord (a start for the inverse of :mod:`cover`, which refines it on the blended curve)."""
+        y = self.y
+        j = bisect_left(y, force)
+        if j == 0:
+            return self.x_first
+        if j == len(y):
+            return self.x_max
+        i = j - 1
+        c0, c1, c2, c3 = self.coef[i]
+        t = (force - c0) / (y[j] - c0)              # y[i] < force <= y[j]
+        for _ in range(3):
+            d = c1 + t * (2.0 * c2 + 3.0 * t * c3)
+            if not d > 0.0:
+                break
+            t -= (c0 + t * (c1 + t * (c2 + t * c3)) - force) / d
+            t = 0.0 if t < 0.0 else (1.0 if t > 1.0 else t)
+        return self.x[i] + t / self.inv_h[i]
 
     def __call__(self, u: float) -> float:
         """F(u), N."""
@@ -288,6 +309,18 @@ class Bracket:
         f1, d1 = self.c1.value_slope(self.a1 + v * r1)
         w0, w = self.w0, self.w
         return w0 * f0 + w * f1, w0 * d0 * r0 + w * d1 * r1
+
+    def u_start(self, force: float) -> float:
+        """An estimate of the compression (m) where F reaches ``force`` (N), for the inverse's Newton start: one
+        curve's :meth:`Curve.u_at`; between two tables each curve's root on the common normalised compression,
+        blended with the weights (the blended root lies between the two)."""
+        if self.c1 is None:
+            return self.c0.u_at(force)
+        r0, r1 = self.r0, self.r1
+        if not (r0 > 0.0 and r1 > 0.0):
+            return 0.5 * (self.first + self.full)
+        return self.first + (self.w0 * (self.c0.u_at(force) - self.a0) / r0
+                             + self.w * (self.c1.u_at(force) - self.a1) / r1)
 
     # ``force_slope(u)``: (F, dF/du) at compression ``u`` (m), N and N/m; set per instance (one curve or a blend)
 

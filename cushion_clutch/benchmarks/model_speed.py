@@ -5,7 +5,9 @@
 - ``step``: the FMU benchmark's "Python model alone" loop (``thermal_step`` + ``outputs``, the temperature
   changing every step, so every call prepares a new cover frame);
 - ``outputs``: ``outputs`` at one temperature pair over a sweep of ``x_to`` (the frame cached);
-- ``state``: the cover's forward map ``_Frame.state`` alone (frame cached);
+- ``state``: the cover's forward map ``_Frame.state`` alone over the whole stroke (frame cached; a bearing
+  position past the solid point needs no Newton iteration);
+- ``state_cushion``: the same between the kiss and the solid points, where the TCUs work;
 - ``x_for_clamp``: the inverse (``_Frame.x_for_clamp``) over a sweep of clamp forces (frame cached);
 - ``x_to_for_torque``: the API inverse at a temperature that changes every call (a new frame each call);
 - ``prepare``: building a frame (``CoverMap.prepare``) at a new temperature.
@@ -38,6 +40,7 @@ def measure(n: int = 20000, repeat: int = 5) -> dict[str, float]:
     g = _cover_map(p.cover, p.lever_ratio)
     fr = cover_frame(table, p, 400.0, 420.0)
     xs = [-0.001 + 0.022 * k / 997.0 for k in range(997)]
+    xc = [fr.x_kiss + (fr.x_solid - fr.x_kiss) * (k + 0.5) / 997.0 for k in range(997)]
     fs = [8000.0 * k / 991.0 for k in range(991)]
 
     def step(m):
@@ -55,6 +58,11 @@ def measure(n: int = 20000, repeat: int = 5) -> dict[str, float]:
         for k in range(m):
             fr_state(xs[k % 997])
 
+    def state_cushion(m):
+        fr_state = fr.state
+        for k in range(m):
+            fr_state(xc[k % 997])
+
     def inverse(m):
         inv = fr.x_for_clamp
         for k in range(m):
@@ -69,6 +77,7 @@ def measure(n: int = 20000, repeat: int = 5) -> dict[str, float]:
             g.prepare(300.0 + 1e-3 * k, 320.0, 0.0, table, p.x_kiss_ref)
 
     return {"step": _time(step, n, repeat), "outputs": _time(outs, n, repeat), "state": _time(state, n, repeat),
+            "state_cushion": _time(state_cushion, n, repeat),
             "x_for_clamp": _time(inverse, n, repeat), "x_to_for_torque": _time(api_inverse, n, repeat),
             "prepare": _time(prepare, n, repeat)}
 

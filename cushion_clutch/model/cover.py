@@ -482,18 +482,20 @@ class _Frame:
         u = self._b.u_start(force)                   # from the curves' own inverses (inputs only)
         if not lo < u < hi:
             u = 0.5 * (lo + hi)
+        f_hi = self.fc_solid                         # F(hi)
         while hi - lo > tol:
             f, d = fs(u)
             r = f - force
             if r < 0.0:
                 lo = u
             else:
-                hi = u
+                hi, f_hi = u, f
             u_new = u - r / d if d > 0.0 else 0.5 * (lo + hi)
             if abs(u_new - u) < half:
                 u_new += half if r < 0.0 else -half
             u = u_new if lo < u_new < hi else 0.5 * (lo + hi)
-        return self.x_of(self.s_kiss - hi / g.kp)
+        s = self.s_kiss - hi / g.kp                  # = x_of(s), with the cushion force F(hi) already known
+        return self.xc - g.kb * s - g.comp * (g.moment_pair(s, self._fe)[0] - f_hi * g.L_pp) / g.L_b
 
 
 #: the engine torque the wear reserve is stated against (the default launch engine's peak), N.m

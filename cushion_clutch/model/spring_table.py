@@ -33,6 +33,8 @@ except ImportError:
     from table_format import COLUMNS, FORCE_DEFLECTION, FRICTION, KISS_POINT, load_csv
 
 KELVIN = 273.15
+#: brackets (blended curves) a table keeps, by exact temperature
+BRACKETS_KEPT = 64
 #: largest accepted table force, N (a clutch clamp load is kN; larger values are corrupt tables)
 FORCE_LIMIT_N = 1e9
 
@@ -180,7 +182,7 @@ class SpringTable:
         self.friction = None
         self.theta_min_K = self.theta_degC[0] + KELVIN
         self.theta_max_K = self.theta_degC[-1] + KELVIN
-        self._last: Bracket | None = None
+        self._kept: dict[float, Bracket] = {}
 
     @classmethod
     def from_dir(cls, folder: str | Path) -> "SpringTable":
@@ -226,15 +228,18 @@ class SpringTable:
         return i, (theta_degC - ts[i]) / (ts[i + 1] - ts[i])
 
     def bracket(self, theta_degC: float) -> "Bracket":
-        """The blended curve at ``theta_degC`` (kept for the last temperature asked)."""
-        last = self._last
-        if last is not None and last.theta_degC == theta_degC:
-            return last
+        """The blended curve at ``theta_degC`` (kept for the last :data:`BRACKETS_KEPT` temperatures asked, by
+        exact value: a bracket depends on the temperature alone)."""
+        b = self._kept.get(theta_degC)
+        if b is not None:
+            return b
         i, w = self._bracket(theta_degC)
         d = self.delta_kiss_m
         b = Bracket(theta_degC, self.curves[i], self.curves[i + 1] if w != 0.0 else None, w,
                     d[i] if w == 0.0 else (1.0 - w) * d[i] + w * d[i + 1])
-        self._last = b
+        if len(self._kept) >= BRACKETS_KEPT:
+            self._kept.clear()
+        self._kept[theta_degC] = b
         return b
 
     def force(self, u_m: float, theta_degC: float) -> float:

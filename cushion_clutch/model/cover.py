@@ -385,8 +385,9 @@ class _Frame:
         self._fs = self._b.force_slope               # (F, dF/du) at a compression u
         self._fe = g._fal * e_mod                    # the Almen-Laszlo factor times E (CoverMap.moment_pair)
         self.s_kiss, self.s_solid, self.theta_cs, self.wear = s_kiss, s_solid, theta_cs, wear
-        self.fto_solid, self.fc_solid = self.f_to(s_solid)
         self.m_solid = g.moment_pair(s_solid, self._fe)[0]     # the diaphragm's moment at the solid position, N.m
+        self.fc_solid = self._b.f_full                          # the cushion fully compressed, N
+        self.fto_solid = (self.m_solid - self.fc_solid * g.L_pp) / g.L_b       # = f_to(s_solid)
         self.x_solid = xc - g.kb * s_solid - g.comp * self.fto_solid
         self.x_lift = self.x_solid + g.comp * max(self.fto_solid, 0.0)
         self.fto_kiss = self.f_to(s_kiss)[0]

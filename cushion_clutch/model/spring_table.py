@@ -280,10 +280,13 @@ class Bracket:
     first, full : float
         First contact and full compression at this temperature, m: ``(1 - w) a_0 + w a_1`` and
         ``(1 - w) b_0 + w b_1`` of the curves' own (``Curve.x_first``, ``Curve.x_max``).
+    f_first, f_full : float
+        F at and below first contact and at and beyond full compression, N (the curves' first and last forces,
+        blended).
     """
 
     __slots__ = ("theta_degC", "c0", "c1", "w", "first", "full", "r0", "r1", "w0", "a0", "a1", "f_first",
-                 "delta_kiss", "force_slope")
+                 "f_full", "delta_kiss", "force_slope")
 
     def __init__(self, theta_degC: float, c0: Curve, c1: Curve | None, w: float, delta_kiss: float = math.nan):
         self.theta_degC, self.c0, self.c1, self.w = theta_degC, c0, c1, w
@@ -291,6 +294,7 @@ class Bracket:
         self.delta_kiss = delta_kiss
         if w == 0.0:
             self.first, self.full, self.r0, self.r1 = c0.x_first, c0.x_max, 1.0, 0.0
+            self.f_first, self.f_full = c0.y_first, c0.y_last
             self.force_slope = c0.value_slope
             return
         self.first = (1.0 - w) * c0.x_first + w * c1.x_first
@@ -302,6 +306,8 @@ class Bracket:
         self.w0, self.a0, self.a1 = 1.0 - w, c0.x_first, c1.x_first
         #: F below the first contact: each curve's first force, blended
         self.f_first = self.w0 * c0.y_first + w * c1.y_first
+        #: F at and beyond full compression: each curve's last force, blended
+        self.f_full = self.w0 * c0.y_last + w * c1.y_last
         self.force_slope = self._blend
 
     def _blend(self, u: float) -> tuple[float, float]:

@@ -329,9 +329,9 @@ class CoverMap:
 
         Unlike :meth:`prepare` it does not check that the diaphragm holds the fully compressed cushion.
         """
-        s = self.s_kiss(theta_cs, theta_cm, wear, table)
-        f_to = (self.moment(s, self.youngs_modulus(theta_cs)) - table.force(0.0, theta_cs - 273.15) * self.L_pp) \
-            / self.L_b
+        br = table.bracket(theta_cs - 273.15)
+        s = self._s_kiss(br.delta_kiss, theta_cm, wear, table)
+        f_to = (self.moment(s, self.youngs_modulus(theta_cs)) - br.force_slope(0.0)[0] * self.L_pp) / self.L_b
         return self.x_c(table, x_kiss_ref) - self.kb * s - self.comp * f_to
 
     def state(self, x_to: float, theta_cs: float, theta_cm: float, wear: float, table, x_kiss_ref: float,

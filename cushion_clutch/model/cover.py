@@ -68,8 +68,13 @@ pressure-plate travel, paper: 3). Arms ``L_pp = r_pp - r_f``, ``L_b = r_f - r_b 
    the step is immediate.) The torque is then ``n mu R_eq F_pp``, non-decreasing in ``x_to``.
 
 The forward map (``x_to`` -> ``s``) is solved by a safeguarded Newton iteration on ``s``
-bracketed by ``[s_solid, s_rigid]`` (``s_rigid`` = the ``c = 0`` answer); the inverse
-(clamp force -> ``x_to``) is explicit: the cushion table is inverted for ``u``.
+bracketed by ``[s_solid, s_rigid]`` (``s_rigid`` = the ``c = 0`` answer), started from the chord
+between the kiss and solid points; the inverse (clamp force -> ``x_to``) is explicit once the
+cushion table is inverted for ``u``: a bracketed Newton iteration on ``u`` started from each table
+curve's own inverse (its cubic solved in the interval where the force is reached), blended as the
+curves are. Both starts depend on the inputs only; a frame (everything that depends on the
+temperatures and the wear) is kept by the exact inputs (``clutch_model.cover_frame``), so an answer
+never depends on the calls before it (``tests/test_cover_exact.py``).
 
 7. What the cover can hold (:func:`hold_problem`, :func:`wear_limit`). The balance needs
    ``F_to >= 0`` while the cushion compresses, i.e. ``M(s) >= F_c(u(s)) L_pp`` from the kiss to

@@ -3,7 +3,9 @@
 Shared by the pythonfmu slave and the Python API (through ``clutch_model``).
 Force: shape-preserving (PCHIP, Fritsch-Carlson) cubic in u per table
 temperature; u below a curve's first contact gives its first force (zero),
-beyond its full compression the full-compression force.
+beyond its full compression the full-compression force. Each interval's cubic is
+kept as its Hermite form collected by powers of t (built once per table) and
+evaluated with its slope in one call (:meth:`Curve.value_slope`), in plain floats.
 
 Between two table temperatures the curves are blended on a common normalised
 compression: first contact ``a(theta)`` and full compression ``b(theta)`` are

@@ -308,7 +308,7 @@ def thermal_step(theta_cs: float, theta_cm: float, dt: float, p: ClutchParameter
     return theta_inf + (theta_cs - theta_inf) * math.exp(-dt * g / p.C)
 
 
-@dataclass
+@dataclass(slots=True)
 class Outputs:
     """Model outputs at one instant (SI)."""
 
@@ -344,11 +344,17 @@ def _cover_map(cover: CoverParameters, lever_ratio: float) -> CoverMap:
     return _last_cover(_LAST_MAP, _cover_map_cached, cover, lever_ratio)
 
 
-_LAST_FRAME: list = [None, None, None, None]   # table, key, frame, cover: the last temperature/wear frame
+#: frames kept (exact keys; all dropped when full): the TCUs evaluate a few temperature pairs per control cycle
+FRAME_CACHE_SIZE = 64
+_FRAMES: dict = {}
+_FRAMES_OWNER: list = [None, None]      # the table and cover the kept frames belong to
 
 
 def cover_frame(table: SpringTable, p: ClutchParameters, theta_cs: float, theta_cm: float):
-    """The cover's force balance at ``theta_cs``, ``theta_cm`` (K) and ``p.facing_wear`` (cached: last one).
+    """The cover's force balance at ``theta_cs``, ``theta_cm`` (K) and ``p.facing_wear``.
+
+    Kept for the last :data:`FRAME_CACHE_SIZE` exact (lever ratio, x_kiss_ref, wear, theta_cs, theta_cm) of the
+    last table and cover: a frame depends on these alone, so the answer never depends on what was asked before.
 
     Raises
     ------
@@ -356,10 +362,17 @@ def cover_frame(table: SpringTable, p: ClutchParameters, theta_cs: float, theta_
         If the diaphragm cannot hold the cushion at this temperature and wear.
     """
     key = (p.lever_ratio, p.x_kiss_ref, p.facing_wear, theta_cs, theta_cm)
-    if _LAST_FRAME[0] is table and _LAST_FRAME[3] is p.cover and _LAST_FRAME[1] == key:
-        return _LAST_FRAME[2]
+    if _FRAMES_OWNER[0] is table and _FRAMES_OWNER[1] is p.cover:
+        frame = _FRAMES.get(key)
+        if frame is not None:
+            return frame
+    else:
+        _FRAMES.clear()
+        _FRAMES_OWNER[:] = [table, p.cover]
     frame = _cover_map(p.cover, p.lever_ratio).prepare(theta_cs, theta_cm, p.facing_wear, table, p.x_kiss_ref)
-    _LAST_FRAME[:] = [table, key, frame, p.cover]
+    if len(_FRAMES) >= FRAME_CACHE_SIZE:
+        _FRAMES.clear()
+    _FRAMES[key] = frame
     return frame
 
 
@@ -393,6 +406,23 @@ def _check_table_parameters(table: SpringTable, p: ClutchParameters) -> None:
     problems = table_problems(table, p)
     if problems:
         raise ValueError("p: " + "; ".join(problems))
+
+
+_CHECKED: list = [None, None, None]     # table, cover, values of CLUTCH_PARAMETERS that passed every check
+
+
+def _parameters_checked(table: SpringTable, p: ClutchParameters) -> tuple | None:
+    """None if ``p`` (CLUTCH_PARAMETERS and its cover) passed :func:`_clutch_ok` and :func:`table_problems` with
+    ``table`` in the last check, else the key to record with :func:`_passed` once they do (exact values: a NaN
+    never matches)."""
+    key = (p.n_surfaces, p.mu, p.R_eq, p.x_kiss_ref, p.lever_ratio, p.facing_wear)
+    if _CHECKED[0] is table and _CHECKED[1] is p.cover and _CHECKED[2] == key:
+        return None
+    return key
+
+
+def _passed(table: SpringTable, p: ClutchParameters, key: tuple) -> None:
+    _CHECKED[:] = [table, p.cover, key]
 
 
 def validity(theta_cs: float, theta_cm: float | None, table: SpringTable, p: ClutchParameters) -> int:
@@ -466,12 +496,15 @@ def outputs(x_to: float, theta_cs: float, table: SpringTable, p: ClutchParameter
     ValueError
         Naming the argument or parameter if one is not finite or outside its range.
     """
+    key = _parameters_checked(table, p)
     if not (X_TO_MIN <= x_to <= X_TO_MAX and THETA_MIN_K <= theta_cs <= THETA_MAX_K
             and -OMEGA_SLIP_LIMIT <= omega_slip <= OMEGA_SLIP_LIMIT
-            and (theta_cm is None or THETA_MIN_K <= theta_cm <= THETA_MAX_K) and _clutch_ok(p)):
+            and (theta_cm is None or THETA_MIN_K <= theta_cm <= THETA_MAX_K) and (key is None or _clutch_ok(p))):
         raise _argument_error({"x_to": x_to, "theta_cs": theta_cs, "omega_slip": omega_slip,
                                **({} if theta_cm is None else {"theta_cm": theta_cm})}, p, CLUTCH_PARAMETERS)
-    _check_table_parameters(table, p)
+    if key is not None:
+        _check_table_parameters(table, p)
+        _passed(table, p, key)
     st = cover_frame(table, p, theta_cs, theta_cs if theta_cm is None else theta_cm).state(x_to)
     clamped = not (table.theta_min_K <= theta_cs <= table.theta_max_K)
     mu = friction_coefficient(table, p, theta_cm, omega_slip)
@@ -516,12 +549,15 @@ def x_to_for_torque(torque: float, theta_cs: float, table: SpringTable, p: Clutc
         Naming the argument or parameter if one is not finite or outside its range
         (``torque`` in [-1e9, 1e9] N.m).
     """
+    key = _parameters_checked(table, p)
     if not (-1e9 <= torque <= 1e9 and THETA_MIN_K <= theta_cs <= THETA_MAX_K and 0.0 < tol_m <= 1.0
             and -OMEGA_SLIP_LIMIT <= omega_slip <= OMEGA_SLIP_LIMIT
-            and (theta_cm is None or THETA_MIN_K <= theta_cm <= THETA_MAX_K) and _clutch_ok(p)):
+            and (theta_cm is None or THETA_MIN_K <= theta_cm <= THETA_MAX_K) and (key is None or _clutch_ok(p))):
         raise _argument_error({"torque": torque, "theta_cs": theta_cs, "tol_m": tol_m, "omega_slip": omega_slip,
                                **({} if theta_cm is None else {"theta_cm": theta_cm})}, p, CLUTCH_PARAMETERS)
-    _check_table_parameters(table, p)
+    if key is not None:
+        _check_table_parameters(table, p)
+        _passed(table, p, key)
     gain = p.n_surfaces * friction_coefficient(table, p, theta_cm, omega_slip) * p.R_eq
     frame = cover_frame(table, p, theta_cs, theta_cs if theta_cm is None else theta_cm)
     return frame.x_for_clamp(torque / gain if gain > 0.0 else 0.0, tol_m)

@@ -68,8 +68,13 @@ pressure-plate travel, paper: 3). Arms ``L_pp = r_pp - r_f``, ``L_b = r_f - r_b 
    the step is immediate.) The torque is then ``n mu R_eq F_pp``, non-decreasing in ``x_to``.
 
 The forward map (``x_to`` -> ``s``) is solved by a safeguarded Newton iteration on ``s``
-bracketed by ``[s_solid, s_rigid]`` (``s_rigid`` = the ``c = 0`` answer); the inverse
-(clamp force -> ``x_to``) is explicit: the cushion table is inverted for ``u``.
+bracketed by ``[s_solid, s_rigid]`` (``s_rigid`` = the ``c = 0`` answer), started from the chord
+between the kiss and solid points; the inverse (clamp force -> ``x_to``) is explicit once the
+cushion table is inverted for ``u``: a bracketed Newton iteration on ``u`` started from each table
+curve's own inverse (its cubic solved in the interval where the force is reached), blended as the
+curves are. Both starts depend on the inputs only; a frame (everything that depends on the
+temperatures and the wear) is kept by the exact inputs (``clutch_model.cover_frame``), so an answer
+never depends on the calls before it (``tests/test_cover_exact.py``).
 
 7. What the cover can hold (:func:`hold_problem`, :func:`wear_limit`). The balance needs
    ``F_to >= 0`` while the cushion compresses, i.e. ``M(s) >= F_c(u(s)) L_pp`` from the kiss to
@@ -220,7 +225,7 @@ def almen_laszlo_slope(s: float, a: float, b: float, t: float, h: float, e_mod: 
     return c * ((h - s) * (h - 0.5 * s) / (t * t) + 1.0 - s * (1.5 * h - s) / (t * t))
 
 
-@dataclass
+@dataclass(slots=True)
 class CoverState:
     """The cover at one bearing position (SI)."""
 
@@ -251,6 +256,7 @@ class CoverMap:
         t, nu = cover.diaphragm_thickness_m, cover.diaphragm_poisson_ratio
         #: F_AL(s) / E / (s/t) / [...]: the Almen-Laszlo factor without E, 1/Pa * N
         self._fal = 4.0 / (1.0 - nu * nu) * t ** 4 / (k1(self.a, self.b) * 4.0 * self.a * self.a)
+        self._t, self._h, self._tt = t, cover.diaphragm_cone_height_m, t * t
         self._xc: tuple = (None, None, None)     # (table, x_kiss_ref, X_c) of the last call: holds one table only
         self._u_full_ref: tuple = (None, 0.0)     # (table, full compression at the reference temperature)
 
@@ -262,13 +268,18 @@ class CoverMap:
 
     def moment(self, s: float, e_mod: float) -> float:
         """Elastic moment M(s) = F_AL(s) e of the diaphragm section, N.m (:func:`almen_laszlo_force` times e)."""
-        t, h = self.c.diaphragm_thickness_m, self.c.diaphragm_cone_height_m
-        return self._fal * e_mod * (s / t) * ((h - s) * (h - 0.5 * s) / (t * t) + 1.0) * self.e
+        return self.moment_pair(s, self._fal * e_mod)[0]
 
     def moment_slope(self, s: float, e_mod: float) -> float:
         """dM/ds, N (:func:`almen_laszlo_slope` times e)."""
-        t, h = self.c.diaphragm_thickness_m, self.c.diaphragm_cone_height_m
-        return self._fal * e_mod / t * ((h - s) * (h - 0.5 * s) / (t * t) + 1.0 - s * (1.5 * h - s) / (t * t)) * self.e
+        return self.moment_pair(s, self._fal * e_mod)[1]
+
+    def moment_pair(self, s: float, fe: float) -> tuple[float, float]:
+        """(M(s), dM/ds) (N.m, N) with ``fe`` = the Almen-Laszlo factor times E (``_fal * e_mod``, kept by a frame)."""
+        t, h, tt = self._t, self._h, self._tt
+        hs = h - s
+        q = hs * (h - 0.5 * s) / tt + 1.0
+        return fe * (s / t) * q * self.e, fe / t * (q - s * (1.5 * h - s) / tt) * self.e
 
     def x_slope_bound(self, e_mod: float) -> float:
         """-(dx_to/ds) at its largest, open phase, 1 (> 0: no snap-through)."""
@@ -297,15 +308,20 @@ class CoverMap:
     def prepare(self, theta_cs: float, theta_cm: float, wear: float, table, x_kiss_ref: float) -> "_Frame":
         """Everything of the balance that depends on temperature and wear, not on ``x_to``."""
         theta_c = theta_cs - 273.15
-        s_kiss = self.s_kiss(theta_cs, theta_cm, wear, table)
+        br = table.bracket(theta_c)
+        s_kiss = self._s_kiss(br.delta_kiss, theta_cm, wear, table)
         return _Frame(self, table, theta_c, self.youngs_modulus(theta_cs), self.x_c(table, x_kiss_ref), s_kiss,
-                      s_kiss - table.full_compression(theta_c) / self.kp, theta_cs, wear)
+                      s_kiss - br.full / self.kp, theta_cs, wear, br)
 
     def s_kiss(self, theta_cs: float, theta_cm: float, wear: float, table) -> float:
         """Diaphragm deflection (m) at the kiss point: installed deflection, cushion shift, stack growth, wear."""
+        return self._s_kiss(table.delta_kiss(theta_cs - 273.15), theta_cm, wear, table)
+
+    def _s_kiss(self, delta_kiss: float, theta_cm: float, wear: float, table) -> float:
+        """:meth:`s_kiss` with the cushion's kiss shift ``delta_kiss`` (m) at theta_cs given."""
         c = self.c
         g = theta_cm - c.reference_temperature_K
-        stack = table.delta_kiss(theta_cs - 273.15) + (
+        stack = delta_kiss + (
             c.facing_thickness_m * c.facing_expansion_per_K * g
             + c.pressure_plate_thickness_m * c.pressure_plate_expansion_per_K * g
             + c.flywheel_length_m * c.flywheel_expansion_per_K * g)        # = sum(self.growth(theta_cm).values())
@@ -318,9 +334,9 @@ class CoverMap:
 
         Unlike :meth:`prepare` it does not check that the diaphragm holds the fully compressed cushion.
         """
-        s = self.s_kiss(theta_cs, theta_cm, wear, table)
-        f_to = (self.moment(s, self.youngs_modulus(theta_cs)) - table.force(0.0, theta_cs - 273.15) * self.L_pp) \
-            / self.L_b
+        br = table.bracket(theta_cs - 273.15)
+        s = self._s_kiss(br.delta_kiss, theta_cm, wear, table)
+        f_to = (self.moment(s, self.youngs_modulus(theta_cs)) - br.force_slope(0.0)[0] * self.L_pp) / self.L_b
         return self.x_c(table, x_kiss_ref) - self.kb * s - self.comp * f_to
 
     def state(self, x_to: float, theta_cs: float, theta_cm: float, wear: float, table, x_kiss_ref: float,
@@ -364,12 +380,19 @@ class CoverMap:
 class _Frame:
     """The cover balance at one temperature and wear (see the module docstring for the equations)."""
 
+    __slots__ = ("g", "table", "theta_c", "e_mod", "xc", "_b", "_fs", "_fe", "s_kiss", "s_solid", "theta_cs", "wear",
+                 "fto_solid", "fc_solid", "x_solid", "x_lift", "fto_kiss", "x_kiss", "m_solid")
+
     def __init__(self, g: CoverMap, table, theta_c: float, e_mod: float, xc: float, s_kiss: float, s_solid: float,
-                 theta_cs: float, wear: float):
+                 theta_cs: float, wear: float, bracket=None):
         self.g, self.table, self.theta_c, self.e_mod, self.xc = g, table, theta_c, e_mod, xc
-        self._b = table.bracket(theta_c)            # F(u) at this temperature, as table.force uses it
+        self._b = table.bracket(theta_c) if bracket is None else bracket   # F(u) at this temperature (table.force)
+        self._fs = self._b.force_slope               # (F, dF/du) at a compression u
+        self._fe = g._fal * e_mod                    # the Almen-Laszlo factor times E (CoverMap.moment_pair)
         self.s_kiss, self.s_solid, self.theta_cs, self.wear = s_kiss, s_solid, theta_cs, wear
-        self.fto_solid, self.fc_solid = self.f_to(s_solid)
+        self.m_solid = g.moment_pair(s_solid, self._fe)[0]     # the diaphragm's moment at the solid position, N.m
+        self.fc_solid = self._b.f_full                          # the cushion fully compressed, N
+        self.fto_solid = (self.m_solid - self.fc_solid * g.L_pp) / g.L_b       # = f_to(s_solid)
         self.x_solid = xc - g.kb * s_solid - g.comp * self.fto_solid
         self.x_lift = self.x_solid + g.comp * max(self.fto_solid, 0.0)
         self.fto_kiss = self.f_to(s_kiss)[0]
@@ -383,17 +406,17 @@ class _Frame:
 
     def cushion(self, u: float) -> float:
         """F(u, theta_cs), N (= ``table.force``, with the temperature bracket found once)."""
-        return self._b.force(u)
+        return self._fs(u)[0]
 
     def cushion_slope(self, u: float) -> float:
         """dF/du at theta_cs, N/m (= ``table.force_slope``)."""
-        return self._b.slope(u)
+        return self._fs(u)[1]
 
     def f_to(self, s: float) -> tuple[float, float]:
         """(bearing force, cushion force) at deflection ``s`` while the bearing is on the fingers, N."""
         g = self.g
-        fc = self.cushion((self.s_kiss - s) * g.kp)
-        return (g.moment(s, self.e_mod) - fc * g.L_pp) / g.L_b, fc
+        fc = self._fs((self.s_kiss - s) * g.kp)[0]
+        return (g.moment_pair(s, self._fe)[0] - fc * g.L_pp) / g.L_b, fc
 
     def x_of(self, s: float) -> float:
         """Bearing position at deflection ``s`` (s >= s_solid), m."""
@@ -401,72 +424,84 @@ class _Frame:
 
     def clamp_installed(self) -> float:
         """The diaphragm's load at the solid position, bearing lifted: the closed clamp force, N."""
-        return self.g.moment(self.s_solid, self.e_mod) / self.g.L_pp
+        return self.m_solid / self.g.L_pp
 
     def state(self, x_to: float, tol: float = 1e-15) -> CoverState:
-        g, kb, kp, comp = self.g, self.g.kb, self.g.kp, self.g.comp
-        s_kiss, u_full = self.s_kiss, (self.s_kiss - self.s_solid) * kp
-        if x_to >= self.x_solid:
-            fto = max(0.0, self.fto_solid - (x_to - self.x_solid) / comp) if comp > 0.0 else 0.0
-            fpp = (g.moment(self.s_solid, self.e_mod) - fto * g.L_b) / g.L_pp
-            return CoverState(fpp, fto, self.fc_solid, u_full, self.s_solid, self.x_kiss, self.x_solid, self.x_lift)
-        lo, hi = self.s_solid, (self.xc - x_to) / kb       # x_of(lo) > x_to >= x_of(hi)
+        g = self.g
+        kb, kp, comp, L_pp, L_b = g.kb, g.kp, g.comp, g.L_pp, g.L_b
+        s_kiss, s_solid, x_solid = self.s_kiss, self.s_solid, self.x_solid
+        u_full = (s_kiss - s_solid) * kp
+        if x_to >= x_solid:
+            fto = max(0.0, self.fto_solid - (x_to - x_solid) / comp) if comp > 0.0 else 0.0
+            fpp = (self.m_solid - fto * L_b) / L_pp
+            return CoverState(fpp, fto, self.fc_solid, u_full, s_solid, self.x_kiss, x_solid, self.x_lift)
+        xc = self.xc
+        lo, hi = s_solid, (xc - x_to) / kb       # x_of(lo) > x_to >= x_of(hi)
         # start (as the C core's, from the inputs only): the chord of x(s) between the solid and kiss points
         # (cushion phase) or the rigid lever shifted by the kiss point's compliance (open)
         if x_to >= self.x_kiss:
-            s = self.s_solid + (s_kiss - self.s_solid) * (self.x_solid - x_to) / (self.x_solid - self.x_kiss)
+            s = s_solid + (s_kiss - s_solid) * (x_solid - x_to) / (x_solid - self.x_kiss)
         else:
-            s = (self.xc - x_to - comp * self.fto_kiss) / kb
+            s = (xc - x_to - comp * self.fto_kiss) / kb
         if not lo < s < hi:
             s = hi
-        xc = self.xc
-        fto, fc = self.f_to(s)
+        mp, fs, fe = g.moment_pair, self._fs, self._fe
+        m, dm = mp(s, fe)
+        fc, dfc = fs((s_kiss - s) * kp)
+        fto = (m - fc * L_pp) / L_b
         r = xc - kb * s - comp * fto - x_to                  # = self.x_of(s) - x_to
+        eps_r = tol * (1.0 + abs(x_to))
         for _ in range(100):
-            if abs(r) <= tol * (1.0 + abs(x_to)) or hi - lo <= tol * (1.0 + hi):
+            if abs(r) <= eps_r or hi - lo <= tol * (1.0 + hi):
                 break
             if r > 0.0:
                 lo = s
             else:
                 hi = s
-            u = (s_kiss - s) * kp
-            slope = -kb - comp * (g.moment_slope(s, self.e_mod)
-                                  + self.cushion_slope(u) * kp * g.L_pp) / g.L_b
+            slope = -kb - comp * (dm + dfc * kp * L_pp) / L_b
             s_new = s - r / slope if slope < 0.0 else 0.5 * (lo + hi)
             s = s_new if lo < s_new < hi else 0.5 * (lo + hi)
-            fto, fc = self.f_to(s)
+            m, dm = mp(s, fe)
+            fc, dfc = fs((s_kiss - s) * kp)
+            fto = (m - fc * L_pp) / L_b
             r = xc - kb * s - comp * fto - x_to
         if fto < 0.0:
             raise ValueError(self._weak(fto, f"x_to = {x_to:g} m"))
-        return CoverState(fc, fto, fc, (s_kiss - s) * kp, s, self.x_kiss, self.x_solid, self.x_lift)
+        return CoverState(fc, fto, fc, (s_kiss - s) * kp, s, self.x_kiss, x_solid, self.x_lift)
 
     def x_for_clamp(self, force: float, tol_m: float = 1e-12) -> float:
         g = self.g
         if force >= self.clamp_installed():
             return self.x_lift
         if force > self.fc_solid:       # solid phase: F_to = (M(s_solid) - F L_pp) / L_b
-            fto = (g.moment(self.s_solid, self.e_mod) - force * g.L_pp) / g.L_b
+            fto = (self.m_solid - force * g.L_pp) / g.L_b
             return self.x_solid + g.comp * (self.fto_solid - fto)
+        fs = self._fs
         lo, hi = self._b.first, self._b.full
-        if force <= self._b.force(lo):
+        if force <= fs(lo)[0]:
             return self.x_of(self.s_kiss - lo / g.kp)
         # the smallest compression u with F(u) >= force, to tol: a bracket F(lo) < force <= F(hi) closed by
         # Newton steps (bisection where a step leaves it); once a step is below tol the other side of the
         # root is probed, so the bracket, not the step, ends the search
         tol = tol_m / g.i
-        u = 0.5 * (lo + hi)
+        half = 0.5 * tol
+        u = self._b.u_start(force)                   # from the curves' own inverses (inputs only)
+        if not lo < u < hi:
+            u = 0.5 * (lo + hi)
+        f_hi = self.fc_solid                         # F(hi)
         while hi - lo > tol:
-            r = self.cushion(u) - force
+            f, d = fs(u)
+            r = f - force
             if r < 0.0:
                 lo = u
             else:
-                hi = u
-            d = self.cushion_slope(u)
+                hi, f_hi = u, f
             u_new = u - r / d if d > 0.0 else 0.5 * (lo + hi)
-            if abs(u_new - u) < 0.5 * tol:
-                u_new += 0.5 * tol if r < 0.0 else -0.5 * tol
+            if abs(u_new - u) < half:
+                u_new += half if r < 0.0 else -half
             u = u_new if lo < u_new < hi else 0.5 * (lo + hi)
-        return self.x_of(self.s_kiss - hi / g.kp)
+        s = self.s_kiss - hi / g.kp                  # = x_of(s), with the cushion force F(hi) already known
+        return self.xc - g.kb * s - g.comp * (g.moment_pair(s, self._fe)[0] - f_hi * g.L_pp) / g.L_b
 
 
 #: the engine torque the wear reserve is stated against (the default launch engine's peak), N.m

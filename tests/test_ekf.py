@@ -233,3 +233,17 @@ def test_the_heat_scale_is_the_networks_inverse_heat_capacity(table):
     unscaled = capacity_mismatch_run(table, 1.0)
     assert max(abs(unscaled)) > 8.0                         # the mismatch matters (K)
     assert max(abs(err)) < 0.05                              # K: the discretisation only
+
+
+def test_a_facing_estimate_beyond_the_models_range_does_not_stop_the_tcu(table):
+    """On heavy duty without protection the estimate can pass the clutch model's 800 K ceiling (the plant's
+    facings at 470 degC, the estimate's Jacobian step 1 K above): the model is evaluated at the ceiling,
+    and the update runs."""
+    p = ClutchParameters()
+    ekf = ClutchEkf(TcuNetworkParams(), EkfParams(), table, p, TA, 799.5)
+    assert ekf.theta_cm_model == 799.5
+    ekf.s[:9] = 850.0
+    assert ekf.theta_cm_model == 800.0
+    x = x_to_for_torque(120.0, table.theta_max_K, table, p, theta_cm=800.0)
+    assert np.isfinite(ekf.model_torque(x))
+    assert ekf.correct(ekf.model_torque(x) + 1.0, x, 100.0, True)

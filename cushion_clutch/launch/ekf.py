@@ -125,6 +125,7 @@ import numpy as np
 from ..config import Checked
 from ..model import x_to_for_torque
 from ..model import ClutchParameters, SpringTable, outputs
+from ..model.clutch_model import THETA_MAX_K, THETA_MIN_K
 from .thermal_network import FACINGS, N_NODES, TcuNetworkBase, ThermalNetwork
 
 #: state indices: the network's nodes, then these
@@ -360,6 +361,13 @@ class ClutchEkf:
         return float(0.5 * (self.s[F1] + self.s[F2]))
 
     @property
+    def theta_cm_model(self) -> float:
+        """The facing temperature the TCU's clutch model is evaluated at: :attr:`theta_cm` within the model's
+        range ``[THETA_MIN_K, THETA_MAX_K]`` (an estimate beyond it, far past the facings' damage limit, must not
+        stop the TCU), K."""
+        return min(max(self.theta_cm, THETA_MIN_K), THETA_MAX_K)
+
+    @property
     def dx_kiss(self) -> float:
         """Learned touch-point offset at the bearing, m."""
         return float(self.s[IX_DX])
@@ -446,7 +454,7 @@ class ClutchEkf:
         """
         s = self.s if s is None else s
         th = min(max(float(s[IX_CS]), self.table.theta_min_K), self.table.theta_max_K)
-        theta_cm = float(0.5 * (s[F1] + s[F2]))          # the stack's growth at the estimated facing temperature
+        theta_cm = min(max(float(0.5 * (s[F1] + s[F2])), THETA_MIN_K), THETA_MAX_K)   # the stack's growth there
         return self.mu_factor(s, mu) * outputs(x_m - float(s[IX_DX]), th, self.table, self.p, theta_cm).torque
 
     def mu_factor(self, s: np.ndarray | None = None, mu: float | None = None) -> float:
@@ -481,7 +489,7 @@ class ClutchEkf:
         """
         e, s = self.e, self.s
         th = min(max(float(s[IX_CS]), self.table.theta_min_K), self.table.theta_max_K)
-        theta_cm = self.theta_cm
+        theta_cm = self.theta_cm_model
         key = (round(th, 0), round(theta_cm, 0))
         pts = self._ev_cache.get(key)
         if pts is None:

@@ -7,7 +7,7 @@ import pytest
 from cushion_clutch.errors import ParameterError
 from cushion_clutch.model import load_table
 from cushion_clutch.model import ClutchParameters, outputs, thermal_step, x_to_for_torque
-from cushion_clutch.launch.ekf import IX_DX, IX_LOSS, ClutchEkf, EkfParams, TcuNetworkParams
+from cushion_clutch.launch.ekf import IX_DX, IX_HEAT, IX_LOSS, ClutchEkf, EkfParams, TcuNetworkParams
 from cushion_clutch.launch.thermal_network import NetworkParams, ThermalNetwork
 
 TA = 293.15
@@ -200,3 +200,50 @@ def test_discretisation_matches_scipy_expm():
         ref = expm(aug)
         assert np.max(np.abs(phi - ref[:N_T, :N_T])) < 1e-12
         assert np.max(np.abs(psi - ref[:N_T, N_T:])) < 1e-12 * dt
+
+
+def capacity_mismatch_run(table, k_heat, capacity_factor=1.15):
+    """Four 3 s slips at 30 kW every 60 s, then a 10 min cool-down, on a plant whose every heat capacity is
+    ``1 / capacity_factor`` of the TCU's network (matched otherwise); the TCU predicts only (``k_heat`` held).
+    Returns the facing-temperature error (estimate minus plant, K) every EKF period."""
+    plant, tcu = matched_network()
+    net = ThermalNetwork(plant, TA, TA)
+    net.caps = [c / capacity_factor for c in net.caps]
+    ekf = ClutchEkf(tcu, EkfParams(), table, ClutchParameters(), TA, TA)
+    ekf.s[IX_HEAT] = k_heat
+    errors = []
+    for k in range(8400):                          # 4 x 60 s + 600 s at 0.1 s
+        t = (k % 600) * 0.1 if k < 2400 else 99.0
+        slip = t < 3.0
+        pw, w_disc = (30e3, 40.0) if slip else (0.0, 0.0)
+        for _ in range(10):                       # the plant at 10 ms
+            net.step(0.01, pw, 190.0, w_disc, slip)
+        ekf.accumulate(0.1, pw)
+        ekf.predict(190.0, w_disc, slip)
+        errors.append(ekf.theta_cm - net.theta_cm)
+    return np.array(errors)
+
+
+def test_the_heat_scale_is_the_networks_inverse_heat_capacity(table):
+    """A heat-capacity error changes how fast the clutch cools as much as how fast it heats: with the heat scale
+    at the capacity ratio the TCU's network follows the plant through four hot slips and a 10 min cool-down
+    (when the scale multiplied the slip heat only, it heated right and cooled 15 % too slowly: 2.1 K off at the
+    end of the cool-down, and growing)."""
+    err = capacity_mismatch_run(table, 1.15)
+    unscaled = capacity_mismatch_run(table, 1.0)
+    assert max(abs(unscaled)) > 8.0                         # the mismatch matters (K)
+    assert max(abs(err)) < 0.05                              # K: the discretisation only
+
+
+def test_a_facing_estimate_beyond_the_models_range_does_not_stop_the_tcu(table):
+    """On heavy duty without protection the estimate can pass the clutch model's 800 K ceiling (the plant's
+    facings at 470 degC, the estimate's Jacobian step 1 K above): the model is evaluated at the ceiling,
+    and the update runs."""
+    p = ClutchParameters()
+    ekf = ClutchEkf(TcuNetworkParams(), EkfParams(), table, p, TA, 799.5)
+    assert ekf.theta_cm_model == 799.5
+    ekf.s[:9] = 850.0
+    assert ekf.theta_cm_model == 800.0
+    x = x_to_for_torque(120.0, table.theta_max_K, table, p, theta_cm=800.0)
+    assert np.isfinite(ekf.model_torque(x))
+    assert ekf.correct(ekf.model_torque(x) + 1.0, x, 100.0, True)

@@ -85,11 +85,15 @@ def _offset_torque_Nm(offset_m: float) -> float:
 
 
 def test_the_temperature_estimate_holds_on_heavy_duty(plant):
-    """3500 kg hill starts on the plant network (the protection duty, unprotected): before the ECU-offset
-    state and the RLS readiness fix the theta_cs estimate was 33-64 K high after twelve starts."""
+    """3500 kg hill starts on the plant network (the protection duty, unprotected) until the plant's facings pass
+    the damage limit (350 degC, at start 23): the issue's target is 25 K up to it, 15 K in the shipped scenarios.
+    Before the ECU-offset state and the RLS readiness fix the theta_cs estimate was 33-64 K high after twelve
+    starts; with the heat scale on the slip heat only it was 13.1 K off up to the damage limit, with it the
+    network's inverse heat capacity 9.1 K (main f0e6b1a / branch thermest, 2026-11-26)."""
     sc = load_scenario(scenario_path("protection"))
-    sc = dataclasses.replace(sc, run=dataclasses.replace(sc.run, launches=12),
+    sc = dataclasses.replace(sc, run=dataclasses.replace(sc.run, launches=23),
                              protection=dataclasses.replace(sc.protection, enabled=False))
     r = simulate_launches(plant, sc, load_table(), "production")
-    assert r.metrics[-1]["theta_cs_start_degC"] > 130.0                 # the clutch did heat up
-    assert max(abs(m["theta_cs_error_K"]) for m in r.metrics) < 10.0
+    start = r.series["launch"] == 23
+    assert r.series["theta_cm_K"][start].max() > 623.15                  # the facings reach the damage limit
+    assert max(abs(m["theta_cs_error_K"]) for m in r.metrics) < 15.0

@@ -7,23 +7,31 @@ State (K for each network node and the cushion spring, m, 1, 1, 1)::
 
 * **Prediction**: the TCU's own :class:`~.thermal_network.ThermalNetwork`
   (parameters ``[tcu_thermal]``, deliberately not the plant's) heated by
-  ``k_heat P``, ``P = T_est w_slip`` the engine control unit's torque estimate
-  times the measured slip speed, and losing heat to the air and the engine
-  block through ``k_loss`` times its sink conductances; plus the cushion-spring
-  ODE with the TCU's U, H, C (``C dtheta_cs/dt = U (theta_cm - theta_cs) +
-  H (theta_a - theta_cs)``, ``theta_cm`` the mean of the facings; not scaled:
-  they are the clutch model's). ``dx_kiss`` (touch-point offset at the
-  bearing), ``mu_scale`` (friction relative to the nominal mu) and the two
-  thermal scales are random walks. Process noise: ``heat_share_sd`` of each
-  node's slip heat, plus the random walks.
+  ``P = T_est w_slip``, the engine control unit's torque estimate times the
+  measured slip speed, and losing heat to the air and the engine block through
+  ``k_loss`` times its sink conductances, the whole network's heat balance per
+  J/K scaled by ``k_heat``: ``dtheta/dt = k_heat (A_link theta + k_loss (a_sink
+  theta + b_sink) + q)``; plus the cushion-spring ODE with the TCU's U, H, C
+  (``C dtheta_cs/dt = U (theta_cm - theta_cs) + H (theta_a - theta_cs)``,
+  ``theta_cm`` the mean of the facings; not scaled: they are the clutch
+  model's). ``dx_kiss`` (touch-point offset at the bearing), ``mu_scale``
+  (friction relative to the nominal mu) and the two thermal scales are random
+  walks. Process noise: ``heat_share_sd`` of each node's slip heat, plus the
+  random walks.
 * **Thermal scales** (what a production TCU adapts instead of being given the
   plant's values): ``k_loss`` (prior sd ``loss_scale_sd``) stands for the
-  convection and conduction losses the network gets wrong, ``k_heat`` (prior
-  sd ``heat_scale_sd``) for the slip heat per J/K the network gets wrong (a
-  heat-capacity error, the torque estimate's gain and offset). Their effect on
+  heat-transfer coefficients the network gets wrong (convection, engine block),
+  ``k_heat`` (prior sd ``heat_scale_sd``) for its heat capacities: the
+  network's inverse heat capacity relative to the TCU's, so it scales
+  conduction and losses as it scales the slip heat (and absorbs the torque
+  estimate's gain and offset error in the heat). A capacity error changes how
+  fast the clutch cools as much as how fast it heats: with ``k_heat`` scaling
+  the slip heat alone, a ``k_heat`` learned on the heat-up left the cooling
+  wrong by the same factor, and the cool-downs between and after hot launches
+  went uncorrected (``docs/explanation/tcu_thermal_estimate.md``). Their effect on
   the temperatures accumulates in the prediction: the covariance between a
-  scale and the temperatures grows while heat flows in (``k_heat``) or out
-  (``k_loss``, in proportion to ``theta - theta_sink``), and a torque residual
+  scale and the temperatures grows while heat flows (``k_heat``) or flows
+  out (``k_loss``, in proportion to ``theta - theta_sink``), and a torque residual
   at the next launch corrects the scale through it. Besides learning, the
   scales make the filter honest: a network that may lose half as much heat or half again
   as much is uncertain by tens of kelvin after a five-minute cool-down, so the torque
@@ -125,6 +133,7 @@ import numpy as np
 from ..config import Checked
 from ..model import x_to_for_torque
 from ..model import ClutchParameters, SpringTable, outputs
+from ..model.clutch_model import THETA_MAX_K, THETA_MIN_K
 from .thermal_network import FACINGS, N_NODES, TcuNetworkBase, ThermalNetwork
 
 #: state indices: the network's nodes, then these
@@ -241,7 +250,8 @@ class EkfParams(Checked):
     loss_walk_per_s: float = 1e-7
     """random walk of the heat-loss scale, 1/s (its variance grows by this per second)"""
     heat_scale_sd: float = 0.15
-    """prior sd of the heat-input scale (the slip power's share that reaches the network per J/K of it), 1;
+    """prior sd of the heat scale (the network's heat per J/K, its inverse heat capacity relative to the TCU's: the
+    slip heat, conduction and losses alike), 1;
     0 keeps the slip power as measured"""
     heat_walk_per_s: float = 1e-7
     """random walk of the heat-input scale, 1/s"""
@@ -381,6 +391,13 @@ class ClutchEkf:
         return float(0.5 * (self.s[F1] + self.s[F2]))
 
     @property
+    def theta_cm_model(self) -> float:
+        """The facing temperature the TCU's clutch model is evaluated at: :attr:`theta_cm` within the model's
+        range ``[THETA_MIN_K, THETA_MAX_K]`` (an estimate beyond it, far past the facings' damage limit, must not
+        stop the TCU), K."""
+        return min(max(self.theta_cm, THETA_MIN_K), THETA_MAX_K)
+
+    @property
     def dx_kiss(self) -> float:
         """Learned touch-point offset at the bearing, m."""
         return float(self.s[IX_DX])
@@ -456,7 +473,7 @@ class ClutchEkf:
         """
         s = self.s if s is None else s
         th = min(max(float(s[IX_CS]), self.table.theta_min_K), self.table.theta_max_K)
-        theta_cm = float(0.5 * (s[F1] + s[F2]))
+        theta_cm = min(max(float(0.5 * (s[F1] + s[F2])), THETA_MIN_K), THETA_MAX_K)   # within the model's range
         key = (round(th, 0), round(theta_cm, 0), round(float(s[IX_DX]) - self.dx_prior, 7))
         hit = self._ecu_cache.get(key)
         if hit is None:
@@ -506,7 +523,7 @@ class ClutchEkf:
         """
         s = self.s if s is None else s
         th = min(max(float(s[IX_CS]), self.table.theta_min_K), self.table.theta_max_K)
-        theta_cm = float(0.5 * (s[F1] + s[F2]))          # the stack's growth at the estimated facing temperature
+        theta_cm = min(max(float(0.5 * (s[F1] + s[F2])), THETA_MIN_K), THETA_MAX_K)   # the stack's growth there
         return self.mu_factor(s, mu) * outputs(x_m - float(s[IX_DX]), th, self.table, self.p, theta_cm).torque
 
     def mu_factor(self, s: np.ndarray | None = None, mu: float | None = None) -> float:
@@ -541,7 +558,7 @@ class ClutchEkf:
         """
         e, s = self.e, self.s
         th = min(max(float(s[IX_CS]), self.table.theta_min_K), self.table.theta_max_K)
-        theta_cm = self.theta_cm
+        theta_cm = self.theta_cm_model
         key = (round(th, 0), round(theta_cm, 0))
         pts = self._ev_cache.get(key)
         if pts is None:
@@ -622,22 +639,25 @@ class ClutchEkf:
         return self.t_acc >= self.e.period_s - 1e-12
 
     def _discrete(self, w_engine: float, w_disc: float, clamped: bool, dt: float,
-                  k_loss: float) -> tuple[np.ndarray, np.ndarray, tuple]:
+                  k_loss: float, k_heat: float = 1.0) -> tuple[np.ndarray, np.ndarray, tuple]:
         """``(Phi, Psi, parts)``: ``exp(A dt)`` and ``int_0^dt exp(A s) ds`` of the temperatures with
-        the loss scale ``k_loss`` held: the exponential of ``[[A, I], [0, 0]] dt`` by scaling and squaring
+        the scales held: the network's rows ``k_heat (A_link + k_loss a_sink)`` (the heat scale is the
+        network's inverse heat capacity: it scales conduction and losses as it scales the heat), the cushion
+        spring's row unscaled. The exponential of ``[[A, I], [0, 0]] dt`` by scaling and squaring
         (Taylor series to order 8 of the matrix scaled to a norm below 1/4, then squared back; relative
         error below 1e-10, a test compares it with scipy's ``expm``; the network's surface layers have time
         constants near the EKF period, so a short series of ``A dt`` alone would not do). Cached per speed
-        band and period, recomputed when ``k_loss`` has changed (only measurement updates change it).
+        band and period, recomputed when a scale has changed (only measurement updates change them).
         """
         key = (clamped, round(w_engine / SPEED_BAND), round(w_disc / SPEED_BAND), round(dt * 1e4))
         hit = self._dcache.get(key)
-        if hit is None or hit[0] != k_loss:
+        if hit is None or hit[0] != (k_loss, k_heat):
             parts = self._parts(w_engine, w_disc, clamped)
             a = parts[0].copy()
             a[np.arange(N_T), np.arange(N_T)] += k_loss * parts[1]
+            a[:N_NODES] *= k_heat
             phi, psi = _exp_and_integral(a, dt)
-            hit = self._dcache[key] = (k_loss, phi, psi, parts)
+            hit = self._dcache[key] = ((k_loss, k_heat), phi, psi, parts)
         return hit[1], hit[2], hit[3]
 
     def predict(self, w_engine: float, w_disc: float, clamped: bool) -> None:
@@ -645,11 +665,13 @@ class ClutchEkf:
 
         The augmented system is bilinear (a scale times a temperature); with
         the scales held over the period the temperatures advance exactly,
-        ``theta+ = Phi theta + Psi (k_loss b_sink + k_heat q)``, and the
-        transition of the covariance is the linearisation at the estimate:
-        the scales' rows are zero, so ``exp(J dt)`` has ``Phi`` in its
-        temperature block and ``Psi`` times the scales' Jacobian columns
-        (``a_sink theta + b_sink`` and ``q``) in their columns.
+        ``theta+ = Phi theta + Psi k_heat (k_loss b_sink + q)`` (``Phi``, ``Psi``
+        of the scaled matrix, :meth:`_discrete`), and the transition of the
+        covariance is the linearisation at the estimate: the scales' rows are
+        zero, so ``exp(J dt)`` has ``Phi`` in its temperature block and ``Psi``
+        times the scales' Jacobian columns (``k_heat (a_sink theta + b_sink)``
+        and the network's heat flow per J/K, ``A_link theta + k_loss (a_sink
+        theta + b_sink) + q``) in their columns.
         """
         dt = self.t_acc
         if dt <= 0.0:
@@ -657,19 +679,22 @@ class ClutchEkf:
         p_mean = self.energy_J / dt
         s = self.s
         k_loss, k_heat = float(s[IX_LOSS]), float(s[IX_HEAT])
-        phi, psi, (_, a_sink, b_sink, b_cs) = self._discrete(w_engine, w_disc, clamped, dt, k_loss)
+        phi, psi, (a_link, a_sink, b_sink, b_cs) = self._discrete(w_engine, w_disc, clamped, dt, k_loss, k_heat)
         th = s[:N_T]
         q = np.zeros(N_T)
         if p_mean != 0.0:
             q[:N_NODES] = np.array(self.model.heat_inputs(p_mean)) / self.model.caps
-        b = k_loss * b_sink + k_heat * q
+        loss = a_sink * th + b_sink                 # the losses per J/K at k_loss = 1 (0 in the spring's row)
+        rate = a_link @ th + k_loss * loss + q      # the network's heat flow per J/K at k_heat = 1
+        rate[IX_CS] = 0.0                           # the spring's ODE is the clutch model's: not scaled
+        b = k_heat * (k_loss * b_sink + q)
         b[IX_CS] += b_cs
         s_new = s.copy()
         s_new[:N_T] = phi @ th + psi @ b
         f = np.eye(N_STATE)
         f[:N_T, :N_T] = phi
-        f[:N_T, IX_LOSS] = psi @ (a_sink * th + b_sink)
-        f[:N_T, IX_HEAT] = psi @ q
+        f[:N_T, IX_LOSS] = psi @ (k_heat * loss)
+        f[:N_T, IX_HEAT] = psi @ rate
         ref = self.e.mu_reference_max_degC + 273.15      # the friction may change as the facings heat above it
         cm_old, cm_new = 0.5 * float(s[F1] + s[F2]), 0.5 * float(s_new[F1] + s_new[F2])
         d_cm = max(cm_new, ref) - max(cm_old, ref)

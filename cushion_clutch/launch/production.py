@@ -94,8 +94,8 @@ class ProductionTcu(TcuController):
         return self.ekf.theta_cm
 
     def theta_cm_used(self) -> float:
-        """The facing temperature the TCU's clutch model assumes (the EKF's estimate), K."""
-        return self.ekf.theta_cm
+        """The facing temperature the TCU's clutch model assumes (the EKF's estimate, within the model's range), K."""
+        return self.ekf.theta_cm_model
 
     def kiss(self) -> float:
         """The kiss point the TCU believes, in the true bearing frame, m."""

@@ -1,6 +1,7 @@
 """Issue 26's bar for the production TCU: every shipped scenario, naive and production, from the launch metrics.
 
     python -m cushion_clutch.benchmarks.production_bar [--scenarios default,cooldown,...] [--repeat N]
+    python -m cushion_clutch.benchmarks.production_bar --out docs/results/production_bar.md
 
 Per scenario: production's worst characteristic error over all launches (the first included; target
 <= 7.2 N.m, 3 % of the engine's 240 N.m peak) and over the hot launches, naive's, every launch starting
@@ -14,6 +15,7 @@ from __future__ import annotations
 import argparse
 import math
 import statistics
+import sys
 import tempfile
 from pathlib import Path
 
@@ -56,24 +58,50 @@ def bar(name: str, repeat: int = 1) -> dict:
             "naive_theta_cm_peak_degC": peaks(res["naive"])["plant_theta_cm_peak_degC"]}
 
 
-def main() -> None:
+INTRO = """Issue 26's bar for the production TCU, every shipped scenario run with the naive and the production TCU
+on the committed tables and the native plant FMU. The bar: production's worst characteristic error over all
+launches, the first included, at most 7.2 N.m (3 % of the engine's 240 N.m peak), and on every launch that
+starts below 40 degC within 0.5 N.m of naive's or better. Also: the largest |theta_cs error| of production's
+estimate at a launch start (target 15 K), how its TCU started (reset: standstill touch-point learning, with
+that routine's error; learned: a stored state), the plant's peak temperatures, and the CPU-time real-time
+factors (sim time / CPU time; median of `--repeat` runs; machine-dependent, noisy under load). How the
+production TCU works: [the production TCU](../explanation/production_tcu.md)."""
+
+HEADER = ("| scenario | launches | production worst, all [N.m] | production worst, hot [N.m] | naive worst, all [N.m] "
+          "| naive worst, hot [N.m] | launches < 40 degC: production / naive [N.m] | bar "
+          "| max abs theta_cs error at a start [K] | start, standstill error [um] "
+          "| plant peak theta_cm / theta_cs [degC] (naive's theta_cm) | RTF naive / production (CPU) |")
+
+
+def row(name: str, b: dict) -> str:
+    """One Markdown table row of :func:`bar`'s figures."""
+    ok = b["prod_all"] <= 7.2 and not b["cold_fail"]
+    cold = ", ".join(f"L{k}: {x:.2f} / {y:.2f}" for k, x, y in b["cold"]) or "–"
+    return (f"| {name} | {b['n']} | {b['prod_all']:.2f} | {b['prod_hot']:.2f} | {b['naive_all']:.2f} | "
+            f"{b['naive_hot']:.2f} | {cold} | {'met' if ok else 'MISSED'} | {b['theta_err']:.1f} | "
+            f"{b['prod_tcu_start']}, {b['prod_standstill_kiss_error_um']:.1f} | "
+            f"{b['prod_plant_theta_cm_peak_degC']:.0f} / {b['prod_plant_theta_cs_peak_degC']:.0f} "
+            f"({b['naive_theta_cm_peak_degC']:.0f}) | {b['rtf_naive']:.0f} / {b['rtf_prod']:.0f} |")
+
+
+def main(argv: list[str] | None = None) -> None:
+    from .page import results_page
+
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--scenarios", default=",".join(SHIPPED))
-    ap.add_argument("--repeat", type=int, default=1)
-    a = ap.parse_args()
-    print("| scenario | launches | production worst, all | production worst, hot | naive worst, all | naive worst, hot "
-          "| launches < 40 degC: production / naive | bar | max abs theta_cs error at a start [K] | start, standstill "
-          "error [um] | plant peak theta_cm / theta_cs [degC] (naive's theta_cm) | RTF naive / production (CPU) |")
-    print("|" + "---|" * 12)
-    for name in a.scenarios.split(","):
-        b = bar(name, a.repeat)
-        ok = b["prod_all"] <= 7.2 and not b["cold_fail"]
-        cold = ", ".join(f"L{k}: {x:.2f} / {y:.2f}" for k, x, y in b["cold"]) or "–"
-        print(f"| {name} | {b['n']} | {b['prod_all']:.2f} | {b['prod_hot']:.2f} | {b['naive_all']:.2f} | "
-              f"{b['naive_hot']:.2f} | {cold} | {'met' if ok else 'MISSED'} | {b['theta_err']:.1f} | "
-              f"{b['prod_tcu_start']}, {b['prod_standstill_kiss_error_um']:.1f} | "
-              f"{b['prod_plant_theta_cm_peak_degC']:.0f} / {b['prod_plant_theta_cs_peak_degC']:.0f} "
-              f"({b['naive_theta_cm_peak_degC']:.0f}) | {b['rtf_naive']:.0f} / {b['rtf_prod']:.0f} |", flush=True)
+    ap.add_argument("--scenarios", default=",".join(SHIPPED), help="comma-separated shipped scenario names")
+    ap.add_argument("--repeat", type=int, default=1, help="runs per TCU; the real-time factor is their median")
+    ap.add_argument("--out", type=Path, help="also write the table as a results page (docs/results/production_bar.md)")
+    a = ap.parse_args(argv)
+    rows = []
+    with results_page(a.out, "Production TCU bar", "cushion_clutch.benchmarks.production_bar", argv,
+                      INTRO) as page:
+        stream = sys.stderr if a.out is not None else sys.stdout     # the page gets the table, not the progress
+        print(HEADER, file=stream)
+        for name in a.scenarios.split(","):
+            rows.append(row(name, bar(name, a.repeat)))
+            print(rows[-1], file=stream, flush=True)
+        if a.out is not None:
+            page.markdown("\n".join([HEADER, "|" + "---|" * 12, *rows]))
 
 
 if __name__ == "__main__":

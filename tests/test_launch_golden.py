@@ -91,3 +91,24 @@ if __name__ == "__main__" and "--write" in sys.argv:
     with tempfile.TemporaryDirectory() as tmp:
         GOLDEN.write_text(json.dumps(_runs(Path(tmp)), indent=1, allow_nan=True) + "\n")
     print(f"wrote {GOLDEN}")
+
+
+def test_the_tcu_memo_returns_what_it_computed_and_stays_bounded():
+    """The TCU's model memo (tcu._memo): exact keys only; -0.0 is not remembered under 0.0's key."""
+    from cushion_clutch.launch.tcu import MEMO_SIZE, _memo
+
+    memo: dict = {}
+    calls = []
+
+    def f(v):
+        calls.append(v)
+        return v * 2.0
+
+    assert _memo(memo, (1.5, 300.0), lambda: f(1.5)) == 3.0
+    assert _memo(memo, (1.5, 300.0), lambda: f(1.5)) == 3.0 and calls == [1.5]
+    assert _memo(memo, (1.5, 300.0 + 1e-13), lambda: f(1.5)) == 3.0 and len(calls) == 2
+    _memo(memo, (-0.0, 300.0), lambda: f(-0.0))
+    assert (0.0, 300.0) not in memo
+    for i in range(3 * MEMO_SIZE):
+        _memo(memo, (float(i), 1.0), lambda: f(1.0))
+    assert len(memo) <= MEMO_SIZE

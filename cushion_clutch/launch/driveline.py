@@ -74,7 +74,7 @@ class Driveline:
 
     __slots__ = ("h", "i_tot", "r", "eta", "f_grade", "f_roll", "j_v", "j_d", "j_e", "j_disc", "mass", "k", "c",
                  "kappa", "air", "brake_torque", "w_e", "w_d", "v", "phi", "locked", "en", "t_c", "slip_J",
-                 "slip_W", "t_load_rest", "_const")
+                 "slip_W", "t_load_rest")
 
     def __init__(self, sc: Scenario, w_e: float):
         dl, veh = sc.driveline, sc.vehicle
@@ -97,7 +97,6 @@ class Driveline:
         self.w_e, self.w_d, self.v, self.phi, self.locked = w_e, 0.0, 0.0, 0.0, False
         self.en = Energy()
         self.t_c = self.slip_J = self.slip_W = 0.0
-        self._constants(h)
 
     def kinetic(self) -> float:
         """Kinetic energy of engine, disc and vehicle, J."""
@@ -117,30 +116,15 @@ class Driveline:
         return (self.k * self.phi + kappa * (self.w_d - w_v + 0.5 * h * (t1 / j1 + t_veh / self.j_v))) / \
             (1.0 + 0.5 * kappa * h * (1.0 / j1 + self.eta / self.j_v))
 
-    def _constants(self, h: float) -> tuple:
-        """Per-step constants for the step ``h`` (s): the same expressions :meth:`_shaft` evaluates, once."""
-        kappa, j_v, j_disc = self.kappa, self.j_v, self.j_disc
-        j_lock = self.j_e + j_disc
-        c = (h, 0.5 * h, j_lock, self.f_grade * self.r / self.i_tot,
-             1.0 + 0.5 * kappa * h * (1.0 / j_disc + self.eta / j_v),
-             1.0 + 0.5 * kappa * h * (1.0 / j_lock + self.eta / j_v),
-             1.0 + 0.5 * kappa * h / j_disc, 1.0 + 0.5 * kappa * h / j_lock, h / j_v, 1.0 - self.eta)
-        self._const = c
-        return c
-
     def step(self, t_e: float, t_cap: float, engaged: bool, braking: bool) -> int:
         """Advance with engine torque ``t_e`` and clutch capacity ``t_cap`` (N.m); 1 locked, -1 unlocked, else 0.
 
         ``engaged``: the TCU is launching or closing (lock-up allowed);
         ``braking``: the service brake stops the car.
-
-        The shaft torque is :meth:`_shaft` written out with its step constants precomputed
-        (:meth:`_constants`; the same floating-point operations in the same order).
         """
         h, en = self.h, self.en
-        w_e, w_d, v, phi = self.w_e, self.w_d, self.v, self.phi
-        locked = self.locked
-        if v == 0.0 and t_cap == 0.0 and w_d == 0.0 and phi == 0.0 and not locked:
+        w_e, w_d, v = self.w_e, self.w_d, self.v
+        if v == 0.0 and t_cap == 0.0 and w_d == 0.0 and self.phi == 0.0 and not self.locked:
             # at rest, clutch open, shafts relaxed: only the engine moves
             w_e_new = w_e + t_e / self.j_e * h
             if w_e_new < 0.0:
@@ -149,33 +133,28 @@ class Driveline:
             self.w_e = w_e_new
             self.t_c = self.slip_J = self.slip_W = 0.0
             return 0
-        c = self._const
-        if c[0] != h:
-            c = self._constants(h)
-        _, hh, j_lock, f_grade_disc, den_slip, den_lock, den_slip_held, den_lock_held, h_jv, loss_eta = c
-        i_tot, r, eta, j_e, j_v, j_disc = self.i_tot, self.r, self.eta, self.j_e, self.j_v, self.j_disc
-        k, kappa = self.k, self.kappa
+        i_tot, r, eta, j_e, j_v = self.i_tot, self.r, self.eta, self.j_e, self.j_v
         w_v = v * i_tot / r
         f_res = (self.f_roll if v > 0.0 else 0.0) + self.air * v * v + self.f_grade
         t_res = f_res * r / i_tot                                   # resistance at the disc
+        locked = self.locked
         event = 0
+        j_lock = j_e + self.j_disc
         t_brake = self.brake_torque if braking and v > 0.0 else 0.0
-        t_veh = t_res + t_brake
-        kphi = k * phi
         if locked:
-            t_s = (kphi + kappa * (w_d - w_v + hh * (t_e / j_lock + t_veh / j_v))) / den_lock
-            t_c = (j_disc * t_e + j_e * t_s) / j_lock
+            t_s = self._shaft(j_lock, t_e, w_v, t_res + t_brake, False)
+            t_c = (self.j_disc * t_e + j_e * t_s) / j_lock
             if abs(t_c) > t_cap:
                 locked, event = False, -1
         if not locked:
             t_c = math.copysign(t_cap, w_e - w_d) if w_e != w_d else 0.0
-            j1, t1 = j_disc, t_c
-            t_s = (kphi + kappa * (w_d - w_v + hh * (t1 / j1 + t_veh / j_v))) / den_slip
+            j1, t1 = self.j_disc, t_c
         else:
-            j1, t1 = j_lock, t_e                                    # t_s: the locked one above
-        w_v_new = w_v + h_jv * (eta * t_s - t_res - t_brake)
+            j1, t1 = j_lock, t_e
+        t_s = self._shaft(j1, t1, w_v, t_res + t_brake, False)
+        w_v_new = w_v + h / j_v * (eta * t_s - t_res - t_brake)
         if w_v_new < 0.0:                                           # the brake / hill hold keeps it at rest
-            t_s = (kphi + kappa * (w_d - 0.5 * w_v + hh * t1 / j1)) / (den_lock_held if locked else den_slip_held)
+            t_s = self._shaft(j1, t1, w_v, 0.0, True)
             w_v_new = 0.0
             t_brake = eta * t_s - t_res + j_v * w_v / h
         w_d_new = w_d + h / j1 * (t1 - t_s)
@@ -186,31 +165,30 @@ class Driveline:
             if w_e_new < 0.0:
                 w_e_new = 0.0
         d_m = 0.5 * (w_d + w_d_new) - 0.5 * (w_v + w_v_new)       # midpoint twist rate
-        phi += h * d_m
-        self.phi = phi
+        self.phi += h * d_m
         # energy bookkeeping with midpoint speeds
         wm_e, wm_d, wm_v = 0.5 * (w_e + w_e_new), 0.5 * (w_d + w_d_new), 0.5 * (w_v + w_v_new)
         en.engine_work += t_e * wm_e * h
         slip_w = t_c * (wm_e - wm_d) if not locked else 0.0
         slip = slip_w * h
         en.damping += self.c * d_m * d_m * h
-        en.resistance += ((f_res - self.f_grade) * r / i_tot + loss_eta * t_s) * wm_v * h
-        en.potential += f_grade_disc * wm_v * h
+        en.resistance += ((f_res - self.f_grade) * r / i_tot + (1.0 - eta) * t_s) * wm_v * h
+        en.potential += self.f_grade * r / i_tot * wm_v * h
         en.brake += t_brake * wm_v * h
         # lock-up: the slip speed crosses zero and the locked torque fits the capacity
         if not locked and t_cap > 0.0 and engaged and (w_e - w_d) * (w_e_new - w_d_new) <= 0.0:
-            t_s_new = k * phi + self.c * (w_d_new - w_v_new)
-            if abs((j_disc * t_e + j_e * t_s_new) / j_lock) <= t_cap:
-                ke_before = 0.5 * (j_e * w_e_new ** 2 + j_disc * w_d_new ** 2)
-                w_e_new = w_d_new = (j_e * w_e_new + j_disc * w_d_new) / j_lock
+            t_s_new = self.k * self.phi + self.c * (w_d_new - w_v_new)
+            if abs((self.j_disc * t_e + j_e * t_s_new) / j_lock) <= t_cap:
+                ke_before = 0.5 * (j_e * w_e_new ** 2 + self.j_disc * w_d_new ** 2)
+                w_e_new = w_d_new = (j_e * w_e_new + self.j_disc * w_d_new) / j_lock
                 slip += ke_before - 0.5 * j_lock * w_e_new ** 2        # the impact of merging the speeds
                 locked, event = True, 1
         en.slip += slip
         self.w_e, self.w_d, self.v, self.locked = w_e_new, w_d_new, w_v_new * r / i_tot, locked
         self.t_c, self.slip_J, self.slip_W = t_c, slip, abs(slip_w)
         if (not locked and t_cap == 0.0 and w_v_new == 0.0 and abs(w_d_new) < 1e-6
-                and abs(phi) < 1e-9):                               # rung down at rest: snap, keep the books
-            en.damping += 0.5 * j_disc * w_d_new ** 2 + 0.5 * k * phi ** 2
+                and abs(self.phi) < 1e-9):                          # rung down at rest: snap, keep the books
+            en.damping += 0.5 * self.j_disc * w_d_new ** 2 + 0.5 * self.k * self.phi ** 2
             self.w_d = self.phi = 0.0
         return event
 

@@ -35,7 +35,7 @@ def _fmu_call_us(fmu: Path, n: int = 50000) -> tuple[float, float]:
     c = ClutchFmu(fmu, {})
     t0 = time.perf_counter()
     for k in range(n):
-        c.step(k * 1e-3, 1e-3, 0.005, 400.0, 10.0)
+        c.step(k * 1e-3, 1e-3, 0.005, 400.0, 10.0 + k * 1e-6)      # a changing input: every step sets it
     ours = (time.perf_counter() - t0) / n * 1e6
     c.close()
     md = read_model_description(str(fmu))
@@ -49,7 +49,7 @@ def _fmu_call_us(fmu: Path, n: int = 50000) -> tuple[float, float]:
     vin, vout = [vr[x] for x in INPUTS], [vr[x] for x in OUTPUTS]
     t0 = time.perf_counter()
     for k in range(n):
-        s.setReal(vin, [0.005, 400.0, 10.0])
+        s.setReal(vin, [0.005, 400.0, 10.0 + k * 1e-6])
         s.doStep(k * 1e-3, 1e-3)
         s.getReal(vout)
     theirs = (time.perf_counter() - t0) / n * 1e6

@@ -11,6 +11,7 @@ naming the FMI function.
 """
 from __future__ import annotations
 
+import math
 import shutil
 from pathlib import Path
 
@@ -76,20 +77,28 @@ class ClutchFmu:
         set_real, do_step, get_real, comp = lib.fmi2SetReal, lib.fmi2DoStep, lib.fmi2GetReal, self._c
         vr_in, vr_out, v, o = self._vr_in, self._vr_out, self._v_in, self._v_out
 
+        held = [math.nan] * 3          # the inputs last set: an FMU keeps its inputs, unchanged ones need no call
+
         def step(t: float, h: float, x_to: float, theta_cm: float, omega_slip: float) -> tuple[float, float, float]:
             """Set the inputs (m, K, rad/s), advance ``h`` s from ``t``; return torque (N.m), theta_cs (K), x_kiss (m).
+
+            ``fmi2SetReal`` is skipped when the inputs equal those last set (held inputs: the clutch
+            locked or open between TCU cycles).
 
             Raises
             ------
             FmuCallError
                 Naming the FMI function that did not return fmi2OK/fmi2Warning.
             """
-            v[0] = x_to
-            v[1] = theta_cm
-            v[2] = omega_slip
-            st = set_real(comp, vr_in, 3, v)
-            if st > 1:
-                raise FmuCallError("fmi2SetReal", st, f"x_to={x_to!r}, theta_cm={theta_cm!r}, omega_slip={omega_slip!r}")
+            if omega_slip != held[2] or x_to != held[0] or theta_cm != held[1]:    # NaN: never equal, set
+                v[0] = held[0] = x_to
+                v[1] = held[1] = theta_cm
+                v[2] = held[2] = omega_slip
+                st = set_real(comp, vr_in, 3, v)
+                if st > 1:
+                    held[0] = math.nan
+                    raise FmuCallError("fmi2SetReal", st,
+                                       f"x_to={x_to!r}, theta_cm={theta_cm!r}, omega_slip={omega_slip!r}")
             st = do_step(comp, t, h, 1)
             if st > 1:
                 raise FmuCallError("fmi2DoStep", st, f"t={t!r}, h={h!r}")

@@ -104,8 +104,8 @@ class ProductionTcu(TcuController):
     def command(self, torque_Nm: float) -> float:
         """Bearing position for ``torque_Nm`` (N.m) as the position sensor reads it, m."""
         th = min(max(self.ekf.theta_cs, self.table.theta_min_K), self.table.theta_max_K)
-        return (x_to_for_torque(torque_Nm / max(self.ekf.mu_applied, 1e-3), th, self.table, self.p,
-                                theta_cm=self.theta_cm_used()) + self.ekf.dx_used)
+        return (self.x_for_torque(torque_Nm / max(self.ekf.mu_applied, 1e-3), th, self.theta_cm_used())
+                + self.ekf.dx_used)
 
     def model_torque(self, x_m: float) -> float:
         """Torque the TCU believes at the true bearing position ``x_m`` (it sees it through its sensor), N.m.

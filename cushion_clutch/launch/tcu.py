@@ -79,6 +79,25 @@ VARIANTS = {v.name: v for v in (
 
 OPEN, LAUNCH, CLOSE, PREFILL = 0, 1, 2, 3     #: TCU phases
 
+#: entries a memo of the TCU's model keeps before it starts afresh
+MEMO_SIZE = 64
+
+
+def _memo(memo: dict, key: tuple, compute):
+    """``memo[key]``, computed by ``compute()`` the first time: exact inputs, so exactly the value computed.
+
+    A key starting with -0.0 is not remembered (it compares equal to 0.0); NaN never compares equal, so
+    it is computed every time.
+    """
+    hit = memo.get(key)
+    if hit is None:
+        hit = compute()
+        if key[0] != 0.0 or math.copysign(1.0, key[0]) > 0.0:
+            if len(memo) >= MEMO_SIZE:
+                memo.clear()
+            memo[key] = hit
+    return hit
+
 
 class TcuController:
     """One TCU variant; :meth:`cycle` runs once per TCU period.
@@ -129,6 +148,8 @@ class TcuController:
         self.t_closed = math.inf
         self._kiss_key: tuple = ()
         self._kiss_value = math.nan
+        self._command_memo: dict = {}
+        self._torque_memo: dict = {}
         #: thermal protection by the facing-temperature estimate (:mod:`.protection`), TCUs that have one
         self.protection = (ThermalProtection(sc.protection)
                            if sc.protection.enabled and variant.temperature != "none" else None)
@@ -178,14 +199,28 @@ class TcuController:
         """The kiss point the TCU believes, m."""
         return self.model_kiss(self.theta_used()) + self.offset
 
+    def x_for_torque(self, torque_Nm: float, theta: float, theta_cm: float | None) -> float:
+        """The model's bearing position for ``torque_Nm`` (N.m) at ``theta`` and ``theta_cm`` (K), m
+        (:func:`~cushion_clutch.model.x_to_for_torque` on the TCU's table and parameters).
+
+        Remembered per exact inputs (:func:`_memo`): a creep demand held at its level, or the pre-fill's
+        0 N.m, repeats them from cycle to cycle while the temperature estimate stands.
+        """
+        return _memo(self._command_memo, (torque_Nm, theta, theta_cm), lambda: x_to_for_torque(
+            torque_Nm, theta, self.table, self.p, theta_cm=theta_cm))
+
     def command(self, torque_Nm: float) -> float:
         """Bearing position for ``torque_Nm``, m."""
-        return x_to_for_torque(torque_Nm, self.theta_used(), self.table, self.p,
-                               theta_cm=self.theta_cm_used()) + self.offset
+        return self.x_for_torque(torque_Nm, self.theta_used(), self.theta_cm_used()) + self.offset
 
     def model_torque(self, x_m: float) -> float:
-        """Torque the TCU's model expects at bearing position ``x_m``, N.m."""
-        return outputs(x_m - self.offset, self.theta_used(), self.table, self.p, self.theta_cm_used()).torque
+        """Torque the TCU's model expects at bearing position ``x_m``, N.m.
+
+        Remembered per exact inputs (:func:`_memo`): the closed position is asked every launch cycle.
+        """
+        theta, theta_cm = self.theta_used(), self.theta_cm_used()
+        return _memo(self._torque_memo, (x_m, theta, theta_cm, self.offset), lambda: outputs(
+            x_m - self.offset, theta, self.table, self.p, theta_cm).torque)
 
     def _learn(self, torque_Nm: float, x_mean: float) -> None:
         theta = self.theta_used()

@@ -334,38 +334,42 @@ class ThermalNetwork:
                          gl + gr + c["engine"][i], self.shares[i]))
         return tuple(rows)
 
+    def _prepare(self, clamped: bool, dt: float) -> tuple:
+        """The per-node constants of :meth:`step` for one clamp state and step: ``(i, cap, g_left, g_right,
+        area_cooled, disc speed?, g_engine * theta_engine, g_fixed, share, decay or None)`` per node (the decay
+        factor precomputed for a node without convection), and the convection constants."""
+        p = self.p
+        nodes = tuple((i, cap, gl, gr, area, sp == 1, ge_te, gfix, share,
+                       math.exp(-dt * gfix / cap) if area == 0.0 and gfix > 0.0 else None)
+                      for i, (cap, gl, gr, area, sp, ge_te, gfix, share) in enumerate(self._table(clamped)))
+        hit = self._cache[(clamped, dt)] = (nodes, p.still_air_W_per_m2_K, p.rotating_W_per_m2_K,
+                                            p.convection_reference_rad_s)
+        return hit
+
     def step(self, dt: float, p_slip_W: float, w_engine: float, w_disc: float, clamped: bool) -> None:
         """Advance ``dt`` s with the slip power (W), speeds (rad/s) and clamp state held.
 
         The same conductances as :meth:`conductances`, evaluated inline (this runs every TCU period); the
-        decay factors of the nodes without convection are cached per step and clamp state (``shares`` and
-        ``caps`` are read at the first step).
+        node constants and the decay factors of the nodes without convection are cached per step and clamp
+        state (:meth:`_prepare`; ``shares`` and ``caps`` are read at the first step).
         """
-        key = (clamped, dt)
-        cache = self._cache
-        hit = cache.get(key)
+        hit = self._cache.get((clamped, dt))
         if hit is None:
-            rows = self._table(clamped)
-            fixed = tuple(math.exp(-dt * r[6] / r[0]) if r[3] == 0.0 and r[6] > 0.0 else None for r in rows)
-            hit = cache[key] = (rows, fixed)
-        rows, fixed = hit
-        p = self.p
-        wr = p.convection_reference_rad_s
-        h0, hr = p.still_air_W_per_m2_K, p.rotating_W_per_m2_K
-        hs = (h0 + hr * (abs(w_engine) / wr) ** 0.8, h0 + hr * (abs(w_disc) / wr) ** 0.8)
+            hit = self._prepare(clamped, dt)
+        nodes, h0, hr, wr = hit
+        h_engine = h0 + hr * (abs(w_engine) / wr) ** 0.8
+        h_disc = h0 + hr * (abs(w_disc) / wr) ** 0.8
         ta = self.theta_a
         th = self.theta
         left = 0.0
-        for i in range(N_NODES):
-            cap, gl, gr, area, sp, ge_te, gfix, share = rows[i]
+        for i, cap, gl, gr, area, on_disc, ge_te, gfix, share, decay in nodes:
             flow = share * p_slip_W + ge_te
             if gl:
                 flow += gl * left
             if gr:
                 flow += gr * th[i + 1]
-            decay = fixed[i]
             if decay is None:
-                conv = area * hs[sp]
+                conv = area * (h_disc if on_disc else h_engine)
                 gs = gfix + conv
                 flow += conv * ta
                 if gs > 0.0:

@@ -9,7 +9,6 @@ positions within 1e-13 m, the inverse within 3e-12 m (its tolerance, 1e-12 m of 
 cushion, seen through the release compliance). Measured on 2026-11-26: forces within 1.8e-11 relative, u within
 3e-16 m, the inverse within 1.3e-12 m (the model before the speed-up: the same and 1.2e-12 m).
 """
-import math
 import random
 from bisect import bisect_right
 

@@ -36,7 +36,7 @@ from dataclasses import dataclass
 from collections import deque
 from pathlib import Path
 
-from ..model import ClutchParameters, SpringTable, x_to_for_torque
+from ..model import ClutchParameters, SpringTable
 from .ekf import IX_DX, ClutchEkf, EkfParams, TcuNetworkParams
 from .mass_grade import MassGrade, MassGradeEstimator
 from .sensors import ProductionSensors, TcuSensors

@@ -13,7 +13,7 @@
  * (3-4 iterations); the start depends on the inputs only, so results are reproducible bit for bit
  * (saved and restored states, any call history).
  */
-#include "clutch_core.h"
+#include "clutch_cover.h"
 
 #include <math.h>
 #include <string.h>

@@ -3,9 +3,11 @@
  * friction.csv) read from the FMU's resources, its interpolation (as cushion_clutch/model/spring_table.py and
  * friction.py, operation for operation). The resource URI -> path conversion is in resource_uri.c.
  */
-#include "clutch_core.h"
+#include "clutch_tables.h"
+#include "resource_uri.h" /* cc_fopen */
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 

@@ -22,7 +22,7 @@ SLAVE_MODULES = {"cushion_slave.py": FMU_SRC, "clutch_model.py": MODEL_SRC, "spr
                  "friction.py": MODEL_SRC, "table_format.py": MODEL_SRC, "cover.py": MODEL_SRC}
 
 #: the native model core (shared) and the front end of each FMI version, as shipped in sources/
-CORE_HEADERS = ("clutch_core.h", "resource_uri.h")
+CORE_HEADERS = ("clutch_core.h", "clutch_tables.h", "clutch_cover.h", "resource_uri.h")
 CORE_SOURCES = ("clutch_core.c", "clutch_tables.c", "clutch_cover.c", "resource_uri.c")
 FRONT_ENDS = {2: "fmi2_frontend.c", 3: "fmi3_frontend.c"}
 #: the pythonfmu FMU's guard library

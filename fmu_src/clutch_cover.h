@@ -1,0 +1,51 @@
+/*
+ * The diaphragm-spring cover (clutch_cover.c): its force balance with the cushion spring, prepared once per
+ * parameter set, the forward map from the bearing position, and what it can hold (cushion_clutch/model/cover.py).
+ * Knows the tables, not the FMU.
+ */
+#ifndef CLUTCH_COVER_H
+#define CLUTCH_COVER_H
+
+#include "clutch_tables.h"
+
+/* cover parameters, in the order of cover.CoverParameters' fields (cushion_clutch/model/cover.py) */
+enum {
+    CV_A, CV_B, CV_T, CV_H, CV_E, CV_KE, CV_NU, CV_RPP, CV_RF, CV_SINST, CV_C, CV_TF, CV_AF, CV_TPP, CV_APP,
+    CV_LFW, CV_AFW, CV_TREF, CV_NPAR
+};
+
+/* the cover's force balance, prepared once per parameter set (clutch_cover.c) */
+typedef struct {
+    double p[CV_NPAR];
+    double e, L_pp, L_b, kb, kp, fal; /* arms (m), bearing/pp travel per unit s, F_AL factor without E */
+    double u_full_ref;                /* cushion full compression at the reference temperature, m */
+    double xc;                        /* bearing-system constant X_c, m */
+    int hint[2], hint_k[2];           /* last intervals of the two curves, solver and kiss point (search starts) */
+    int hint_t;                       /* last interval of the table temperatures (the frame's bracket) */
+    /* the frame of the last (theta_cs K, theta_cm K, wear m): bracket, E, positions and forces */
+    double f_theta_cs, f_theta_cm, f_wear, f_e;
+    TBracket f_br;
+    double s_kiss, s_solid, fc_solid, m_solid, fto_solid, fto_kiss, x_solid, x_kiss;
+} CcCover;
+
+typedef struct {
+    double clamp, bearing, cushion; /* F_pp, F_to, F_c, N */
+    double u, s;                    /* cushion compression from its kiss point, diaphragm deflection, m */
+    double x_kiss, x_solid, x_lift; /* bearing positions, m */
+} CcCoverState;
+
+void cc_cover_prepare(CcCover *cv, const double *par, double lever_ratio, double x_kiss_ref, const Table *tb);
+double cc_cover_slope_bound(const CcCover *cv);
+/* 0, or -1 if the diaphragm cannot hold the cushion (bearing force < 0); out is filled either way */
+int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, double theta_cm, double wear,
+                   CcCoverState *out);
+/* what the cover can hold (cover.hold_problem / wear_limit): the temperature grid of the check (K), 1 if the
+   diaphragm holds the cushion at wear for every pair of it (else 0, with the first failing pair), and the
+   largest such wear (m; -1 if none) */
+#define CC_HOLD_GRID_MAX 128
+int cc_cover_grid(const Table *tb, double lo, double hi, double *g);
+int cc_cover_holds(const CcCover *cv, const Table *tb, double wear, double lo, double hi, double *fto,
+                   double *theta_cs, double *theta_cm);
+double cc_cover_wear_limit(const CcCover *cv, const Table *tb, double lo, double hi);
+
+#endif

@@ -1,0 +1,73 @@
+/*
+ * The cushion spring's tables (clutch_tables.c): the F(u) curves per table temperature with their interval
+ * locator and cubic coefficients, the kiss shift, the optional friction table, and the temperature bracket that
+ * blends two curves (cushion_clutch/model/spring_table.py, operation for operation). Knows nothing of the FMU.
+ */
+#ifndef CLUTCH_TABLES_H
+#define CLUTCH_TABLES_H
+
+#include <stddef.h>
+
+typedef struct {
+    int n;
+    double *x, *y, *d;
+    double x_first; /* first contact: the last row still at the first force, m (spring_table.Curve.x_first) */
+    /* the interval locator's buckets: nb uniform buckets of width 1/inv_bw from x[0], each holding the interval
+       of its lower edge (a start only: cc_curve_locate corrects it, so it finds the binary search's interval) */
+    int nb;
+    double inv_bw;
+    unsigned short *bk;
+    /* the cubic of interval i in t = (u - x[i]) / (x[i+1] - x[i]): F = y[i] + t (q0 + t (q1 + t q2)), and
+       q3 = 1 / (x[i+1] - x[i]); pc[4 i + k] = qk (the cover's solver: value, slope and curvature at once) */
+    double *pc;
+} Curve;
+
+/* F(u) at one temperature: curves c0 and c1 (weight w of c1; c1 = c0 where w = 0) blended on a common
+   normalised compression between the first contact and the full compression, both linear in theta
+   (spring_table.Bracket); r0, r1 = d(u_k)/du */
+typedef struct {
+    const Curve *c0, *c1;
+    double w, first, full, r0, r1;
+    int i; /* c0 = curves[i] (the table index of theta) */
+} TBracket;
+
+typedef struct {
+    int nt;
+    double *theta; /* degC, increasing */
+    double *delta; /* m */
+    Curve *curves;
+    /* optional friction table mu(theta_cm degC, |omega_slip| rad/s), row-major [ntf][nw] */
+    int ntf, nw;
+    double *f_theta, *f_omega, *f_mu;
+} Table;
+
+int cc_table_load(Table *tb, const char *dir, char *err, size_t errlen);
+void cc_table_free(Table *tb);
+double cc_table_force(const Table *tb, double u, double theta_degC);
+double cc_table_delta(const Table *tb, double theta_degC);
+/* the kiss shift of a bracket's temperature (the same number as cc_table_delta at that temperature), m */
+double cc_table_delta_at(const Table *tb, const TBracket *br);
+/* the interval i of x[0] < u < x[n-1]: x[i] <= u < x[i+1] (the binary search's; found from a bucket) */
+int cc_curve_locate(const Curve *c, double u);
+/* the same, inline (the cover's solver): the interval from the bucket of u, corrected until x[i] <= u < x[i+1]
+   holds, so it is the one interval the binary search finds whatever the rounding of the bucket index (buckets
+   are no wider than the narrowest interval: at most one step up from the bucket's start in exact arithmetic) */
+static inline int cc_curve_locate_inline(const Curve *c, double u) {
+    const double *x = c->x;
+    int k = (int)((u - x[0]) * c->inv_bw), i;
+    if (k > c->nb - 1) k = c->nb - 1;
+    if (k < 0) k = 0;
+    i = c->bk[k];
+    i += u >= x[i + 1];
+    while (u < x[i]) --i;
+    while (u >= x[i + 1]) ++i;
+    return i;
+}
+double cc_table_mu(const Table *tb, double theta_degC, double omega);
+double cc_table_full(const Table *tb, double theta_degC);
+/* table temperatures i and i+1 around theta with weight w of i+1 (clamped: w = 0 or 1) */
+void cc_table_bracket(const Table *tb, double theta_degC, TBracket *br);
+/* the same, trying the table interval *hint first (the last one found, kept in *hint) */
+void cc_table_bracket_hint(const Table *tb, double theta_degC, TBracket *br, int *hint);
+
+#endif

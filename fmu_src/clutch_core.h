@@ -72,6 +72,7 @@ typedef struct {
     void *log_ctx;
 #if CC_THERMAL
     int net_skip;     /* the next output update skips the nodes' derivatives (a CS step computes them at its end) */
+    TnMemo tn_memo;   /* the network's last exp/pow arguments and values (exact: results independent of history) */
 #endif
 } CcModel;
 

@@ -60,8 +60,10 @@ static void derivatives(double *r, const TnParams *p, const TnOperating *op) {
 }
 
 /* the operating point at the current inputs and clamp state (clamp force > 0) */
-static void operating(const double *r, const TnParams *p, TnOperating *op) {
-    tn_operating(p, r[VR_OMEGA_ENGINE], r[VR_OMEGA_ENGINE] - r[VR_OMEGA_SLIP], r[VR_CLAMP_FORCE] > 0.0, op);
+static void operating(CcModel *m, const TnParams *p, TnOperating *op) {
+    const double *r = m->r;
+    tn_operating(p, r[VR_OMEGA_ENGINE], r[VR_OMEGA_ENGINE] - r[VR_OMEGA_SLIP], r[VR_CLAMP_FORCE] > 0.0, op,
+                 &m->tn_memo);
 }
 
 void cc_net_start(double *r) {
@@ -106,7 +108,7 @@ int cc_net_outputs(CcModel *m) {
         return CC_OK;
     }
     params(r, &p);
-    operating(r, &p, &op);
+    operating(m, &p, &op);
     derivatives(r, &p, &op);
     return CC_OK;
 }
@@ -117,9 +119,9 @@ int cc_net_step(CcModel *m, double h, const char *fn, int (*outputs)(CcModel *))
     TnOperating op;
     int i;
     params(r, &p);
-    operating(r, &p, &op);
+    operating(m, &p, &op);
     for (i = 0; i < TN_N; ++i) th[i] = r[TN_VR_THETA[i]];
-    tn_step(&p, &op, th, h, r[VR_SLIP_POWER]);
+    tn_step(&p, &op, th, h, r[VR_SLIP_POWER], &m->tn_memo);
     store(r, th);
     if (!(r[VR_THETA_CM] > 0.0 && r[VR_THETA_CM] < THETA_CM_LIMIT)) {
         cc_log(m, CC_DISCARD, "%s: t = %g s: the facing temperature theta_cm = %g K left (0, %g) K; step refused", fn,

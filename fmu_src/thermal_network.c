@@ -11,12 +11,24 @@ void tn_links(const TnParams *p, int clamped, TnOperating *op) {
     for (i = 0; i + 1 < p->n; ++i) op->link[i] = clamped ? p->g_always[i] + p->g_clamped[i] : p->g_always[i];
 }
 
-void tn_operating(const TnParams *p, double w_engine, double w_disc, int clamped, TnOperating *op) {
+/* a ** 0.8, or the memo's value for the same a */
+static double pow08(double a, int k, TnMemo *memo) {
+    if (memo && memo->ready & 1 && a == memo->pow_in[k]) return memo->pow_out[k];
+    if (!memo) return pow(a, 0.8);
+    memo->pow_in[k] = a;
+    return memo->pow_out[k] = pow(a, 0.8);
+}
+
+void tn_operating(const TnParams *p, double w_engine, double w_disc, int clamped, TnOperating *op, TnMemo *memo) {
     int i;
     /* (|w| / w_ref)^0.8 per speed source (turbulent forced convection, Nu ~ Re^0.8) */
     double x[2];
-    x[TN_ENGINE] = pow(fabs(w_engine) / p->w_ref, 0.8);
-    x[TN_DISC] = pow(fabs(w_disc) / p->w_ref, 0.8);
+    x[TN_ENGINE] = pow08(fabs(w_engine) / p->w_ref, TN_ENGINE, memo);
+    x[TN_DISC] = pow08(fabs(w_disc) / p->w_ref, TN_DISC, memo);
+    if (memo && !(memo->ready & 1)) {
+        /* the first call filled both entries: they are valid from now on */
+        memo->ready |= 1;
+    }
     tn_links(p, clamped, op);
     for (i = 0; i < p->n; ++i) {
         double conv = p->area[i] > 0.0 ? p->area[i] * (p->h_still + p->h_rot * x[p->speed[i]]) : 0.0;
@@ -26,7 +38,15 @@ void tn_operating(const TnParams *p, double w_engine, double w_disc, int clamped
     }
 }
 
-void tn_step(const TnParams *p, const TnOperating *op, double *th, double dt, double power) {
+/* exp(a) of node i, or the memo's value for the same a */
+static double exp_node(double a, int i, TnMemo *memo) {
+    if (!memo) return exp(a);
+    if (memo->ready & 2 && a == memo->exp_in[i]) return memo->exp_out[i];
+    memo->exp_in[i] = a;
+    return memo->exp_out[i] = exp(a);
+}
+
+void tn_step(const TnParams *p, const TnOperating *op, double *th, double dt, double power, TnMemo *memo) {
     const double *link = op->link, *sg = op->sink_g, *st = op->sink_t;
     int i, n = p->n;
     for (i = 0; i < n; ++i) {
@@ -36,11 +56,13 @@ void tn_step(const TnParams *p, const TnOperating *op, double *th, double dt, do
                       (i < n - 1 ? gr * th[i + 1] : 0.0);
         if (gs > 0.0) {
             double inf = flow / gs;
-            th[i] = inf + (th[i] - inf) * exp(-dt * gs / p->cap[i]);
+            th[i] = inf + (th[i] - inf) * exp_node(-dt * gs / p->cap[i], i, memo);
         } else {
             th[i] += flow * dt / p->cap[i];
+            if (memo) memo->exp_in[i] = NAN; /* no entry for this node: the next call computes it */
         }
     }
+    if (memo) memo->ready |= 2;
 }
 
 void tn_derivative(const TnParams *p, const TnOperating *op, const double *th, double power, double *der) {

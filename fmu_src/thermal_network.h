@@ -32,12 +32,21 @@ typedef struct {
     double link[TN_MAX], sink_g[TN_MAX], sink_t[TN_MAX]; /* W/K, W/K, K */
 } TnOperating;
 
-/* the operating point at the given speeds (rad/s) and clamp state */
-void tn_operating(const TnParams *p, double w_engine, double w_disc, int clamped, TnOperating *op);
+/* the last arguments of the network's transcendental calls and their values, kept by the caller between steps:
+   a call with the same argument (compared exactly) takes the kept value, the same bits exp/pow would give, so the
+   results do not depend on the call history; ready = 0 (a zeroed memo) computes everything */
+typedef struct {
+    int ready;
+    double pow_in[2], pow_out[2]; /* |w| / w_ref of the engine and the disc, and its power 0.8 */
+    double exp_in[TN_MAX], exp_out[TN_MAX]; /* -dt g_i / C_i of each node, and its exponential */
+} TnMemo;
+
+/* the operating point at the given speeds (rad/s) and clamp state (memo: NULL or the caller's TnMemo) */
+void tn_operating(const TnParams *p, double w_engine, double w_disc, int clamped, TnOperating *op, TnMemo *memo);
 /* the links alone for another clamp state (the sinks depend on the speeds only) */
 void tn_links(const TnParams *p, int clamped, TnOperating *op);
-/* advance theta (K) by dt (s) with the slip power (W) and the operating point held */
-void tn_step(const TnParams *p, const TnOperating *op, double *theta, double dt, double power);
+/* advance theta (K) by dt (s) with the slip power (W) and the operating point held (memo: NULL or the caller's) */
+void tn_step(const TnParams *p, const TnOperating *op, double *theta, double dt, double power, TnMemo *memo);
 /* dtheta/dt (K/s) */
 void tn_derivative(const TnParams *p, const TnOperating *op, const double *theta, double power, double *der);
 

@@ -228,3 +228,26 @@ def test_every_binary_exports_exactly_the_fmi_api(fmus, tmp_path):
             assert exports == fmi_functions(version), (name, exports ^ fmi_functions(version))
             seen.add(name.split("/")[1])
     assert seen == set(EXPECTED)
+
+
+def test_network_steps_do_not_depend_on_the_instance_history(fmus, launch_inputs):
+    """The C network keeps its last exp/pow arguments and values between steps (thermal_network.c, TnMemo).
+    A launch's second half from a state copied into a fresh instance (empty memo) gives the same bits as the
+    instance that ran the whole launch (a warm memo), and a fresh instance gives the same bits as a warm one."""
+    sc, x_to, w_slip, w_engine, _ = launch_inputs
+    h = sc.run.step_s
+    names = ["theta_cm", "theta_cs", "torque", *NODE_OUTPUTS]
+    inputs = list(zip(x_to.tolist(), w_slip.tolist(), w_engine.tolist()))
+    half = len(inputs) // 2
+    whole, first, fresh = Slave(fmus[2]), Slave(fmus[2]), Slave(fmus[2])
+    try:
+        ref = [whole.step(h, names, x_to=x, omega_slip=w, omega_engine=we) for x, w, we in inputs]
+        for x, w, we in inputs[:half]:
+            first.step(h, names, x_to=x, omega_slip=w, omega_engine=we)
+        fresh.s.setFMUstate(fresh.s.deSerializeFMUstate(first.s.serializeFMUstate(first.s.getFMUstate())))
+        fresh.t = first.t
+        got = [fresh.step(h, names, x_to=x, omega_slip=w, omega_engine=we) for x, w, we in inputs[half:]]
+    finally:
+        for s in (whole, first, fresh):
+            s.close()
+    assert got == ref[half:]                        # bit for bit, every output of every step

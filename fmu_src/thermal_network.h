@@ -9,7 +9,7 @@
  *   heat input:      q_i = share[i] * P  (P the slip power, W).
  * Co-Simulation: tn_step advances node by node (0 first) with the exact exponential solution for the node's
  * neighbours held, the same Gauss-Seidel exponential splitting as the Python plant
- * (cushion_clutch.launch.thermal_network.ThermalNetwork.step); Model Exchange: tn_derivative.
+ * (cushion_clutch.model.thermal_network.ThermalNetwork.step); Model Exchange: tn_derivative.
  * The structure (n, speed sources, mean weights) and the parameters' value references are generated from
  * Python into cushion_variables.h (cushion_clutch.fmu.thermal_chain); this file knows no node by name.
  */

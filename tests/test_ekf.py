@@ -8,7 +8,7 @@ from cushion_clutch.errors import ParameterError
 from cushion_clutch.model import load_table
 from cushion_clutch.model import ClutchParameters, outputs, thermal_step, x_to_for_torque
 from cushion_clutch.launch.ekf import IX_DX, IX_HEAT, IX_LOSS, ClutchEkf, EkfParams, TcuNetworkParams
-from cushion_clutch.launch.thermal_network import NetworkParams, ThermalNetwork
+from cushion_clutch.model.thermal_network import NetworkParams, ThermalNetwork
 
 TA = 293.15
 

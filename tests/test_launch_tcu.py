@@ -11,7 +11,7 @@ from cushion_clutch.data import DEFAULT_TABLES
 from cushion_clutch.model import load_table
 from cushion_clutch.launch.fmu_client import ClutchFmu
 from cushion_clutch.launch.scenario import load_scenario, scenario_path
-from cushion_clutch.launch.thermal_network import NetworkParams
+from cushion_clutch.model.thermal_network import NetworkParams
 from cushion_clutch.launch.tcu_params import Observer
 from cushion_clutch.launch.simulate import simulate_launches
 

@@ -19,7 +19,7 @@ from cushion_clutch.cli import main
 from cushion_clutch.fmu.build import build_fmu
 from cushion_clutch.fmu.thermal_chain import chain_of, node_output
 from cushion_clutch.data import DEFAULT_TABLES
-from cushion_clutch.launch.thermal_network import NODES, ThermalNetwork
+from cushion_clutch.model.thermal_network import NODES, ThermalNetwork
 from cushion_clutch.model import ClutchParameters, clutch_model, load_table, outputs, thermal_step
 
 pytestmark = pytest.mark.fmu

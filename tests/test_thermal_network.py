@@ -7,7 +7,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from cushion_clutch.errors import ParameterError
-from cushion_clutch.launch.thermal_network import (FACINGS, N_NODES, NODES, SURFACES, NetworkParams,
+from cushion_clutch.model.thermal_network import (FACINGS, N_NODES, NODES, SURFACES, NetworkParams,
                                                    TcuNetworkBase, ThermalNetwork, chain, coefficients,
                                                    node_time_constants, time_constants)
 

@@ -134,7 +134,7 @@ def plant_replay() -> dict[str, float]:
 def main(argv=None) -> None:
     from cushion_clutch.data import DEFAULT_TABLES
     from cushion_clutch.fmu.build import build_fmu
-    from cushion_clutch.launch.thermal_network import NODES
+    from cushion_clutch.model.thermal_network import NODES
 
     with tempfile.TemporaryDirectory() as tmp:
         fmu = build_fmu(DEFAULT_TABLES, Path(tmp) / "thermal.fmu", thermal=True)

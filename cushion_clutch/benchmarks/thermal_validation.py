@@ -54,7 +54,7 @@ def per_launch(res) -> list[dict]:
 def semi_infinite(p, q_W: float = 10e3, t_end: float = 5.0, dt: float = 0.01) -> tuple[np.ndarray, np.ndarray,
                                                                                       np.ndarray]:
     """(t s, surface node rise K, closed form K) for ``q_W`` into one metal surface, the rest adiabatic."""
-    from ..launch.thermal_network import N_NODES, SURFACES, ThermalNetwork
+    from ..model.thermal_network import N_NODES, SURFACES, ThermalNetwork
 
     net = ThermalNetwork(p, 293.15, 293.15)
     net.shares = [0.0] * N_NODES

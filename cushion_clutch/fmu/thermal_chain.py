@@ -8,7 +8,7 @@ second generated variable table. Everything the C chain needs comes from here:
 * :class:`Chain`: the network as arrays (nodes, capacities, heat shares, cooled areas with their
   speed source, engine-block conductances, link conductances (always, and added while clamped),
   the weights of the facing temperature ``theta_cm``). :func:`chain_of` maps the plant's
-  :class:`~cushion_clutch.launch.thermal_network.NetworkParams` onto it; a new node list is a
+  :class:`~cushion_clutch.model.thermal_network.NetworkParams` onto it; a new node list is a
   new :class:`Chain`, and the C table, the FMU variables and the descriptions follow.
 * :func:`thermal_variables`: the FMU interface. ``clutch_model.VARIABLES`` in their order with
   ``theta_cm`` turned into an output (the network's facing mean), then the input ``omega_engine``,
@@ -93,11 +93,11 @@ class Chain:
 
 
 def chain_of(p=None) -> Chain:
-    """The plant's network (:class:`~cushion_clutch.launch.thermal_network.NetworkParams`, default: its
+    """The plant's network (:class:`~cushion_clutch.model.thermal_network.NetworkParams`, default: its
     defaults) as a :class:`Chain`, in the plant's node order and with its conductance laws, taken as they are
     from the network's arrays (``thermal_network.coefficients``).
     """
-    from ..launch import thermal_network as tn
+    from ..model import thermal_network as tn
     from ..model import KELVIN
     p = p or tn.NetworkParams()
     c = tn.coefficients(p)

@@ -134,7 +134,7 @@ from ..config import Checked
 from ..model import x_to_for_torque
 from ..model import ClutchParameters, SpringTable, outputs
 from ..model.clutch_model import THETA_MAX_K, THETA_MIN_K
-from .thermal_network import FACINGS, N_NODES, TcuNetworkBase, ThermalNetwork
+from ..model.thermal_network import FACINGS, N_NODES, TcuNetworkBase, ThermalNetwork
 
 #: state indices: the network's nodes, then these
 IX_CS, IX_DX, IX_MU, IX_LOSS, IX_HEAT = N_NODES, N_NODES + 1, N_NODES + 2, N_NODES + 3, N_NODES + 4

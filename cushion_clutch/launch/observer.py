@@ -13,7 +13,7 @@ import random
 from ..model import ClutchParameters, thermal_step
 from .tcu_params import Observer, Sensors
 from .thermal import FacingModel
-from .thermal_network import ThermalNetwork
+from ..model.thermal_network import ThermalNetwork
 
 
 class SpeedSensors:

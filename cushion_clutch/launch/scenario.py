@@ -16,7 +16,7 @@ from .mass_grade import MassGrade
 from .protection import Protection
 from .sensors import ProductionSensors
 from .tcu_params import Adaptation, Observer, Sensors, Standstill, TcuStore
-from .thermal_network import PlantThermal
+from ..model.thermal_network import PlantThermal
 
 
 

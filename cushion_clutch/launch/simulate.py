@@ -39,7 +39,7 @@ from .engine import RPM
 from .production import KeyOn, ProductionTcu, key_off, key_on
 from .tcu import CLOSE, LAUNCH, OPEN, PREFILL, VARIANTS, TcuController
 from .thermal import FacingModel
-from .thermal_network import ThermalNetwork
+from ..model.thermal_network import ThermalNetwork
 
 __all__ = ["COLUMNS", "Energy", "LaunchResult", "simulate_launches"]
 

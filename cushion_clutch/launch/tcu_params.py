@@ -8,7 +8,7 @@ from dataclasses import dataclass
 from typing import Iterable
 
 from ..config import Checked
-from .thermal_network import TcuNetworkBase
+from ..model.thermal_network import TcuNetworkBase
 
 
 @dataclass(frozen=True)

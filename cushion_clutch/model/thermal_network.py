@@ -48,7 +48,7 @@ from typing import Iterable
 import numpy as np
 
 from ..config import Checked
-from ..model import KELVIN
+from .spring_table import KELVIN
 
 #: node order of every state vector
 NODES = ("flywheel_bulk", "flywheel_layer", "flywheel_surface", "facing_flywheel_side",

@@ -7,6 +7,7 @@ callgrind (docs/reference/fmu.md); the C host's ``checksum`` mode compares two b
 import shutil
 import subprocess
 import zipfile
+from pathlib import Path
 
 import pytest
 from fmpy import read_model_description
@@ -116,20 +117,27 @@ int main(int argc, char **argv) {
 """
 
 
-def test_caches_give_the_bits_of_the_plain_searches_and_a_cold_cover(tmp_path):
+def _cover_driver(tmp: Path, driver_c: str) -> tuple[Path, Path]:
+    """A gcc -O2 build of ``driver_c`` with the C tables and cover (no FMI), and a resource folder with the
+    default tables: (executable, resource folder). Skips without gcc."""
     cc = shutil.which("gcc")
     if cc is None:
         pytest.skip("gcc not installed")
-    src = tmp_path / "src"
+    src = tmp / "src"
     stage_sources(src, "{00000000-0000-0000-0000-000000000000}", 2, table_set_x_kiss_ref(DEFAULT_TABLES))
-    (src / "driver.c").write_text(DRIVER)
-    res_dir = tmp_path / "res"
+    (src / "driver.c").write_text(driver_c)
+    res_dir = tmp / "res"
     res_dir.mkdir()
     (res_dir / "tables").symlink_to(DEFAULT_TABLES)
-    exe = tmp_path / "driver"
+    exe = tmp / "driver"
     subprocess.run([cc, "-std=c99", "-O2", "-Wall", f"-I{src}", *(str(src / f) for f in
                     ("driver.c", "clutch_tables.c", "clutch_cover.c", "resource_uri.c")), "-o", str(exe), "-lm"],
                    check=True)
+    return exe, res_dir
+
+
+def test_caches_give_the_bits_of_the_plain_searches_and_a_cold_cover(tmp_path):
+    exe, res_dir = _cover_driver(tmp_path, DRIVER)
     res = subprocess.run([str(exe), str(res_dir)], capture_output=True, text=True, timeout=120)
     assert res.returncode == 0, res.stdout[-2000:] + res.stderr[-2000:]
     checked = int(res.stdout.split()[-3])
@@ -208,20 +216,8 @@ int main(int argc, char **argv) {
 
 @pytest.fixture(scope="module")
 def scan_driver(tmp_path_factory):
-    cc = shutil.which("gcc")
-    if cc is None:
-        pytest.skip("gcc not installed")
     tmp = tmp_path_factory.mktemp("scan")
-    src = tmp / "src"
-    stage_sources(src, "{00000000-0000-0000-0000-000000000000}", 2, table_set_x_kiss_ref(DEFAULT_TABLES))
-    (src / "driver.c").write_text(SCAN_DRIVER)
-    res_dir = tmp / "res"
-    res_dir.mkdir()
-    (res_dir / "tables").symlink_to(DEFAULT_TABLES)
-    exe = tmp / "driver"
-    subprocess.run([cc, "-std=c99", "-O2", "-Wall", f"-I{src}", *(str(src / f) for f in
-                    ("driver.c", "clutch_tables.c", "clutch_cover.c", "resource_uri.c")), "-o", str(exe), "-lm"],
-                   check=True)
+    exe, res_dir = _cover_driver(tmp, SCAN_DRIVER)
 
     def run(inputs, order):
         text = "".join(" ".join(float(v).hex() for v in row) + "\n" for row in inputs)

@@ -180,7 +180,8 @@ class TcuNetworkParams(TcuNetworkBase):
         yield from self._ranges({"spring_U_W_per_K": (0.0, 1e4), "spring_H_W_per_K": (0.0, 1e4),
                                  "spring_C_J_per_K": (0.0, 1e6, True)})
         if self.spring_U_W_per_K + self.spring_H_W_per_K <= 0.0:
-            yield "tcu_thermal.spring_U_W_per_K + spring_H_W_per_K: must be > 0"
+            yield (f"tcu_thermal.spring_H_W_per_K: spring_U_W_per_K + spring_H_W_per_K = "
+                   f"{self.spring_U_W_per_K + self.spring_H_W_per_K:g} W/K; must be > 0 (the spring exchanges heat)")
 
 
 @dataclass(frozen=True)

@@ -48,7 +48,8 @@ class Engine(Checked):
             "governor_ki_Nm_per_rad": (0.0, 1e4), "stall_speed_rpm": (0.0, 3000.0),
             "max_speed_rpm": (1000.0, 20000.0)})
         if len(self.torque_curve_rpm) < 2 or len(self.torque_curve_rpm) != len(self.torque_curve_Nm):
-            yield "engine.torque_curve_rpm / torque_curve_Nm: need equal lengths >= 2"
+            yield (f"engine.torque_curve_Nm: {len(self.torque_curve_Nm)} values for {len(self.torque_curve_rpm)} "
+                   "torque_curve_rpm values; need equal lengths >= 2")
         elif list(self.torque_curve_rpm) != sorted(set(self.torque_curve_rpm)):
             yield "engine.torque_curve_rpm: must be strictly increasing"
         for i, v in enumerate(self.torque_curve_Nm):

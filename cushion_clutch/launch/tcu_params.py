@@ -42,7 +42,8 @@ class Observer(TcuNetworkBase):
             "capacity_J_per_K": (1.0, 1e6), "loss_W_per_K": (0.0, 1e4), "heat_share": (0.0, 1.0),
             "spring_U_W_per_K": (0.0, 1e4), "spring_H_W_per_K": (0.0, 1e4), "spring_C_J_per_K": (0.0, 1e6, True)})
         if self.spring_U_W_per_K + self.spring_H_W_per_K <= 0.0:
-            yield "observer.spring_U_W_per_K + spring_H_W_per_K: must be > 0"
+            yield (f"observer.spring_H_W_per_K: spring_U_W_per_K + spring_H_W_per_K = "
+                   f"{self.spring_U_W_per_K + self.spring_H_W_per_K:g} W/K; must be > 0 (the spring exchanges heat)")
 
 
 @dataclass(frozen=True)

@@ -1,6 +1,6 @@
 """Issue 26's bar for the production TCU: every shipped scenario, naive and production, from the launch metrics.
 
-    python -m cushion_clutch.benchmarks.production_bar [--scenarios default,cooldown,...] [--repeat N]
+    python -m cushion_clutch.benchmarks.production_bar [--scenarios default,cooldown,...] [--repeat N] [--seed N]
     python -m cushion_clutch.benchmarks.production_bar --out docs/results/production_bar.md
 
 Per scenario: production's worst characteristic error over all launches (the first included; target
@@ -22,8 +22,14 @@ from pathlib import Path
 SHIPPED = ("default", "trailer", "cooldown", "creep", "fade", "wear", "wear_learned", "tolerance", "protection")
 
 
-def bar(name: str, repeat: int = 1) -> dict:
-    """Run ``name`` with the naive and the production TCU; the bar's figures."""
+def bar(name: str, repeat: int = 1, seed: int | None = None) -> dict:
+    """Run ``name`` with the naive and the production TCU; the bar's figures.
+
+    ``seed``: another realisation of the sensors' noise (``tcu_sensors.seed`` and ``sensors.seed`` both set to
+    it; None: the scenario's own), to see how much of a figure is one noise draw.
+    """
+    import dataclasses
+
     from cushion_clutch.data import DEFAULT_TABLES
     from cushion_clutch.launch.plant import build_plant_fmu
     from cushion_clutch.launch.report import peaks
@@ -32,6 +38,9 @@ def bar(name: str, repeat: int = 1) -> dict:
     from cushion_clutch.model import load_table
 
     sc = load_scenario(scenario_path(name))
+    if seed is not None:
+        sc = dataclasses.replace(sc, tcu_sensors=dataclasses.replace(sc.tcu_sensors, seed=seed),
+                                 sensors=dataclasses.replace(sc.sensors, seed=seed))
     tables = Path(DEFAULT_TABLES)
     table = load_table(sc.tables_path("tcu") or tables)
     with tempfile.TemporaryDirectory() as tmp:
@@ -64,7 +73,8 @@ launches, the first included, at most 7.2 N.m (3 % of the engine's 240 N.m peak)
 starts below 40 degC within 0.5 N.m of naive's or better. Also: the largest |theta_cs error| of production's
 estimate at a launch start (target 15 K), how its TCU started (reset: standstill touch-point learning, with
 that routine's error; learned: a stored state), the plant's peak temperatures, and the CPU-time real-time
-factors (sim time / CPU time; median of `--repeat` runs; machine-dependent, noisy under load). How the
+factors (sim time / CPU time; median of `--repeat` runs; machine-dependent, noisy under load). `--seed N`
+reruns every scenario with another realisation of the sensors' noise. How the
 production TCU works: [the production TCU](../explanation/production_tcu.md)."""
 
 HEADER = ("| scenario | launches | production worst, all [N.m] | production worst, hot [N.m] | naive worst, all [N.m] "
@@ -90,6 +100,7 @@ def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--scenarios", default=",".join(SHIPPED), help="comma-separated shipped scenario names")
     ap.add_argument("--repeat", type=int, default=1, help="runs per TCU; the real-time factor is their median")
+    ap.add_argument("--seed", type=int, help="sensor-noise seed for every scenario (default: each scenario's own)")
     ap.add_argument("--out", type=Path, help="also write the table as a results page (docs/results/production_bar.md)")
     a = ap.parse_args(argv)
     rows = []
@@ -98,7 +109,7 @@ def main(argv: list[str] | None = None) -> None:
         stream = sys.stderr if a.out is not None else sys.stdout     # the page gets the table, not the progress
         print(HEADER, file=stream)
         for name in a.scenarios.split(","):
-            rows.append(row(name, bar(name, a.repeat)))
+            rows.append(row(name, bar(name, a.repeat, a.seed)))
             print(rows[-1], file=stream, flush=True)
         if a.out is not None:
             page.markdown("\n".join([HEADER, "|" + "---|" * 12, *rows]))

@@ -91,19 +91,32 @@ def _finish(root: ET.Element) -> str:
 
 
 
-def scalar_real(variables: ET.Element, vr: int, name: str, causality: str, unit: str, desc: str) -> ET.Element:
-    """Append an FMI 2.0 ``ScalarVariable`` with its ``Real`` element to ``variables``; return the ``Real``.
-
-    Parameters are fixed and exact, everything else continuous; the description ends with the unit, and a
-    kelvin variable is displayed in degC.
-    """
+def _common_attributes(vr: int, name: str, causality: str, unit: str, desc: str) -> dict[str, str]:
+    """A variable's attributes common to FMI 2.0 and 3.0: parameters fixed and exact, everything else
+    continuous; the description ends with the unit."""
     attrs = dict(name=name, valueReference=str(vr), description=f"{desc} [{unit}]", causality=causality)
     attrs.update(variability="fixed", initial="exact") if causality == "parameter" else attrs.update(
         variability="continuous")
-    real = ET.SubElement(ET.SubElement(variables, "ScalarVariable", attrs), "Real", unit=unit)
+    return attrs
+
+
+def scalar_real(variables: ET.Element, vr: int, name: str, causality: str, unit: str, desc: str) -> ET.Element:
+    """Append an FMI 2.0 ``ScalarVariable`` with its ``Real`` element to ``variables``; return the ``Real``
+    (a kelvin variable displayed in degC)."""
+    real = ET.SubElement(ET.SubElement(variables, "ScalarVariable", _common_attributes(vr, name, causality, unit,
+                                                                                        desc)), "Real", unit=unit)
     if unit == "K":
         real.set("displayUnit", "degC")
     return real
+
+
+def float64_attributes(vr: int, name: str, causality: str, unit: str, desc: str) -> dict[str, str]:
+    """The attributes of an FMI 3.0 ``Float64`` variable (with its unit; a kelvin variable displayed in degC)."""
+    attrs = _common_attributes(vr, name, causality, unit, desc)
+    attrs["unit"] = unit
+    if unit == "K":
+        attrs["displayUnit"] = "degC"
+    return attrs
 
 def fmi2_description(guid: str, has_friction: bool, x_kiss_ref_m: float | None = None) -> str:
     """FMI 2.0 modelDescription.xml: ME and CS, SourceFiles, ModelStructure with dependencies."""
@@ -161,12 +174,7 @@ def fmi3_description(token: str, has_friction: bool, x_kiss_ref_m: float | None 
     ET.SubElement(variables, "Float64", name="time", valueReference=str(vr_time()), causality="independent",
                   variability="continuous", unit="s", description="simulation time [s]")
     for vr, name, causality, unit, desc, start in _variables(x_kiss_ref_m):
-        attrs = dict(name=name, valueReference=str(vr), description=f"{desc} [{unit}]", causality=causality)
-        attrs.update(variability="fixed", initial="exact") if causality == "parameter" else attrs.update(
-            variability="continuous")
-        attrs["unit"] = unit
-        if unit == "K":
-            attrs["displayUnit"] = "degC"
+        attrs = float64_attributes(vr, name, causality, unit, desc)
         if vr == vr_der():
             attrs["derivative"] = str(_vr("theta_cs"))
         attrs.update(bounds_attributes(name))

@@ -16,8 +16,8 @@ from xml.etree import ElementTree as ET
 
 from ..model import clutch_model
 from .constants import sources
-from .descriptions import (_finish, dependencies, fmi2_description, fmi3_build_description, fmi3_description,
-                           scalar_real, vr_der)
+from .descriptions import (_finish, dependencies, float64_attributes, fmi2_description, fmi3_build_description,
+                           fmi3_description, scalar_real, vr_der)
 from .thermal_chain import (NETWORK_SOURCES, THERMAL_SLAVE, Chain, node_output, thermal_ranges, thermal_starts,
                             thermal_variables)
 
@@ -180,12 +180,7 @@ def thermal_fmi3_description(token: str, has_friction: bool, chain: Chain, x_kis
     for vr, name, causality, unit, desc in all_:
         if vr < len(clutch_model.VARIABLES) or name == "der(theta_cs)":
             continue
-        attrs = dict(name=name, valueReference=str(vr), description=f"{desc} [{unit}]", causality=causality)
-        attrs.update(variability="fixed", initial="exact") if causality == "parameter" else attrs.update(
-            variability="continuous")
-        attrs["unit"] = unit
-        if unit == "K":
-            attrs["displayUnit"] = "degC"
+        attrs = float64_attributes(vr, name, causality, unit, desc)
         if name.startswith("der("):
             attrs["derivative"] = str(vrs[name[4:-1]])
         if causality in ("input", "parameter"):

@@ -18,14 +18,13 @@
 #include "host_platform.h" /* LIB, OPEN, SYM, CLOSE, LOAD, now_s() */
 
 #include "fmi2Functions.h"
-#include "host_fmi2_logger.h" /* logger: every message to stderr */
+#include "host_fmi2.h"          /* logger, LOAD_FMI2_CS, host_fmi2_start() */
 
 int main(int argc, char **argv) {
     LIB lib;
     long steps, k;
     double h, in[2], out[5], t = 0.0;
     const fmi2ValueReference vin[2] = {0, 1}, vout[5] = {2, 3, 4, 5, 6};
-    fmi2CallbackFunctions cb = {logger, calloc, free, NULL, NULL};
     fmi2Component c;
     double t0, t1;
     unsigned long long hash = 14695981039346656037ULL;
@@ -39,16 +38,10 @@ int main(int argc, char **argv) {
     lib = OPEN(argv[1]);
     if (!lib) { fprintf(stderr, "cannot load %s\n", argv[1]); return 2; }
     {
-        LOAD(fmi2Instantiate) LOAD(fmi2SetupExperiment) LOAD(fmi2EnterInitializationMode)
-        LOAD(fmi2ExitInitializationMode) LOAD(fmi2SetReal) LOAD(fmi2GetReal) LOAD(fmi2DoStep)
-        LOAD(fmi2Terminate) LOAD(fmi2FreeInstance)
-        c = fmi2Instantiate("host", fmi2CoSimulation, argv[3], argv[2], &cb, fmi2False, fmi2False);
-        if (!c) { fprintf(stderr, "fmi2Instantiate failed\n"); return 1; }
-        if (fmi2SetupExperiment(c, fmi2False, 0.0, 0.0, fmi2False, 0.0) > fmi2Warning ||
-            fmi2EnterInitializationMode(c) > fmi2Warning || fmi2ExitInitializationMode(c) > fmi2Warning) {
-            fprintf(stderr, "initialization failed\n");
-            return 1;
-        }
+        LOAD_FMI2_CS
+        c = host_fmi2_start(fmi2Instantiate, fmi2SetupExperiment, fmi2EnterInitializationMode,
+                            fmi2ExitInitializationMode, argv[3], argv[2]);
+        if (!c) return 1;
         t0 = now_s();
         for (k = 0; k < steps; ++k) {
             in[0] = 0.003 + 0.005 * (double)((k * 7919) % 1000) / 1000.0;

@@ -77,7 +77,7 @@ class ClutchFmu:
         set_real, do_step, get_real, comp = lib.fmi2SetReal, lib.fmi2DoStep, lib.fmi2GetReal, self._c
         vr_in, vr_out, v, o = self._vr_in, self._vr_out, self._v_in, self._v_out
 
-        held = [math.nan] * 3          # the inputs last set: an FMU keeps its inputs, unchanged ones need no call
+        held = self.held = [math.nan] * 3    # the inputs last set: an FMU keeps its inputs, unchanged ones need no call
 
         def step(t: float, h: float, x_to: float, theta_cm: float, omega_slip: float) -> tuple[float, float, float]:
             """Set the inputs (m, K, rad/s), advance ``h`` s from ``t``; return torque (N.m), theta_cs (K), x_kiss (m).

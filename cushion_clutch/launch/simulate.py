@@ -20,6 +20,7 @@ driveline (:mod:`.driveline`) advance, the facings heat up
 """
 from __future__ import annotations
 
+import logging
 import math
 import time
 from dataclasses import dataclass, field
@@ -41,7 +42,12 @@ from .tcu import CLOSE, LAUNCH, OPEN, PREFILL, VARIANTS, TcuController
 from .thermal import FacingModel
 from ..model.thermal_network import ThermalNetwork
 
-__all__ = ["COLUMNS", "Energy", "LaunchResult", "simulate_launches"]
+__all__ = ["COLUMNS", "Energy", "LaunchResult", "PLANTS", "simulate_launches"]
+
+log = logging.getLogger(__name__)
+
+#: the plant loop: compiled blocks between TCU cycles (plant_block) or the Python loop (the reference)
+PLANTS = ("native", "python")
 
 #: bearing positions closer to zero than this count as retracted (quiet steps), m
 X_RETRACTED_M = 1e-6
@@ -76,6 +82,8 @@ class LaunchResult:
     """production TCU: how it started (reset or learned) and its standstill touch-point learning"""
     protection_events: list = field(default_factory=list)
     """(s into the launch slot, launch, level, message): what the thermal protection told the driver"""
+    plant: str = "python"
+    """the plant loop that ran: ``native`` (compiled blocks, :mod:`.plant_block`) or ``python``"""
 
 
 def _facing_profile(path: str) -> Callable[[float], float]:
@@ -84,17 +92,34 @@ def _facing_profile(path: str) -> Callable[[float], float]:
     return lambda x: float(np.interp(x, t, th))
 
 
+def _native_plant(clutch, engine, dl, h, act, w_lift, prefill, tcu_every, net_every, alpha):
+    """The compiled plant steps (:mod:`.plant_block`), or None (logged) if the library cannot be built."""
+    from .metrics import CREEP_NM
+    from .plant_block import NativePlant
+    try:
+        return NativePlant(clutch, engine, dl, h, act, w_lift, prefill, tcu_every, net_every, alpha, CREEP_NM)
+    except (RuntimeError, ValueError, OSError) as exc:
+        log.warning("the native launch plant is not available, running the Python loop: %s", exc)
+        return None
+
+
 def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bool = "naive",
-                      record_every: int = 10, progress: Callable[[float], None] | None = None) -> LaunchResult:
+                      record_every: int = 10, progress: Callable[[float], None] | None = None,
+                      plant: str = "native") -> LaunchResult:
     """Run the scenario's launches with one TCU variant (a name of :data:`VARIANTS`).
 
     ``tcu`` True/False are the ``aware``/``naive`` variants. ``table`` is
     the TCU's characteristic; the plant is the FMU (with its own friction
     table, if any). ``progress(t)`` is called every 10,000 steps.
+    ``plant``: ``"native"`` runs the plant steps between two TCU cycles in one compiled call
+    (:mod:`.plant_block`; with the plant's thermal network, else, or if it cannot be built, the Python
+    loop), ``"python"`` the Python loop (the reference). Both give the same results.
     """
     name = {True: "aware", False: "naive"}.get(tcu, tcu) if isinstance(tcu, bool) else tcu
     if name not in VARIANTS:
         raise ValueError(f"tcu = {tcu!r}: allowed {', '.join(VARIANTS)}")
+    if plant not in PLANTS:
+        raise ValueError(f"plant = {plant!r}: allowed {', '.join(PLANTS)}")
     fac, tc, run, drv = sc.facing, sc.tcu, sc.run, sc.driver
     h = run.step_s
     theta_a, theta0 = fac.ambient_degC + KELVIN, fac.initial_degC + KELVIN
@@ -161,6 +186,9 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
     act_quiet = act ** tcu_every
     facing_quiet = FacingModel(fac.capacity_J_per_K, fac.loss_W_per_K, fac.heat_share, theta_a, h_quiet)
     n_quiet = 0
+    native = None
+    if plant == "native" and net is not None:
+        native = _native_plant(clutch, engine, dl, h, act, w_lift, prefill, tcu_every, net_every, recs[0].alpha)
     wall0, cpu0 = time.perf_counter(), time.process_time()
     try:
         k = 0
@@ -233,6 +261,51 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
                 k += tcu_every
                 n_quiet += 1
                 continue
+            if native is not None:
+                # -- the steps to the next TCU cycle in one compiled call (plant_block; the same step as below)
+                if cycled and sampling:                  # at the actual bearing position of the first step
+                    x_cmd = ctl.x_cmd
+                    believed = ctl.model_torque(x_cmd + (x_act - x_cmd) * act)
+                (m, x_act, lifted, stalled, net_n, net_e, t_e, t_cap, theta_cs, x_kiss) = native.block(
+                    k, n_steps, next_switch, slot_start, slot_end, countdown, ctl.x_cmd,
+                    pedal_level, ctl.t_dem, ctl.t_rate, engaged, braking, launching, x_act, theta_cm, lifted,
+                    stalled, net_n, net_e, rec)
+                out = native.out
+                o0 = out[0]
+                if engaged and not rec.started:
+                    rec.start(ctl.kiss_now - o0.x_kiss, o0.theta_cs, ctl.theta_now - o0.theta_cs)
+                if cycled and sampling:
+                    rec.characteristic(believed, o0.t_cap)
+                if engaged:
+                    if not rec.acc:
+                        rec.t_first = tl + h - prefill
+                    rec.acc.extend([out[j].accel for j in range(m)])
+                theta_estimate = protection_level = None
+                for j in range(m):
+                    o = out[j]
+                    if o.event:
+                        ev = o.event
+                        events.append((n + 1, "lock" if ev > 0 else "unlock", (k + j) * h + h if ev != -1
+                                       else (k + j) * h))
+                    if o.net_due:
+                        net.step(net_n * h, net_e / (net_n * h), o.net_w_e, o.net_w_d, engaged)
+                        theta_cm, net_n, net_e = net.theta_cm, 0, 0.0
+                    if rec_countdown == 0:
+                        rec_countdown = record_every
+                        if theta_estimate is None:
+                            theta_estimate = ctl.theta_cm_estimate()
+                            protection_level = ctl.protection.level if ctl.protection is not None else 0.0
+                        t = (k + j) * h
+                        rows.append((t, n + 1, o.w_e, o.w_d, o.v, o.accel, ctl.x_cmd, o.x_act, o.t_dem, o.t_cap,
+                                     o.t_c, o.theta_cm_step, o.theta_cs, ctl.theta_now, o.x_kiss, ctl.kiss_now,
+                                     o.throttle, o.locked, theta_estimate, believed if sampling else math.nan,
+                                     o.t_shaft, *net_temps(), protection_level))
+                        if progress is not None and (k + j) % 10000 == 0:
+                            progress(t)
+                    rec_countdown -= 1
+                countdown -= m
+                k += m
+                continue
             countdown -= 1
             x_cmd = ctl.x_cmd
             x_act = x_cmd + (x_act - x_cmd) * act
@@ -303,4 +376,5 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
     if keyed is not None:
         key_off(ctl, sc, keyed)
     return LaunchResult(name, series, metrics, dl.en, events, wall, total, cpu, learned, n_quiet * h_quiet, keyed,
-                        ctl.protection.events if ctl.protection is not None else [])
+                        ctl.protection.events if ctl.protection is not None else [],
+                        "native" if native is not None else "python")

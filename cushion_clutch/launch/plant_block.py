@@ -1,0 +1,195 @@
+"""The launch loop's plant steps between two TCU cycles in one compiled call (``fmu_src/launch_plant.c``).
+
+The Python loop of :func:`.simulate.simulate_launches` is the reference; with ``plant="native"`` the steps
+from a TCU cycle to the next (ten 1 ms steps at the shipped 10 ms period) run in C: the actuator, the
+clutch FMU (the instance fmpy loaded, called through its ``fmi2SetReal``/``fmi2DoStep``/``fmi2GetReal``),
+the engine and its idle governor, the driveline with its energy books, the slip energy into the thermal
+network's accumulator and the launch record's per-step metrics. The TCU, the sensors, the thermal network's
+step and the series' rows stay in Python. The C code keeps the Python expressions' order of operations (no
+fused multiply-adds, libm's ``pow``), so both paths give the same results to the last bit on this machine;
+``tests/test_launch_plant_block.py`` checks series, metrics, energy and events against the reference.
+
+The library is compiled once per source version with zig (``ziglang``; the FMU's compiler) or the system
+C compiler, and cached under ``$XDG_CACHE_HOME/cushion_clutch`` (default ``~/.cache``).
+"""
+from __future__ import annotations
+
+import hashlib
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+import cffi
+
+from ..data import fmu_sources
+from ..errors import FmuCallError
+
+SOURCE, HEADER = "launch_plant.c", "launch_plant.h"
+#: exact IEEE arithmetic as Python's: no contraction into FMAs, no builtin rewriting of pow
+CFLAGS = ("-std=c99", "-O2", "-shared", "-fPIC", "-fvisibility=hidden", "-Wall", "-ffp-contract=off",
+          "-fno-builtin")
+#: the most points of an engine torque curve the C step takes (lp_consts.curve_w)
+MAX_CURVE = 32
+FMI_FUNCTIONS = {-1: "fmi2SetReal", -2: "fmi2DoStep", -3: "fmi2GetReal"}
+
+
+def _cache_dir() -> Path:
+    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    return Path(base) / "cushion_clutch"
+
+
+def compile_command(src: Path, out: Path) -> list[str]:
+    """zig cc (``ziglang``) or the system C compiler, for this machine."""
+    import importlib.util
+    if importlib.util.find_spec("ziglang") is not None:
+        return [sys.executable, "-m", "ziglang", "cc", *CFLAGS, f"-I{src.parent}", str(src), "-o", str(out), "-lm"]
+    cc = shutil.which("gcc") or shutil.which("cc")
+    if cc is None:
+        raise RuntimeError("no C compiler for the native launch plant: pip install ziglang, or install gcc")
+    return [cc, *CFLAGS, f"-I{src.parent}", str(src), "-o", str(out), "-lm"]
+
+
+def library() -> Path:
+    """The compiled plant step (built on first use, cached by the sources' hash).
+
+    Raises
+    ------
+    RuntimeError
+        If no compiler is found or the build fails (with the compiler's message).
+    """
+    src = fmu_sources()
+    digest = hashlib.sha256((src / SOURCE).read_bytes() + (src / HEADER).read_bytes()
+                            + " ".join(CFLAGS).encode()).hexdigest()[:16]
+    suffix = ".dll" if sys.platform == "win32" else (".dylib" if sys.platform == "darwin" else ".so")
+    for folder in (_cache_dir(), Path(tempfile.gettempdir()) / "cushion_clutch"):
+        out = folder / f"launch_plant_{digest}{suffix}"
+        if out.exists():
+            return out
+        try:
+            folder.mkdir(parents=True, exist_ok=True)
+        except OSError:
+            continue
+        tmp = out.with_name(f"{out.stem}.{os.getpid()}{suffix}")
+        proc = subprocess.run(compile_command(src / SOURCE, tmp), capture_output=True, text=True)
+        if proc.returncode != 0 or not tmp.exists():
+            tmp.unlink(missing_ok=True)
+            raise RuntimeError(f"building the native launch plant failed:\n{proc.stderr}")
+        os.replace(tmp, out)                        # atomic: a parallel build leaves one whole library
+        return out
+    raise RuntimeError("no writable cache folder for the native launch plant")
+
+
+_FFI = None
+_LIB = None
+
+
+def _lib():
+    global _FFI, _LIB
+    if _LIB is None:
+        ffi = cffi.FFI()
+        ffi.cdef((fmu_sources() / HEADER).read_text())
+        _LIB, _FFI = ffi.dlopen(str(library())), ffi
+    return _FFI, _LIB
+
+
+class NativePlant:
+    """The compiled plant steps of one run, on the Python objects' state (copied in and out per block).
+
+    Parameters
+    ----------
+    clutch : ClutchFmu
+        The clutch FMU (its instance and held inputs are used).
+    engine : EngineGovernor
+    dl : Driveline
+    h, act, w_lift, prefill : float
+        Step (s), the actuator's decay per step, the driver's lift-off speed (rad/s), the pre-fill time (s).
+    tcu_every, net_every : int
+        Steps per TCU period and per thermal-network step.
+    alpha_jerk, creep_nm : float
+        The launch record's jerk-filter coefficient and creep threshold (N.m).
+    """
+
+    def __init__(self, clutch, engine, dl, h: float, act: float, w_lift: float, prefill: float, tcu_every: int,
+                 net_every: int, alpha_jerk: float, creep_nm: float):
+        if len(engine.w) > MAX_CURVE:
+            raise ValueError(f"engine torque curve: {len(engine.w)} points, the native plant takes {MAX_CURVE}")
+        ffi, lib = _lib()
+        self.ffi, self.run_block = ffi, lib.lp_run_block
+        self.clutch, self.engine, self.dl = clutch, engine, dl
+        c = self.c = ffi.new("lp_consts *")
+        fl = clutch._lib
+        c.comp = clutch._c
+        c.set_real = ffi.cast("lp_set_real", fl.fmi2SetReal)
+        c.do_step = ffi.cast("lp_do_step", fl.fmi2DoStep)
+        c.get_real = ffi.cast("lp_get_real", fl.fmi2GetReal)
+        for i in range(3):
+            c.vr_in[i], c.vr_out[i] = clutch._vr_in[i], clutch._vr_out[i]
+        c.n_curve = len(engine.w)
+        for i, (w, t) in enumerate(zip(engine.w, engine.t)):
+            c.curve_w[i], c.curve_t[i] = w, t
+        c.drag, c.kp, c.ki = engine.drag, engine.kp, engine.ki
+        c.w_idle, c.w_stall, c.w_max = engine.w_idle, engine.w_stall, engine.w_max
+        for name in ("i_tot", "r", "eta", "f_grade", "f_roll", "j_v", "j_e", "j_disc", "k", "c", "kappa", "air",
+                     "brake_torque"):
+            setattr(c, name, getattr(dl, name))
+        c.h, c.act, c.w_lift, c.prefill, c.alpha_jerk, c.creep_nm = h, act, w_lift, prefill, alpha_jerk, creep_nm
+        c.tcu_every, c.net_every = tcu_every, net_every
+        self.s = ffi.new("lp_state *")
+        self.b = ffi.new("lp_block *")
+        self.max_steps = tcu_every
+        self.out = ffi.new("lp_step_out[]", tcu_every)
+        self.status = ffi.new("int *")
+        self.b.n_steps = 0
+
+    def block(self, k0: int, n_steps: int, next_switch: float, slot_start: float, slot_end: float, countdown: int,
+              x_cmd: float, pedal_level: float, t_dem: float, t_rate: float, engaged: bool, braking: bool,
+              launching: bool, x_act: float, theta_cm: float, lifted: bool, stalled: bool, net_n: int,
+              net_e: float, rec) -> tuple:
+        """Run the steps from ``k0`` to the next TCU cycle (see ``lp_run_block``); the driveline, the engine,
+        the clutch's held inputs and ``rec``'s accumulators are updated.
+
+        Returns ``(steps, x_act, lifted, stalled, net_n, net_e, t_e, t_cap, theta_cs, x_kiss)``; the
+        steps' figures are in :attr:`out`.
+
+        Raises
+        ------
+        FmuCallError
+            Naming the FMI function that failed, as the Python path does.
+        """
+        s, b, dl, en, eng, held = self.s, self.b, self.dl, self.dl.en, self.engine, self.clutch.held
+        b.k0, b.n_steps, b.next_switch, b.slot_start, b.slot_end, b.countdown = (k0, n_steps, next_switch,
+                                                                                 slot_start, slot_end, countdown)
+        b.x_cmd, b.pedal_level, b.t_dem, b.t_rate = x_cmd, pedal_level, t_dem, t_rate
+        b.engaged, b.braking, b.launching = engaged, braking, launching
+        s.w_e, s.w_d, s.v, s.phi, s.locked = dl.w_e, dl.w_d, dl.v, dl.phi, dl.locked
+        s.engine_work, s.potential, s.slip, s.damping, s.resistance, s.brake = (
+            en.engine_work, en.potential, en.slip, en.damping, en.resistance, en.brake)
+        s.integral = eng.integral
+        s.x_act, s.theta_cm = x_act, theta_cm
+        s.held[0], s.held[1], s.held[2] = held
+        s.lifted, s.stalled, s.net_n, s.net_e = lifted, stalled, net_n, net_e
+        s.has_lock, s.rec_stall = rec.lock_time is not None, rec.stall
+        s.rec_slip_J, s.a_filt, s.jerk = rec.slip_J, rec.a_filt, rec.jerk
+        s.n_err, s.sq_err, s.max_err, s.n_creep, s.sum_creep = (rec.n_err, rec.sq_err, rec.max_err, rec.n_creep,
+                                                                rec.sum_creep)
+        n = self.run_block(self.c, s, b, self.out, self.max_steps, self.status)
+        held[0], held[1], held[2] = s.held
+        if n < 0:
+            t = k0 * self.c.h
+            raise FmuCallError(FMI_FUNCTIONS[n], self.status[0], f"t={t!r} (native launch plant)")
+        dl.w_e, dl.w_d, dl.v, dl.phi, dl.locked = s.w_e, s.w_d, s.v, s.phi, bool(s.locked)
+        dl.t_c, dl.slip_J, dl.slip_W = s.t_c, s.slip_J, s.slip_W
+        en.engine_work, en.potential, en.slip, en.damping, en.resistance, en.brake = (
+            s.engine_work, s.potential, s.slip, s.damping, s.resistance, s.brake)
+        eng.integral, eng.throttle = s.integral, s.throttle
+        if s.has_lock and rec.lock_time is None:
+            rec.lock_time = s.lock_time
+        rec.stall = bool(s.rec_stall)
+        rec.slip_J, rec.a_filt, rec.jerk = s.rec_slip_J, s.a_filt, s.jerk
+        rec.n_err, rec.sq_err, rec.max_err, rec.n_creep, rec.sum_creep = (s.n_err, s.sq_err, s.max_err, s.n_creep,
+                                                                          s.sum_creep)
+        return (n, s.x_act, bool(s.lifted), bool(s.stalled), s.net_n, s.net_e, s.t_e, s.t_cap, s.theta_cs,
+                s.x_kiss)

@@ -1,0 +1,266 @@
+/* The launch simulation's plant steps between two TCU cycles, compiled: the same step as the Python loop of
+ * cushion_clutch/launch/simulate.py (the reference; tests/test_launch_plant_block.py checks that both give the
+ * same series and metrics), written out for speed. Every expression keeps the Python one's order of
+ * operations (built with -ffp-contract=off -fno-builtin: no fused multiply-adds, pow stays pow), so the two
+ * agree to the last bit where the FMU and libm are the same.
+ *
+ * Per step: first-order actuator, the clutch FMU (inputs held over the step; fmi2SetReal only when they
+ * change), the engine with its idle governor (engine.EngineGovernor.torque), the compliant driveline with
+ * slip/lock and its energy books (driveline.Driveline.step), the slip energy into the thermal network's
+ * accumulator, and the launch record's per-step metrics (metrics.LaunchRecord.step). */
+#include <math.h>
+#include <stddef.h>
+#include "launch_plant.h"
+
+#if defined(_WIN32)
+#define LP_EXPORT __declspec(dllexport)
+#else
+#define LP_EXPORT __attribute__((visibility("default")))
+#endif
+
+/* engine.EngineGovernor.torque */
+static double engine_torque(const lp_consts *c, lp_state *s, double w_e, double pedal, int stalled)
+{
+    const double *w = c->curve_w, *t = c->curve_t;
+    int n = c->n_curve;
+    double t_max;
+    if (w_e <= w[0]) {
+        t_max = t[0];
+    } else if (w_e >= w[n - 1]) {
+        t_max = t[n - 1];
+    } else {
+        int i = 0;                                  /* bisect_right(w, w_e) - 1 */
+        while (i + 1 < n && w[i + 1] <= w_e)
+            i++;
+        t_max = t[i] + (t[i + 1] - t[i]) * (w_e - w[i]) / (w[i + 1] - w[i]);
+    }
+    double err = c->w_idle - w_e;
+    double gov = (c->kp * err + c->ki * s->integral + c->drag * w_e) / t_max;
+    gov = gov > 1.0 ? 1.0 : (gov < 0.0 ? 0.0 : gov);
+    if (pedal < gov && (gov < 1.0 || err < 0.0) && (gov > 0.0 || err > 0.0))
+        s->integral += err * c->h;
+    double thr = pedal > gov ? pedal : gov;
+    if (w_e > c->w_max || w_e <= c->w_stall || stalled)
+        thr = 0.0;
+    s->throttle = thr;
+    return thr * t_max - c->drag * w_e;
+}
+
+/* driveline.Driveline._shaft */
+static double shaft(const lp_consts *c, const lp_state *s, double j1, double t1, double w_v, double t_veh,
+                    int held)
+{
+    double h = c->h, kappa = c->kappa;
+    if (held)
+        return (c->k * s->phi + kappa * (s->w_d - 0.5 * w_v + 0.5 * h * t1 / j1)) / (1.0 + 0.5 * kappa * h / j1);
+    return (c->k * s->phi + kappa * (s->w_d - w_v + 0.5 * h * (t1 / j1 + t_veh / c->j_v))) /
+           (1.0 + 0.5 * kappa * h * (1.0 / j1 + c->eta / c->j_v));
+}
+
+/* driveline.Driveline.step */
+static int driveline_step(const lp_consts *c, lp_state *s, double t_e, double t_cap, int engaged, int braking)
+{
+    double h = c->h;
+    double w_e = s->w_e, w_d = s->w_d, v = s->v;
+    if (v == 0.0 && t_cap == 0.0 && w_d == 0.0 && s->phi == 0.0 && !s->locked) {
+        double w_e_new = w_e + t_e / c->j_e * h;
+        if (w_e_new < 0.0)
+            w_e_new = 0.0;
+        s->engine_work += t_e * 0.5 * (w_e + w_e_new) * h;
+        s->w_e = w_e_new;
+        s->t_c = s->slip_J = s->slip_W = 0.0;
+        return 0;
+    }
+    double i_tot = c->i_tot, r = c->r, eta = c->eta, j_e = c->j_e, j_v = c->j_v;
+    double w_v = v * i_tot / r;
+    double f_res = (v > 0.0 ? c->f_roll : 0.0) + c->air * v * v + c->f_grade;
+    double t_res = f_res * r / i_tot;
+    int locked = s->locked, event = 0;
+    double j_lock = j_e + c->j_disc;
+    double t_brake = braking && v > 0.0 ? c->brake_torque : 0.0;
+    double t_s, t_c = 0.0, j1, t1;
+    if (locked) {
+        t_s = shaft(c, s, j_lock, t_e, w_v, t_res + t_brake, 0);
+        t_c = (c->j_disc * t_e + j_e * t_s) / j_lock;
+        if (fabs(t_c) > t_cap) {
+            locked = 0;
+            event = -1;
+        }
+    }
+    if (!locked) {
+        t_c = w_e != w_d ? copysign(t_cap, w_e - w_d) : 0.0;
+        j1 = c->j_disc;
+        t1 = t_c;
+    } else {
+        j1 = j_lock;
+        t1 = t_e;
+    }
+    t_s = shaft(c, s, j1, t1, w_v, t_res + t_brake, 0);
+    double w_v_new = w_v + h / j_v * (eta * t_s - t_res - t_brake);
+    if (w_v_new < 0.0) {
+        t_s = shaft(c, s, j1, t1, w_v, 0.0, 1);
+        w_v_new = 0.0;
+        t_brake = eta * t_s - t_res + j_v * w_v / h;
+    }
+    double w_d_new = w_d + h / j1 * (t1 - t_s);
+    double w_e_new;
+    if (locked) {
+        w_e_new = w_d_new;
+    } else {
+        w_e_new = w_e + (t_e - t_c) / j_e * h;
+        if (w_e_new < 0.0)
+            w_e_new = 0.0;
+    }
+    double d_m = 0.5 * (w_d + w_d_new) - 0.5 * (w_v + w_v_new);
+    s->phi += h * d_m;
+    double wm_e = 0.5 * (w_e + w_e_new), wm_d = 0.5 * (w_d + w_d_new), wm_v = 0.5 * (w_v + w_v_new);
+    s->engine_work += t_e * wm_e * h;
+    double slip_w = !locked ? t_c * (wm_e - wm_d) : 0.0;
+    double slip = slip_w * h;
+    s->damping += c->c * d_m * d_m * h;
+    s->resistance += ((f_res - c->f_grade) * r / i_tot + (1.0 - eta) * t_s) * wm_v * h;
+    s->potential += c->f_grade * r / i_tot * wm_v * h;
+    s->brake += t_brake * wm_v * h;
+    if (!locked && t_cap > 0.0 && engaged && (w_e - w_d) * (w_e_new - w_d_new) <= 0.0) {
+        double t_s_new = c->k * s->phi + c->c * (w_d_new - w_v_new);
+        if (fabs((c->j_disc * t_e + j_e * t_s_new) / j_lock) <= t_cap) {
+            double ke_before = 0.5 * (j_e * pow(w_e_new, 2.0) + c->j_disc * pow(w_d_new, 2.0));
+            w_e_new = w_d_new = (j_e * w_e_new + c->j_disc * w_d_new) / j_lock;
+            slip += ke_before - 0.5 * j_lock * pow(w_e_new, 2.0);
+            locked = 1;
+            event = 1;
+        }
+    }
+    s->slip += slip;
+    s->w_e = w_e_new;
+    s->w_d = w_d_new;
+    s->v = w_v_new * r / i_tot;
+    s->locked = locked;
+    s->t_c = t_c;
+    s->slip_J = slip;
+    s->slip_W = fabs(slip_w);
+    if (!locked && t_cap == 0.0 && w_v_new == 0.0 && fabs(w_d_new) < 1e-6 && fabs(s->phi) < 1e-9) {
+        s->damping += 0.5 * c->j_disc * pow(w_d_new, 2.0) + 0.5 * c->k * pow(s->phi, 2.0);
+        s->w_d = s->phi = 0.0;
+    }
+    return event;
+}
+
+/* metrics.LaunchRecord.step (the acceleration itself is kept by the caller, out->accel) */
+static void record_step(const lp_consts *c, lp_state *s, double accel, double t_dem, double t_cap, int launching)
+{
+    double a_prev = s->a_filt;
+    s->a_filt += c->alpha_jerk * (accel - a_prev);
+    double jerk = fabs(s->a_filt - a_prev) / c->h;
+    if (jerk > s->jerk)
+        s->jerk = jerk;
+    if (launching && !s->has_lock && t_dem > 0.0) {
+        double e = t_cap - t_dem;
+        s->n_err += 1;
+        s->sq_err += e * e;
+        if (fabs(e) > s->max_err)
+            s->max_err = fabs(e);
+        if (t_dem <= c->creep_nm) {
+            s->n_creep += 1;
+            s->sum_creep += e;
+        }
+    }
+}
+
+LP_EXPORT int lp_run_block(const lp_consts *c, lp_state *s, const lp_block *blk, lp_step_out *out,
+                           int max_steps, int *fmi_status)
+{
+    double h = c->h;
+    int countdown = blk->countdown;
+    int engaged = blk->engaged, braking = blk->braking, launching = blk->launching;
+    int j = 0;
+    for (long k = blk->k0; k < blk->n_steps && j < max_steps; k++, j++) {
+        double t = (double)k * h;
+        if (j > 0 && (countdown == 0 || t >= blk->next_switch))
+            break;                                   /* the next TCU cycle or launch slot: the caller's */
+        lp_step_out *o = out + j;
+        double tl = t - blk->slot_start;
+        countdown -= 1;
+        double x_cmd = blk->x_cmd;
+        s->x_act = x_cmd + (s->x_act - x_cmd) * c->act;
+        double w_e = s->w_e;
+        /* the clutch FMU, inputs held over the step */
+        double omega_slip = w_e - s->w_d;
+        if (omega_slip != s->held[2] || s->x_act != s->held[0] || s->theta_cm != s->held[1]) {
+            double v_in[3] = {s->x_act, s->theta_cm, omega_slip};
+            s->held[0] = s->x_act;
+            s->held[1] = s->theta_cm;
+            s->held[2] = omega_slip;
+            int st = c->set_real(c->comp, c->vr_in, 3, v_in);
+            if (st > 1) {
+                s->held[0] = NAN;
+                *fmi_status = st;
+                return -1;
+            }
+        }
+        int st = c->do_step(c->comp, t, h, 1);
+        if (st > 1) {
+            *fmi_status = st;
+            return -2;
+        }
+        double v_out[3];
+        st = c->get_real(c->comp, c->vr_out, 3, v_out);
+        if (st > 1) {
+            *fmi_status = st;
+            return -3;
+        }
+        double t_cap = s->t_cap = v_out[0];
+        s->theta_cs = v_out[1];
+        s->x_kiss = v_out[2];
+        if (engaged && !s->lifted && s->has_lock && w_e > c->w_lift)
+            s->lifted = 1;
+        double t_e = s->t_e = engine_torque(c, s, w_e, engaged && !s->lifted ? blk->pedal_level : 0.0, s->stalled);
+        double v = s->v;
+        int ev = driveline_step(c, s, t_e, t_cap, engaged, braking);
+        o->event = ev;
+        if (ev > 0 && !s->has_lock) {
+            s->has_lock = 1;
+            s->lock_time = tl + h - c->prefill;
+        }
+        double theta_cm_step = s->theta_cm;
+        s->rec_slip_J += s->slip_J;
+        s->net_e += s->slip_J;
+        s->net_n += 1;
+        o->net_due = s->net_n == c->net_every;
+        o->net_w_e = s->w_e;
+        o->net_w_d = s->w_d;
+        double accel = (s->v - v) / h;
+        double t_dem = blk->t_dem + blk->t_rate * (double)(c->tcu_every - countdown) * h;
+        if (engaged) {
+            record_step(c, s, accel, t_dem, t_cap, launching);
+            if (s->w_e <= c->w_stall)
+                s->rec_stall = s->stalled = 1;
+        } else if (s->locked) {
+            s->locked = 0;
+            o->event = -2;
+        }
+        if (s->stalled && tl + h >= blk->slot_end - blk->slot_start - h) {    /* driveline.restart_engine */
+            s->engine_work += 0.5 * c->j_e * (pow(c->w_idle, 2.0) - pow(s->w_e, 2.0));
+            s->w_e = c->w_idle;
+        }
+        o->t_cap = t_cap;
+        o->theta_cs = s->theta_cs;
+        o->x_kiss = s->x_kiss;
+        o->x_act = s->x_act;
+        o->w_e = s->w_e;
+        o->w_d = s->w_d;
+        o->v = s->v;
+        o->accel = accel;
+        o->t_c = s->t_c;
+        o->theta_cm_step = theta_cm_step;
+        o->throttle = s->throttle;
+        o->locked = s->locked ? 1.0 : 0.0;
+        o->t_shaft = c->k * s->phi + c->c * (s->w_d - s->v * c->i_tot / c->r);
+        o->t_dem = t_dem;
+        if (o->net_due) {
+            j++;
+            break;                                   /* the network steps (the caller's), theta_cm changes */
+        }
+    }
+    return j;
+}

@@ -75,7 +75,7 @@ static int driveline_step(const lp_consts *c, lp_state *s, double t_e, double t_
     double w_v = v * i_tot / r;
     double f_res = (v > 0.0 ? c->f_roll : 0.0) + c->air * v * v + c->f_grade;
     double t_res = f_res * r / i_tot;
-    int locked = s->locked, event = 0;
+    int locked = s->locked != 0.0, event = 0;
     double j_lock = j_e + c->j_disc;
     double t_brake = braking && v > 0.0 ? c->brake_torque : 0.0;
     double t_s, t_c = 0.0, j1, t1;
@@ -171,10 +171,11 @@ LP_EXPORT int lp_run_block(const lp_consts *c, lp_state *s, const lp_block *blk,
                            int max_steps, int *fmi_status)
 {
     double h = c->h;
-    int countdown = blk->countdown;
-    int engaged = blk->engaged, braking = blk->braking, launching = blk->launching;
+    int countdown = (int)blk->countdown;
+    int engaged = blk->engaged != 0.0, braking = blk->braking != 0.0, launching = blk->launching != 0.0;
     int j = 0;
-    for (long k = blk->k0; k < blk->n_steps && j < max_steps; k++, j++) {
+    long n_steps = (long)blk->n_steps;
+    for (long k = (long)blk->k0; k < n_steps && j < max_steps; k++, j++) {
         double t = (double)k * h;
         if (j > 0 && (countdown == 0 || t >= blk->next_switch))
             break;                                   /* the next TCU cycle or launch slot: the caller's */
@@ -186,14 +187,14 @@ LP_EXPORT int lp_run_block(const lp_consts *c, lp_state *s, const lp_block *blk,
         double w_e = s->w_e;
         /* the clutch FMU, inputs held over the step */
         double omega_slip = w_e - s->w_d;
-        if (omega_slip != s->held[2] || s->x_act != s->held[0] || s->theta_cm != s->held[1]) {
+        if (omega_slip != s->held2 || s->x_act != s->held0 || s->theta_cm != s->held1) {
             double v_in[3] = {s->x_act, s->theta_cm, omega_slip};
-            s->held[0] = s->x_act;
-            s->held[1] = s->theta_cm;
-            s->held[2] = omega_slip;
+            s->held0 = s->x_act;
+            s->held1 = s->theta_cm;
+            s->held2 = omega_slip;
             int st = c->set_real(c->comp, c->vr_in, 3, v_in);
             if (st > 1) {
-                s->held[0] = NAN;
+                s->held0 = NAN;
                 *fmi_status = st;
                 return -1;
             }
@@ -214,7 +215,8 @@ LP_EXPORT int lp_run_block(const lp_consts *c, lp_state *s, const lp_block *blk,
         s->x_kiss = v_out[2];
         if (engaged && !s->lifted && s->has_lock && w_e > c->w_lift)
             s->lifted = 1;
-        double t_e = s->t_e = engine_torque(c, s, w_e, engaged && !s->lifted ? blk->pedal_level : 0.0, s->stalled);
+        double t_e = s->t_e = engine_torque(c, s, w_e, engaged && !s->lifted ? blk->pedal_level : 0.0,
+                                            s->stalled != 0.0);
         double v = s->v;
         int ev = driveline_step(c, s, t_e, t_cap, engaged, braking);
         o->event = ev;
@@ -226,7 +228,7 @@ LP_EXPORT int lp_run_block(const lp_consts *c, lp_state *s, const lp_block *blk,
         s->rec_slip_J += s->slip_J;
         s->net_e += s->slip_J;
         s->net_n += 1;
-        o->net_due = s->net_n == c->net_every;
+        o->net_due = s->net_n == (double)c->net_every;
         o->net_w_e = s->w_e;
         o->net_w_d = s->w_d;
         double accel = (s->v - v) / h;
@@ -254,10 +256,10 @@ LP_EXPORT int lp_run_block(const lp_consts *c, lp_state *s, const lp_block *blk,
         o->t_c = s->t_c;
         o->theta_cm_step = theta_cm_step;
         o->throttle = s->throttle;
-        o->locked = s->locked ? 1.0 : 0.0;
+        o->locked = s->locked;
         o->t_shaft = c->k * s->phi + c->c * (s->w_d - s->v * c->i_tot / c->r);
         o->t_dem = t_dem;
-        if (o->net_due) {
+        if (o->net_due != 0.0) {
             j++;
             break;                                   /* the network steps (the caller's), theta_cm changes */
         }

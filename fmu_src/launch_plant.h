@@ -27,42 +27,37 @@ typedef struct {
     int tcu_every, net_every;
 } lp_consts;
 
-/* the state carried across steps (copied in and out around a block) */
+/* The state carried across steps (copied in and out around a block), the block's inputs and a step's figures:
+ * doubles only (flags 0/1, counts exact), so that each is also a double[] the caller fills and reads at once. */
 typedef struct {
     /* driveline */
-    double w_e, w_d, v, phi;
-    int locked;
+    double w_e, w_d, v, phi, locked;
     double engine_work, potential, slip, damping, resistance, brake;
     double t_c, slip_J, slip_W;
     /* engine */
     double integral, throttle, t_e;
     /* loop */
     double x_act, theta_cm, t_cap, theta_cs, x_kiss;
-    double held[3];                 /* the FMU inputs last set */
-    int lifted, stalled;
-    int net_n;
-    double net_e;
+    double held0, held1, held2;     /* the FMU inputs last set: x_to, theta_cm, omega_slip */
+    double lifted, stalled, net_n, net_e;
     /* the launch record */
-    int has_lock, rec_stall;
-    double lock_time, rec_slip_J, a_filt, jerk, sq_err, max_err, sum_creep;
-    long n_err, n_creep;
+    double has_lock, rec_stall, lock_time, rec_slip_J, a_filt, jerk, sq_err, max_err, sum_creep, n_err, n_creep;
 } lp_state;
 
 /* held over a block: set by the TCU cycle before it */
 typedef struct {
-    long k0, n_steps;               /* the first step's index, the run's steps */
+    double k0, n_steps;             /* the first step's index, the run's steps */
     double next_switch, slot_start, slot_end;
-    int countdown;                  /* steps to the next TCU cycle, as the loop counts (0: the block's first step is one) */
+    double countdown;               /* steps to the next TCU cycle, as the loop counts (0: the block's first step is one) */
     double x_cmd, pedal_level, t_dem, t_rate;
-    int engaged, braking, launching;
+    double engaged, braking, launching;
 } lp_block;
 
 /* one step's figures (the series' row, the metrics' inputs) */
 typedef struct {
-    double t_cap, theta_cs, x_kiss, x_act, w_e, w_d, v, accel, t_c, theta_cm_step, throttle, t_shaft, t_dem;
-    double locked;
-    int event;                      /* 1 locked (at t + h), -1 unlocked in the step (at t), -2 unlocked as the TCU let go (at t + h) */
-    int net_due;                    /* the thermal network steps after this step, with net_w_e, net_w_d */
+    double w_e, w_d, v, accel, x_act, t_dem, t_cap, t_c, theta_cm_step, theta_cs, x_kiss, throttle, locked, t_shaft;
+    double event;                   /* 1 locked (at t + h), -1 unlocked in the step (at t), -2 unlocked as the TCU let go (at t + h) */
+    double net_due;                 /* the thermal network steps after this step, with net_w_e, net_w_d */
     double net_w_e, net_w_d;
 } lp_step_out;
 

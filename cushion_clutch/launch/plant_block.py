@@ -34,6 +34,9 @@ CFLAGS = ("-std=c99", "-O2", "-shared", "-fPIC", "-fvisibility=hidden", "-Wall",
 #: the most points of an engine torque curve the C step takes (lp_consts.curve_w)
 MAX_CURVE = 32
 FMI_FUNCTIONS = {-1: "fmi2SetReal", -2: "fmi2DoStep", -3: "fmi2GetReal"}
+#: the first fields of ``lp_step_out``: a step's figures in the series' rows
+ROW_FIELDS = ("w_e", "w_d", "v", "accel", "x_act", "t_dem", "t_cap", "t_c", "theta_cm_step", "theta_cs", "x_kiss",
+              "throttle", "locked", "t_shaft")
 
 
 def _cache_dir() -> Path:
@@ -142,7 +145,17 @@ class NativePlant:
         self.max_steps = tcu_every
         self.out = ffi.new("lp_step_out[]", tcu_every)
         self.status = ffi.new("int *")
-        self.b.n_steps = 0
+        # the same memory as double[] (the structs are doubles only): filled and read with one call each
+        self._s = ffi.cast("double *", self.s)
+        self._b = ffi.cast("double *", self.b)
+        self._o = ffi.cast("double *", self.out)
+        self._ns = ffi.sizeof("lp_state") // 8
+        self._nb = ffi.sizeof("lp_block") // 8
+        self.width = ffi.sizeof("lp_step_out") // 8
+        #: index of each ``lp_step_out`` field in a step's values
+        self.ix = {name: i for i, (name, _) in enumerate(ffi.typeof("lp_step_out").fields)}
+        if tuple(self.ix)[:len(ROW_FIELDS)] != ROW_FIELDS:
+            raise RuntimeError(f"{HEADER}: lp_step_out must start with {', '.join(ROW_FIELDS)}")
 
     def block(self, k0: int, n_steps: int, next_switch: float, slot_start: float, slot_end: float, countdown: int,
               x_cmd: float, pedal_level: float, t_dem: float, t_rate: float, engaged: bool, braking: bool,
@@ -151,45 +164,35 @@ class NativePlant:
         """Run the steps from ``k0`` to the next TCU cycle (see ``lp_run_block``); the driveline, the engine,
         the clutch's held inputs and ``rec``'s accumulators are updated.
 
-        Returns ``(steps, x_act, lifted, stalled, net_n, net_e, t_e, t_cap, theta_cs, x_kiss)``; the
-        steps' figures are in :attr:`out`.
+        Returns ``(steps, x_act, lifted, stalled, net_n, net_e, t_e, t_cap, theta_cs, x_kiss, out)`` with
+        ``out`` the steps' figures, ``lp_step_out`` after ``lp_step_out`` (:attr:`width` values each, in
+        the struct's order) in one flat list.
 
         Raises
         ------
         FmuCallError
             Naming the FMI function that failed, as the Python path does.
         """
-        s, b, dl, en, eng, held = self.s, self.b, self.dl, self.dl.en, self.engine, self.clutch.held
-        b.k0, b.n_steps, b.next_switch, b.slot_start, b.slot_end, b.countdown = (k0, n_steps, next_switch,
-                                                                                 slot_start, slot_end, countdown)
-        b.x_cmd, b.pedal_level, b.t_dem, b.t_rate = x_cmd, pedal_level, t_dem, t_rate
-        b.engaged, b.braking, b.launching = engaged, braking, launching
-        s.w_e, s.w_d, s.v, s.phi, s.locked = dl.w_e, dl.w_d, dl.v, dl.phi, dl.locked
-        s.engine_work, s.potential, s.slip, s.damping, s.resistance, s.brake = (
-            en.engine_work, en.potential, en.slip, en.damping, en.resistance, en.brake)
-        s.integral = eng.integral
-        s.x_act, s.theta_cm = x_act, theta_cm
-        s.held[0], s.held[1], s.held[2] = held
-        s.lifted, s.stalled, s.net_n, s.net_e = lifted, stalled, net_n, net_e
-        s.has_lock, s.rec_stall = rec.lock_time is not None, rec.stall
-        s.rec_slip_J, s.a_filt, s.jerk = rec.slip_J, rec.a_filt, rec.jerk
-        s.n_err, s.sq_err, s.max_err, s.n_creep, s.sum_creep = (rec.n_err, rec.sq_err, rec.max_err, rec.n_creep,
-                                                                rec.sum_creep)
-        n = self.run_block(self.c, s, b, self.out, self.max_steps, self.status)
-        held[0], held[1], held[2] = s.held
+        dl, en, eng, held = self.dl, self.dl.en, self.engine, self.clutch.held
+        self._b[0:self._nb] = (k0, n_steps, next_switch, slot_start, slot_end, countdown, x_cmd, pedal_level, t_dem,
+                               t_rate, engaged, braking, launching)
+        self._s[0:self._ns] = (
+            dl.w_e, dl.w_d, dl.v, dl.phi, dl.locked, en.engine_work, en.potential, en.slip, en.damping,
+            en.resistance, en.brake, 0.0, 0.0, 0.0, eng.integral, 0.0, 0.0, x_act, theta_cm, 0.0, 0.0, 0.0,
+            held[0], held[1], held[2], lifted, stalled, net_n, net_e, rec.lock_time is not None, rec.stall, 0.0,
+            rec.slip_J, rec.a_filt, rec.jerk, rec.sq_err, rec.max_err, rec.sum_creep, rec.n_err, rec.n_creep)
+        n = self.run_block(self.c, self.s, self.b, self.out, self.max_steps, self.status)
+        (dl.w_e, dl.w_d, dl.v, dl.phi, locked, en.engine_work, en.potential, en.slip, en.damping, en.resistance,
+         en.brake, dl.t_c, dl.slip_J, dl.slip_W, eng.integral, eng.throttle, t_e, x_act, _, t_cap, theta_cs, x_kiss,
+         held[0], held[1], held[2], lifted, stalled, net_n, net_e, has_lock, rec_stall, lock_time, rec.slip_J,
+         rec.a_filt, rec.jerk, rec.sq_err, rec.max_err, rec.sum_creep, n_err, n_creep) = self.ffi.unpack(self._s,
+                                                                                                     self._ns)
         if n < 0:
-            t = k0 * self.c.h
-            raise FmuCallError(FMI_FUNCTIONS[n], self.status[0], f"t={t!r} (native launch plant)")
-        dl.w_e, dl.w_d, dl.v, dl.phi, dl.locked = s.w_e, s.w_d, s.v, s.phi, bool(s.locked)
-        dl.t_c, dl.slip_J, dl.slip_W = s.t_c, s.slip_J, s.slip_W
-        en.engine_work, en.potential, en.slip, en.damping, en.resistance, en.brake = (
-            s.engine_work, s.potential, s.slip, s.damping, s.resistance, s.brake)
-        eng.integral, eng.throttle = s.integral, s.throttle
-        if s.has_lock and rec.lock_time is None:
-            rec.lock_time = s.lock_time
-        rec.stall = bool(s.rec_stall)
-        rec.slip_J, rec.a_filt, rec.jerk = s.rec_slip_J, s.a_filt, s.jerk
-        rec.n_err, rec.sq_err, rec.max_err, rec.n_creep, rec.sum_creep = (s.n_err, s.sq_err, s.max_err, s.n_creep,
-                                                                          s.sum_creep)
-        return (n, s.x_act, bool(s.lifted), bool(s.stalled), s.net_n, s.net_e, s.t_e, s.t_cap, s.theta_cs,
-                s.x_kiss)
+            raise FmuCallError(FMI_FUNCTIONS[n], self.status[0], f"t={k0 * self.c.h!r} (native launch plant)")
+        dl.locked = locked != 0.0
+        if has_lock and rec.lock_time is None:
+            rec.lock_time = lock_time
+        rec.stall = rec_stall != 0.0
+        rec.n_err, rec.n_creep = int(n_err), int(n_creep)
+        return (n, x_act, lifted != 0.0, stalled != 0.0, int(net_n), net_e, t_e, t_cap, theta_cs, x_kiss,
+                self.ffi.unpack(self._o, n * self.width))

@@ -189,6 +189,11 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
     native = None
     if plant == "native" and net is not None:
         native = _native_plant(clutch, engine, dl, h, act, w_lift, prefill, tcu_every, net_every, recs[0].alpha)
+    if native is not None:               # where a step's figures are in the native block's flat list
+        from .plant_block import ROW_FIELDS
+        width, n_row, ix = native.width, len(ROW_FIELDS), native.ix
+        o_kiss, o_theta_cs, o_t_cap, o_accel = ix["x_kiss"], ix["theta_cs"], ix["t_cap"], ix["accel"]
+        o_event, o_net_due, o_net_w_e, o_net_w_d = ix["event"], ix["net_due"], ix["net_w_e"], ix["net_w_d"]
     wall0, cpu0 = time.perf_counter(), time.process_time()
     try:
         k = 0
@@ -266,29 +271,27 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
                 if cycled and sampling:                  # at the actual bearing position of the first step
                     x_cmd = ctl.x_cmd
                     believed = ctl.model_torque(x_cmd + (x_act - x_cmd) * act)
-                (m, x_act, lifted, stalled, net_n, net_e, t_e, t_cap, theta_cs, x_kiss) = native.block(
+                (m, x_act, lifted, stalled, net_n, net_e, t_e, t_cap, theta_cs, x_kiss, out) = native.block(
                     k, n_steps, next_switch, slot_start, slot_end, countdown, ctl.x_cmd,
                     pedal_level, ctl.t_dem, ctl.t_rate, engaged, braking, launching, x_act, theta_cm, lifted,
                     stalled, net_n, net_e, rec)
-                out = native.out
-                o0 = out[0]
                 if engaged and not rec.started:
-                    rec.start(ctl.kiss_now - o0.x_kiss, o0.theta_cs, ctl.theta_now - o0.theta_cs)
+                    rec.start(ctl.kiss_now - out[o_kiss], out[o_theta_cs], ctl.theta_now - out[o_theta_cs])
                 if cycled and sampling:
-                    rec.characteristic(believed, o0.t_cap)
+                    rec.characteristic(believed, out[o_t_cap])
                 if engaged:
                     if not rec.acc:
                         rec.t_first = tl + h - prefill
-                    rec.acc.extend([out[j].accel for j in range(m)])
+                    rec.acc.extend(out[o_accel:m * width:width])
                 theta_estimate = protection_level = None
                 for j in range(m):
-                    o = out[j]
-                    if o.event:
-                        ev = o.event
-                        events.append((n + 1, "lock" if ev > 0 else "unlock", (k + j) * h + h if ev != -1
+                    b = j * width
+                    if out[b + o_event] != 0.0:
+                        ev = out[b + o_event]
+                        events.append((n + 1, "lock" if ev > 0 else "unlock", (k + j) * h + h if ev != -1.0
                                        else (k + j) * h))
-                    if o.net_due:
-                        net.step(net_n * h, net_e / (net_n * h), o.net_w_e, o.net_w_d, engaged)
+                    if out[b + o_net_due] != 0.0:
+                        net.step(net_n * h, net_e / (net_n * h), out[b + o_net_w_e], out[b + o_net_w_d], engaged)
                         theta_cm, net_n, net_e = net.theta_cm, 0, 0.0
                     if rec_countdown == 0:
                         rec_countdown = record_every
@@ -296,10 +299,12 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
                             theta_estimate = ctl.theta_cm_estimate()
                             protection_level = ctl.protection.level if ctl.protection is not None else 0.0
                         t = (k + j) * h
-                        rows.append((t, n + 1, o.w_e, o.w_d, o.v, o.accel, ctl.x_cmd, o.x_act, o.t_dem, o.t_cap,
-                                     o.t_c, o.theta_cm_step, o.theta_cs, ctl.theta_now, o.x_kiss, ctl.kiss_now,
-                                     o.throttle, o.locked, theta_estimate, believed if sampling else math.nan,
-                                     o.t_shaft, *net_temps(), protection_level))
+                        (w_e_o, w_d_o, v_o, accel_o, x_act_o, t_dem_o, t_cap_o, t_c_o, theta_cm_o, theta_cs_o,
+                         x_kiss_o, throttle_o, locked_o, t_shaft_o) = out[b:b + n_row]
+                        rows.append((t, n + 1, w_e_o, w_d_o, v_o, accel_o, ctl.x_cmd, x_act_o, t_dem_o, t_cap_o,
+                                     t_c_o, theta_cm_o, theta_cs_o, ctl.theta_now, x_kiss_o, ctl.kiss_now,
+                                     throttle_o, locked_o, theta_estimate, believed if sampling else math.nan,
+                                     t_shaft_o, *net_temps(), protection_level))
                         if progress is not None and (k + j) % 10000 == 0:
                             progress(t)
                     rec_countdown -= 1

@@ -90,3 +90,30 @@ def test_lumped_facing_runs_the_python_loop(fmu):
 def test_unknown_plant_named(fmu):
     with pytest.raises(ValueError, match="plant = 'c'.*native, python"):
         simulate_launches(fmu, _scenario("creep", 1, 14.0), load_table(), "naive", plant="c")
+
+
+def test_fmu_refusal_raises_naming_the_function(fmu):
+    """An input the FMU refuses (a NaN bearing position): FmuCallError naming fmi2DoStep, as the Python path."""
+    from cushion_clutch.errors import FmuCallError
+    from cushion_clutch.launch.driveline import Driveline
+    from cushion_clutch.launch.engine import EngineGovernor
+    from cushion_clutch.launch.fmu_client import ClutchFmu
+    from cushion_clutch.launch.metrics import LaunchRecord
+    from cushion_clutch.launch.plant_block import NativePlant
+
+    sc = _scenario("creep", 1)
+    h = sc.run.step_s
+    engine = EngineGovernor(sc.engine, h)
+    dl = Driveline(sc, engine.w_idle)
+    clutch = ClutchFmu(fmu, {})
+    try:
+        native = NativePlant(clutch, engine, dl, h, 0.9, 300.0, 0.3, 10, 10, 0.05, 30.0)
+        rec = LaunchRecord(1, False, h)
+        args = dict(k0=0, n_steps=100, next_switch=1.0, slot_start=0.0, slot_end=1.0, countdown=10, x_cmd=1e-3,
+                    pedal_level=0.5, t_dem=0.0, t_rate=0.0, engaged=True, braking=False, launching=True, x_act=0.0,
+                    theta_cm=400.0, lifted=False, stalled=False, net_n=0, net_e=0.0, rec=rec)
+        assert native.block(**args)[0] == 10                 # ten steps to the next TCU cycle
+        with pytest.raises(FmuCallError, match="fmi2DoStep"):
+            native.block(**{**args, "k0": 10, "x_cmd": math.nan})
+    finally:
+        clutch.close()

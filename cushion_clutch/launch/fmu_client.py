@@ -7,7 +7,8 @@ cffi (ABI mode, on the library fmpy loaded) with preallocated value-reference
 and value arrays, which avoids fmpy's per-call list conversion and logging
 wrapper; cffi's calls cost about 60 % of ctypes' (measured). Every status other
 than fmi2OK/fmi2Warning raises :class:`~cushion_clutch.errors.FmuCallError`
-naming the FMI function.
+naming the FMI function. ``held`` (the inputs last set) is shared with the compiled plant steps
+(:mod:`.plant_block`), which call the same functions of the same instance.
 """
 from __future__ import annotations
 

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import hashlib
 import os
+import platform
 import shutil
 import subprocess
 import sys
@@ -26,6 +27,7 @@ import cffi
 
 from ..data import fmu_sources
 from ..errors import FmuCallError
+from ..fmu.crossbuild import HOST, TARGETS
 
 SOURCE, HEADER = "launch_plant.c", "launch_plant.h"
 #: exact IEEE arithmetic as Python's: no contraction into FMAs, no builtin rewriting of pow
@@ -48,7 +50,11 @@ def compile_command(src: Path, out: Path) -> list[str]:
     """zig cc (``ziglang``) or the system C compiler, for this machine."""
     import importlib.util
     if importlib.util.find_spec("ziglang") is not None:
-        return [sys.executable, "-m", "ziglang", "cc", *CFLAGS, f"-I{src.parent}", str(src), "-o", str(out), "-lm"]
+        # on Linux x86_64 the FMU's target: zig's cache already holds its libc (the FMU build warmed it)
+        target = (["-target", TARGETS[2][HOST[2]][0]]
+                  if sys.platform.startswith("linux") and platform.machine() == "x86_64" else [])
+        return [sys.executable, "-m", "ziglang", "cc", *target, *CFLAGS, f"-I{src.parent}", str(src), "-o", str(out),
+                "-lm"]
     cc = shutil.which("gcc") or shutil.which("cc")
     if cc is None:
         raise RuntimeError("no C compiler for the native launch plant: pip install ziglang, or install gcc")
@@ -65,7 +71,7 @@ def library() -> Path:
     """
     src = fmu_sources()
     digest = hashlib.sha256((src / SOURCE).read_bytes() + (src / HEADER).read_bytes()
-                            + " ".join(CFLAGS).encode()).hexdigest()[:16]
+                            + " ".join(compile_command(Path(SOURCE), Path("lib"))).encode()).hexdigest()[:16]
     suffix = ".dll" if sys.platform == "win32" else (".dylib" if sys.platform == "darwin" else ".so")
     for folder in (_cache_dir(), Path(tempfile.gettempdir()) / "cushion_clutch"):
         out = folder / f"launch_plant_{digest}{suffix}"

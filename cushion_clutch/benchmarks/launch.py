@@ -1,6 +1,7 @@
 """Benchmark: real-time factor of a launch scenario for every TCU variant, or the launch results page.
 
     python -m cushion_clutch.benchmarks.launch [--scenario NAME|FILE] [--backend native|python] [--repeat N]
+        [--plant native|python]
     python -m cushion_clutch.benchmarks.launch --markdown [--scenarios default,trailer,creep,cooldown,fade,wear,wear_learned,tolerance,protection]
     python -m cushion_clutch.benchmarks.launch --markdown --out docs/results/launch.md
 
@@ -190,6 +191,8 @@ def main(argv=None) -> None:
     ap.add_argument("--scenario", default=str(DEFAULT_SCENARIO))
     ap.add_argument("--backend", default="native", choices=("native", "python"))
     ap.add_argument("--repeat", type=int, default=1, help="runs per variant; the median is printed")
+    ap.add_argument("--plant", default="native", choices=("native", "python"),
+                    help="the launch loop's plant steps: compiled blocks (default) or the Python loop (the reference)")
     ap.add_argument("--markdown", action="store_true", help="print the launch results tables")
     ap.add_argument("--scenarios", default="default,trailer,creep,cooldown,fade,wear,wear_learned,tolerance,protection", help="with --markdown")
     ap.add_argument("--out", type=Path, help="with --markdown: write the results page (e.g. docs/results/launch.md)")
@@ -210,7 +213,8 @@ def main(argv=None) -> None:
         print(f"FMU step (set 3 inputs, doStep, get 3 outputs), {args.backend} FMU: {ours:.2f} us through the "
               f"cffi client, {theirs:.2f} us through fmpy FMU2Slave ({theirs / ours:.1f}x)")
         for name in VARIANTS:
-            runs = [simulate_launches(fmu, sc, load_table(sc.tables_path("tcu") or DEFAULT_TABLES), name) for _ in range(args.repeat)]
+            runs = [simulate_launches(fmu, sc, load_table(sc.tables_path("tcu") or DEFAULT_TABLES), name,
+                                      plant=args.plant) for _ in range(args.repeat)]
             wall = statistics.median(r.wall_time_s for r in runs)
             cpu = statistics.median(r.cpu_time_s for r in runs)
             print(f"{name:>24} TCU: {sim:g} s simulated in {wall:.2f} s wall -> real-time factor "

@@ -22,6 +22,25 @@ typedef struct {
     double *pc;
 } Curve;
 
+/* One curve, or two adjacent ones, as cubics of the normalised compression phi = (u - first) / (full - first)
+   (0 at first contact, 1 at full compression; spring_table.Bracket's common coordinate): the knots of both curves
+   in phi, merged, cut phi into cells; in cell j both curves are single cubics in tau = phi - org (org = lo but in
+   the outer cells, where the curves are clamped to constants), F_0 = a0 + tau (a1 + tau (a2 + tau a3)) and
+   F_1 - F_0 the same with d, so the blend (1 - w) F_0 + w F_1 is one cubic with coefficients a + w d (the cover's
+   solver: one search and one polynomial per evaluation instead of two). cell[0].lo = -inf, cell[m + 1].lo = +inf
+   (a sentinel); the buckets locate as Curve's */
+typedef struct {
+    double lo, org, a[4], d[4];
+} PairCell;
+
+typedef struct {
+    int m;          /* cells 0..m, cell m + 1 the sentinel */
+    PairCell *cell;
+    int nb;
+    double phi0, inv_bw;
+    unsigned short *bk;
+} CurvePair;
+
 /* F(u) at one temperature: curves c0 and c1 (weight w of c1; c1 = c0 where w = 0) blended on a common
    normalised compression between the first contact and the full compression, both linear in theta
    (spring_table.Bracket); r0, r1 = d(u_k)/du */
@@ -29,6 +48,8 @@ typedef struct {
     const Curve *c0, *c1;
     double w, first, full, r0, r1;
     int i; /* c0 = curves[i] (the table index of theta) */
+    const CurvePair *pr; /* the two curves (w != 0) or c0 alone (w = 0) in phi */
+    double inv_span;     /* 1 / (full - first), 1/m (0 where full = first: every curve then constant) */
 } TBracket;
 
 typedef struct {
@@ -36,6 +57,7 @@ typedef struct {
     double *theta; /* degC, increasing */
     double *delta; /* m */
     Curve *curves;
+    CurvePair *pairs; /* nt curves alone, then the nt - 1 adjacent pairs (curves k, k + 1 at nt + k) */
     /* optional friction table mu(theta_cm degC, |omega_slip| rad/s), row-major [ntf][nw] */
     int ntf, nw;
     double *f_theta, *f_omega, *f_mu;
@@ -63,6 +85,40 @@ static inline int cc_curve_locate_inline(const Curve *c, double u) {
     while (u >= x[i + 1]) ++i;
     return i;
 }
+/* the cell j of phi in a CurvePair: cell[j].lo <= phi < cell[j + 1].lo (the one cell; from its bucket) */
+static inline int cc_pair_locate(const CurvePair *p, double phi) {
+    const PairCell *c = p->cell;
+    double z = (phi - p->phi0) * p->inv_bw;
+    int k = z >= 0.0 ? (z < (double)(p->nb - 1) ? (int)z : p->nb - 1) : 0, i = p->bk[k];
+    while (phi < c[i].lo) --i;
+    while (phi >= c[i + 1].lo) ++i;
+    return i;
+}
+/* the cushion force F(u) of a bracket (spring_table.Bracket.force; its curves' Hermite forms blended, to about
+   2e-13 relative: tests/test_native_speed.py): the
+   blended cubic of the cell of phi = (u - first) / (full - first) in the bracket's CurvePair; its coefficients
+   1..3 and argument tau in *pt (slopes: dF/du = (c1 + tau (2 c2 + 3 c3 tau)) inv_span); *hint: the last cell, a
+   start for the search only (the cell of phi is unique) */
+typedef struct {
+    double c1, c2, c3, tau;
+} CellPt;
+
+static inline double cc_bracket_force(const TBracket *b, double u, int *hint, CellPt *pt) {
+    const CurvePair *p = b->pr;
+    const PairCell *c;
+    double phi = (u - b->first) * b->inv_span, w = b->w, tau;
+    int i = *hint;
+    if (!((unsigned)i <= (unsigned)p->m && p->cell[i].lo <= phi && phi < p->cell[i + 1].lo))
+        i = *hint = cc_pair_locate(p, phi);
+    c = &p->cell[i];
+    tau = phi - c->org;
+    pt->c1 = c->a[1] + w * c->d[1];
+    pt->c2 = c->a[2] + w * c->d[2];
+    pt->c3 = c->a[3] + w * c->d[3];
+    pt->tau = tau;
+    return (c->a[0] + w * c->d[0]) + tau * (pt->c1 + tau * (pt->c2 + tau * pt->c3));
+}
+
 double cc_table_mu(const Table *tb, double theta_degC, double omega);
 double cc_table_full(const Table *tb, double theta_degC);
 /* table temperatures i and i+1 around theta with weight w of i+1 (clamped: w = 0 or 1) */

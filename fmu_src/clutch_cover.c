@@ -56,6 +56,16 @@ void cc_cover_prepare(CcCover *cv, const double *par, double lever_ratio, double
     s_k0 = par[CV_SINST] + cv->u_full_ref / cv->kp;
     f_to = (moment(cv, s_k0, par[CV_E]) - cc_table_force(tb, 0.0, th_ref) * cv->L_pp) / cv->L_b;
     cv->xc = x_kiss_ref + cv->kb * s_k0 + par[CV_C] * f_to;
+    /* the solver's residual: ck = c / L_b, and P(s)'s coefficients per unit E (see cc_cover_state) */
+    cv->ck = par[CV_C] / cv->L_b;
+    cv->ckl = cv->ck * cv->L_pp;
+    cv->ckp = cv->ckl * cv->kp;
+    {
+        double t = par[CV_T], h = par[CV_H], tt = t * t, km = cv->ck * cv->fal * cv->e / t;
+        cv->pe[0] = km * (1.0 + h * h / tt);
+        cv->pe[1] = km * 1.5 * h / tt;
+        cv->pe[2] = km * 0.5 / tt;
+    }
     cv->f_theta_cs = NAN; /* no frame yet */
     cv->hint = cv->hint_k = cv->hint_t = 0;
 }
@@ -96,8 +106,7 @@ static void frame(CcCover *cv, const Table *tb, double theta_cs, double theta_cm
     double stack, m_solid, e_mod, fk;
     TBracket b;
     e_mod = youngs(cv, theta_cs);
-    cc_table_bracket_hint(tb, theta_cs - KELVIN, &b, &cv->hint_t);
-    stack = cc_table_delta_at(tb, &b) +
+    stack = cc_table_bracket_hint(tb, theta_cs - KELVIN, &b, &cv->hint_t) +
             (p[CV_TF] * p[CV_AF] + p[CV_TPP] * p[CV_APP] + p[CV_LFW] * p[CV_AFW]) * (theta_cm - p[CV_TREF]);
     cv->f_e = e_mod;
     cv->f_br = b;
@@ -116,6 +125,9 @@ static void frame(CcCover *cv, const Table *tb, double theta_cs, double theta_cm
     fk = cushion_value(&b, 0.0, &cv->hint_k);
     cv->fto_kiss = (moment(cv, cv->s_kiss, e_mod) - fk * cv->L_pp) / cv->L_b;
     cv->x_kiss = cv->xc - kb * cv->s_kiss - comp * cv->fto_kiss;
+    cv->p1 = -kb - e_mod * cv->pe[0];
+    cv->p2 = e_mod * cv->pe[1];
+    cv->p3 = -e_mod * cv->pe[2];
     cv->f_theta_cs = theta_cs;
     cv->f_theta_cm = theta_cm;
     cv->f_wear = wear;
@@ -147,13 +159,12 @@ int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
     }
     {
         /* the residual r(s) = x_to(s) - x_to = P(s) + ck L_pp F_c(u(s)), P(s) = X_c - x_to - kb s - ck M(s) a cubic
-           (ck = c / L_b; M(s) = F_AL(s) e expanded in powers of s): r, dr/ds and d2r/ds2 by Horner */
-        const TBracket b = cv->f_br;
-        const double s_kiss = cv->s_kiss, xc = cv->xc, L_pp = cv->L_pp, L_b = cv->L_b, e = cv->e;
-        const double t = p[CV_T], h = p[CV_H], tt = t * t;
-        const double tol_r = 1e-15 * (1.0 + fabs(x_to)), ck = comp / L_b, ckl = ck * L_pp, ckp = ckl * kp;
-        const double km = ck * cv->fal * cv->f_e * e / t;
-        const double p0 = xc - x_to, p1 = -kb - km * (1.0 + h * h / tt), p2 = km * 1.5 * h / tt, p3 = -km * 0.5 / tt;
+           (ck = c / L_b; M(s) = F_AL(s) e expanded in powers of s: p1..p3 of the frame): r, dr/ds and d2r/ds2 by
+           Horner */
+        const TBracket *b = &cv->f_br;
+        const double s_kiss = cv->s_kiss, xc = cv->xc;
+        const double tol_r = 1e-15 * (1.0 + fabs(x_to)), ckl = cv->ckl, ckp = cv->ckp;
+        const double p0 = xc - x_to, p1 = cv->p1, p2 = cv->p2, p3 = cv->p3;
         int hint = cv->hint;
         lo = cv->s_solid;
         hi = (xc - x_to) / kb;
@@ -164,13 +175,13 @@ int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
             s = cv->s_solid + (s_kiss - cv->s_solid) * (cv->x_solid - x_to) / (cv->x_solid - cv->x_kiss);
         else s = (xc - x_to - comp * cv->fto_kiss) / kb;
         if (!(s > lo && s < hi)) s = hi;
-        fc = cushion(&b, (s_kiss - s) * kp, &hint, &pt);
+        fc = cushion(b, (s_kiss - s) * kp, &hint, &pt);
         r = p0 + s * (p1 + s * (p2 + s * p3)) + ckl * fc;
         for (k = 0; k < 100; ++k) {
             double slope, s_new;
             if (fabs(r) <= tol_r || hi - lo <= 1e-15 * (1.0 + hi)) break;
             if (r > 0.0) lo = s; else hi = s;
-            cushion_deriv(&b, &pt, &dfc, &d2fc);
+            cushion_deriv(b, &pt, &dfc, &d2fc);
             slope = p1 + s * (2.0 * p2 + 3.0 * p3 * s) - ckp * dfc;
             if (slope < 0.0) {
                 /* Halley's step 2 r r' / (2 r'^2 - r r'') (third order where x(s) is smooth; one division), or
@@ -180,11 +191,11 @@ int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
                 s_new = den > s2 && den < 4.0 * s2 ? s - 2.0 * r * slope / den : s - r / slope;
             } else s_new = 0.5 * (lo + hi);
             s = (s_new > lo && s_new < hi) ? s_new : 0.5 * (lo + hi);
-            fc = cushion(&b, (s_kiss - s) * kp, &hint, &pt);
+            fc = cushion(b, (s_kiss - s) * kp, &hint, &pt);
             r = p0 + s * (p1 + s * (p2 + s * p3)) + ckl * fc;
         }
         /* the bearing force at the answer as cover.py writes it */
-        fto = (moment(cv, s, cv->f_e) - fc * L_pp) / L_b;
+        fto = (moment(cv, s, cv->f_e) - fc * cv->L_pp) / cv->L_b;
         cv->hint = hint;
         out->clamp = fc;
         out->bearing = fto;

@@ -175,6 +175,15 @@ static double curve_eval(const Curve *c, double u) {
            (t3 - t2) * h * c->d[i + 1];
 }
 
+int cc_table_search(const double *g, int n, double v) {
+    int lo = 0, hi = n - 1;
+    while (hi - lo > 1) {
+        int mid = (lo + hi) / 2;
+        if (g[mid] <= v) lo = mid; else hi = mid;
+    }
+    return lo;
+}
+
 /* grid index and weight of v in g[0..n-1] (clamped) */
 static void grid_bracket_hint(const double *g, int n, double v, int *i, double *w, int *hint) {
     int lo = 0, hi = n - 1;
@@ -207,12 +216,10 @@ static void table_index(const Table *tb, double theta, int *i, double *w, int *h
     if (*w == 1.0) { *i += 1; *w = 0.0; }
 }
 
-void cc_table_bracket(const Table *tb, double theta, TBracket *br) { cc_table_bracket_hint(tb, theta, br, NULL); }
-
-void cc_table_bracket_hint(const Table *tb, double theta, TBracket *br, int *hint) {
+void cc_table_bracket(const Table *tb, double theta, TBracket *br) {
     int i;
     double w, span;
-    table_index(tb, theta, &i, &w, hint);
+    table_index(tb, theta, &i, &w, NULL);
     br->i = i;
     br->c0 = &tb->curves[i];
     br->w = w;
@@ -256,12 +263,6 @@ double cc_table_force(const Table *tb, double u, double theta) {
 double cc_table_delta(const Table *tb, double theta) {
     int i; double w;
     table_index(tb, theta, &i, &w, NULL);
-    return w == 0.0 ? tb->delta[i] : (1.0 - w) * tb->delta[i] + w * tb->delta[i + 1];
-}
-
-double cc_table_delta_at(const Table *tb, const TBracket *br) {
-    int i = br->i;
-    double w = br->w;
     return w == 0.0 ? tb->delta[i] : (1.0 - w) * tb->delta[i] + w * tb->delta[i + 1];
 }
 

@@ -6,6 +6,7 @@
 #ifndef CLUTCH_TABLES_H
 #define CLUTCH_TABLES_H
 
+#include <math.h> /* NAN */
 #include <stddef.h>
 
 typedef struct {
@@ -67,8 +68,6 @@ int cc_table_load(Table *tb, const char *dir, char *err, size_t errlen);
 void cc_table_free(Table *tb);
 double cc_table_force(const Table *tb, double u, double theta_degC);
 double cc_table_delta(const Table *tb, double theta_degC);
-/* the kiss shift of a bracket's temperature (the same number as cc_table_delta at that temperature), m */
-double cc_table_delta_at(const Table *tb, const TBracket *br);
 /* the interval i of x[0] < u < x[n-1]: x[i] <= u < x[i+1] (the binary search's; found from a bucket) */
 int cc_curve_locate(const Curve *c, double u);
 /* the same, inline (the cover's solver): the interval from the bucket of u, corrected until x[i] <= u < x[i+1]
@@ -123,7 +122,46 @@ double cc_table_mu(const Table *tb, double theta_degC, double omega);
 double cc_table_full(const Table *tb, double theta_degC);
 /* table temperatures i and i+1 around theta with weight w of i+1 (clamped: w = 0 or 1) */
 void cc_table_bracket(const Table *tb, double theta_degC, TBracket *br);
-/* the same, trying the table interval *hint first (the last one found, kept in *hint) */
-void cc_table_bracket_hint(const Table *tb, double theta_degC, TBracket *br, int *hint);
+/* the binary search of g[0] <= v < g[n-1] in g[0..n-1]: i with g[i] <= v < g[i+1] */
+int cc_table_search(const double *g, int n, double v);
+/* the cover's bracket (inline): cc_table_bracket's fields but r0 and r1 (NaN: the CurvePair needs neither; the same
+   bits in the others), trying the table interval *hint first (the last one found, kept in *hint); returns the kiss
+   shift delta (cc_table_delta's number), m */
+static inline double cc_table_bracket_hint(const Table *tb, double theta, TBracket *br, int *hint) {
+    const double *g = tb->theta;
+    const Curve *c0;
+    int n = tb->nt, i = *hint;
+    double w;
+    if (n == 1 || theta <= g[0]) { i = 0; w = 0.0; }
+    else if (theta >= g[n - 1]) { i = n - 1; w = 0.0; }
+    else {
+        if (!((unsigned)i < (unsigned)(n - 1) && g[i] <= theta && theta < g[i + 1])) i = *hint = cc_table_search(g, n, theta);
+        w = (theta - g[i]) / (g[i + 1] - g[i]);
+        if (w == 1.0) { i += 1; w = 0.0; }
+    }
+    c0 = &tb->curves[i];
+    br->i = i;
+    br->c0 = c0;
+    br->w = w;
+    br->r0 = br->r1 = NAN;
+    if (w == 0.0) {
+        br->c1 = c0;
+        br->first = c0->x_first;
+        br->full = c0->x[c0->n - 1];
+        br->pr = &tb->pairs[i];
+        br->inv_span = br->full > br->first ? 1.0 / (br->full - br->first) : 0.0;
+        return tb->delta[i];
+    } else {
+        const Curve *c1 = c0 + 1;
+        double span;
+        br->c1 = c1;
+        br->first = (1.0 - w) * c0->x_first + w * c1->x_first;
+        br->full = (1.0 - w) * c0->x[c0->n - 1] + w * c1->x[c1->n - 1];
+        span = br->full - br->first;
+        br->pr = &tb->pairs[n + i];
+        br->inv_span = span > 0.0 ? 1.0 / span : 0.0;
+        return (1.0 - w) * tb->delta[i] + w * tb->delta[i + 1];
+    }
+}
 
 #endif

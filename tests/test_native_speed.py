@@ -40,10 +40,11 @@ static int bsearch_interval(const Curve *c, double u) { /* the plain search */
 
 static int same(const void *a, const void *b, size_t n) { return memcmp(a, b, n) == 0; }
 
-static int same_bracket(const TBracket *a, const TBracket *b) { /* field by field: the struct has padding */
+static int same_bracket(const TBracket *a, const TBracket *b) { /* field by field: the struct has padding; the
+                                                                   cover's bracket leaves r0, r1 out */
     return a->c0 == b->c0 && a->c1 == b->c1 && a->i == b->i && same(&a->w, &b->w, 8) &&
-           same(&a->first, &b->first, 8) && same(&a->full, &b->full, 8) && same(&a->r0, &b->r0, 8) &&
-           same(&a->r1, &b->r1, 8);
+           same(&a->first, &b->first, 8) && same(&a->full, &b->full, 8) && a->pr == b->pr &&
+           same(&a->inv_span, &b->inv_span, 8);
 }
 
 int main(int argc, char **argv) {
@@ -81,10 +82,11 @@ int main(int argc, char **argv) {
         TBracket a, b;
         double th = k % 7 == 0 ? tb.theta[k % tb.nt] : -80.0 + 500.0 * urand();
         if (k % 11 == 0) th = nextafter(tb.theta[k % tb.nt], k % 2 ? INFINITY : -INFINITY);
+        double delta;
         cc_table_bracket(&tb, th, &a);
-        cc_table_bracket_hint(&tb, th, &b, &hint);
+        delta = cc_table_bracket_hint(&tb, th, &b, &hint);
         ++checked;
-        if (!same_bracket(&a, &b) || cc_table_delta(&tb, th) != cc_table_delta_at(&tb, &b)) {
+        if (!same_bracket(&a, &b) || !same(&delta, &(double){cc_table_delta(&tb, th)}, 8)) {
             ++bad; printf("bracket mismatch theta %.17g\n", th);
         }
     }

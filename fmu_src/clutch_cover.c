@@ -56,16 +56,10 @@ void cc_cover_prepare(CcCover *cv, const double *par, double lever_ratio, double
     s_k0 = par[CV_SINST] + cv->u_full_ref / cv->kp;
     f_to = (moment(cv, s_k0, par[CV_E]) - cc_table_force(tb, 0.0, th_ref) * cv->L_pp) / cv->L_b;
     cv->xc = x_kiss_ref + cv->kb * s_k0 + par[CV_C] * f_to;
-    /* the solver's residual: ck = c / L_b, and P(s)'s coefficients per unit E (see cc_cover_state) */
+    /* the solver's residual: ck = c / L_b and its products (see cc_cover_state) */
     cv->ck = par[CV_C] / cv->L_b;
     cv->ckl = cv->ck * cv->L_pp;
     cv->ckp = cv->ckl * cv->kp;
-    {
-        double t = par[CV_T], h = par[CV_H], tt = t * t, km = cv->ck * cv->fal * cv->e / t;
-        cv->pe[0] = km * (1.0 + h * h / tt);
-        cv->pe[1] = km * 1.5 * h / tt;
-        cv->pe[2] = km * 0.5 / tt;
-    }
     cv->f_theta_cs = NAN; /* no frame yet */
     cv->hint = cv->hint_k = cv->hint_t = 0;
 }
@@ -125,9 +119,13 @@ static void frame(CcCover *cv, const Table *tb, double theta_cs, double theta_cm
     fk = cushion_value(&b, 0.0, &cv->hint_k);
     cv->fto_kiss = (moment(cv, cv->s_kiss, e_mod) - fk * cv->L_pp) / cv->L_b;
     cv->x_kiss = cv->xc - kb * cv->s_kiss - comp * cv->fto_kiss;
-    cv->p1 = -kb - e_mod * cv->pe[0];
-    cv->p2 = e_mod * cv->pe[1];
-    cv->p3 = -e_mod * cv->pe[2];
+    {   /* P(s)'s coefficients (operation for operation as the solver had them: the same root to the last bit
+           where it matters, e.g. at the cushion's first contact, where F has a kink) */
+        const double t = p[CV_T], h = p[CV_H], tt = t * t, km = cv->ck * cv->fal * e_mod * cv->e / t;
+        cv->p1 = -kb - km * (1.0 + h * h / tt);
+        cv->p2 = km * 1.5 * h / tt;
+        cv->p3 = -km * 0.5 / tt;
+    }
     cv->f_theta_cs = theta_cs;
     cv->f_theta_cm = theta_cm;
     cv->f_wear = wear;

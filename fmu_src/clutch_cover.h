@@ -20,7 +20,7 @@ typedef struct {
     double e, L_pp, L_b, kb, kp, fal; /* arms (m), bearing/pp travel per unit s, F_AL factor without E */
     double u_full_ref;                /* cushion full compression at the reference temperature, m */
     double xc;                        /* bearing-system constant X_c, m */
-    double ck, ckl, ckp, pe[3];       /* c / L_b, c L_pp / L_b, c L_pp kp / L_b; P(s)'s s, s^2, s^3 terms per unit E */
+    double ck, ckl, ckp;              /* c / L_b, c L_pp / L_b, c L_pp kp / L_b, m/N */
     int hint, hint_k;                 /* last cells of the bracket's CurvePair, solver and kiss point (search starts) */
     int hint_t;                       /* last interval of the table temperatures (the frame's bracket) */
     /* the frame of the last (theta_cs K, theta_cm K, wear m): bracket, E, positions and forces */

@@ -148,6 +148,7 @@ static int pair_build(CurvePair *p, const Curve *a, const Curve *b) {
     p->nb = dmin > 0.0 && span / dmin < 4095.0 ? (int)ceil(span / dmin) : 4096;
     if (p->nb < 1) p->nb = 1;
     bw = span / p->nb;
+    p->zmax = p->nb - 1;
     p->phi0 = m ? k[0] : 0.0;
     p->inv_bw = 1.0 / bw;
     p->bk = (unsigned short *)malloc(sizeof(unsigned short) * p->nb);

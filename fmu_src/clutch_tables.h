@@ -38,7 +38,7 @@ typedef struct {
     int m;          /* cells 0..m, cell m + 1 the sentinel */
     PairCell *cell;
     int nb;
-    double phi0, inv_bw;
+    double phi0, inv_bw, zmax; /* zmax = nb - 1 */
     unsigned short *bk;
 } CurvePair;
 
@@ -86,12 +86,11 @@ static inline int cc_curve_locate_inline(const Curve *c, double u) {
 }
 /* the cell j of phi in a CurvePair: cell[j].lo <= phi < cell[j + 1].lo (the one cell; from its bucket) */
 static inline int cc_pair_locate(const CurvePair *p, double phi) {
-    const PairCell *c = p->cell;
-    double z = (phi - p->phi0) * p->inv_bw;
-    int k = z >= 0.0 ? (z < (double)(p->nb - 1) ? (int)z : p->nb - 1) : 0, i = p->bk[k];
-    while (phi < c[i].lo) --i;
-    while (phi >= c[i + 1].lo) ++i;
-    return i;
+    const double z = (phi - p->phi0) * p->inv_bw;
+    const PairCell *c = p->cell + p->bk[z >= 0.0 ? (z < p->zmax ? (int)z : p->nb - 1) : 0];
+    while (phi < c->lo) --c;
+    while (phi >= c[1].lo) ++c;
+    return (int)(c - p->cell);
 }
 /* the cushion force F(u) of a bracket (spring_table.Bracket.force; its curves' Hermite forms blended, to about
    2e-13 relative: tests/test_native_speed.py): the

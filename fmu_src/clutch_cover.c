@@ -56,8 +56,12 @@ void cc_cover_prepare(CcCover *cv, const double *par, double lever_ratio, double
     s_k0 = par[CV_SINST] + cv->u_full_ref / cv->kp;
     f_to = (moment(cv, s_k0, par[CV_E]) - cc_table_force(tb, 0.0, th_ref) * cv->L_pp) / cv->L_b;
     cv->xc = x_kiss_ref + cv->kb * s_k0 + par[CV_C] * f_to;
+    /* the solver's residual: ck = c / L_b and its products (see cc_cover_state) */
+    cv->ck = par[CV_C] / cv->L_b;
+    cv->ckl = cv->ck * cv->L_pp;
+    cv->ckp = cv->ckl * cv->kp;
     cv->f_theta_cs = NAN; /* no frame yet */
-    cv->hint[0] = cv->hint[1] = cv->hint_k[0] = cv->hint_k[1] = cv->hint_t = 0;
+    cv->hint = cv->hint_k = cv->hint_t = 0;
 }
 
 /* -(dx_to/ds) at its smallest (open phase, s = h) at the largest E: > 0 means no snap-through */
@@ -73,63 +77,20 @@ double cc_cover_slope_bound(const CcCover *cv) {
 #define CC_INLINE static inline
 #endif
 
-/* a point of one curve where F was evaluated: its interval's cubic (NULL beyond either end, where F is clamped
-   and dF/du = 0) and t */
-typedef struct {
-    const double *q;
-    double t;
-} CurvePt;
+/* the cushion force F_c(u) at the bracket's temperature: cc_bracket_force (clutch_tables.h), inlined */
+CC_INLINE double cushion(const TBracket *b, double u, int *hint, CellPt *pt) { return cc_bracket_force(b, u, hint, pt); }
 
-/* F(u) of one curve (PCHIP, the cubic of its interval in powers of t: the value of clutch_tables.c's Hermite form
-   to a few ulps); the point in *pt for curve_deriv; *hint: the last interval, a start for the search only (the
-   interval of u is unique) */
-CC_INLINE double curve_value(const Curve *c, double u, int *hint, CurvePt *pt) {
-    const double *x = c->x, *q;
-    int n = c->n, i = *hint;
-    double t;
-    if (u <= x[0]) { pt->q = NULL; return c->y[0]; }
-    if (u >= x[n - 1]) { pt->q = NULL; return c->y[n - 1]; }
-    if (!((unsigned)i < (unsigned)(n - 1) && x[i] <= u && u < x[i + 1])) i = *hint = cc_curve_locate_inline(c, u);
-    q = c->pc + 4 * i;
-    t = (u - x[i]) * q[3];
-    pt->q = q;
-    pt->t = t;
-    return c->y[i] + t * (q[0] + t * (q[1] + t * q[2]));
+/* dF_c/du in *d1 and d2F_c/du2 in *d2 at the point of the last cushion() call (0 where F_c is clamped) */
+CC_INLINE void cushion_deriv(const TBracket *b, const CellPt *pt, double *d1, double *d2) {
+    double tau = pt->tau, k = b->inv_span;
+    *d1 = (pt->c1 + tau * (2.0 * pt->c2 + 3.0 * pt->c3 * tau)) * k;
+    *d2 = (2.0 * pt->c2 + 6.0 * pt->c3 * tau) * (k * k);
 }
 
-/* dF/du in *d1 and d2F/du2 in *d2 at a point of curve_value (only where the solver takes a step) */
-CC_INLINE void curve_deriv(const CurvePt *pt, double *d1, double *d2) {
-    const double *q = pt->q;
-    double t = pt->t;
-    if (!q) { *d1 = *d2 = 0.0; return; }
-    *d1 = (q[0] + t * (2.0 * q[1] + 3.0 * t * q[2])) * q[3];
-    *d2 = (2.0 * q[1] + 6.0 * t * q[2]) * (q[3] * q[3]);
-}
-
-/* the cushion force F_c(u) at the bracket's temperature (spring_table.Bracket.force); its curves' points in pt */
-CC_INLINE double cushion(const TBracket *b, double u, int *hint, CurvePt *pt) {
-    double f0, f1, v;
-    if (b->w == 0.0) return curve_value(b->c0, u, &hint[0], &pt[0]);
-    v = u - b->first;
-    f0 = curve_value(b->c0, b->c0->x_first + v * b->r0, &hint[0], &pt[0]);
-    f1 = curve_value(b->c1, b->c1->x_first + v * b->r1, &hint[1], &pt[1]);
-    return (1.0 - b->w) * f0 + b->w * f1;
-}
-
-/* dF_c/du in *d1 and d2F_c/du2 in *d2 at the points of the last cushion() call */
-CC_INLINE void cushion_deriv(const TBracket *b, const CurvePt *pt, double *d1, double *d2) {
-    double a0, a1, c0, c1;
-    curve_deriv(&pt[0], &a0, &c0);
-    if (b->w == 0.0) { *d1 = a0; *d2 = c0; return; }
-    curve_deriv(&pt[1], &a1, &c1);
-    *d1 = (1.0 - b->w) * a0 * b->r0 + b->w * a1 * b->r1;
-    *d2 = (1.0 - b->w) * c0 * (b->r0 * b->r0) + b->w * c1 * (b->r1 * b->r1);
-}
-
-/* the cushion force alone (the frame's points); *hint as in curve_vdd */
+/* the cushion force alone (the frame's points); *hint as in cushion */
 static double cushion_value(const TBracket *b, double u, int *hint) {
-    CurvePt pt[2] = {{NULL, 0.0}, {NULL, 0.0}};
-    return cushion(b, u, hint, pt);
+    CellPt pt;
+    return cushion(b, u, hint, &pt);
 }
 
 /* the frame: everything that depends on temperature and wear, not on x_to */
@@ -139,8 +100,7 @@ static void frame(CcCover *cv, const Table *tb, double theta_cs, double theta_cm
     double stack, m_solid, e_mod, fk;
     TBracket b;
     e_mod = youngs(cv, theta_cs);
-    cc_table_bracket_hint(tb, theta_cs - KELVIN, &b, &cv->hint_t);
-    stack = cc_table_delta_at(tb, &b) +
+    stack = cc_table_bracket_hint(tb, theta_cs - KELVIN, &b, &cv->hint_t) +
             (p[CV_TF] * p[CV_AF] + p[CV_TPP] * p[CV_APP] + p[CV_LFW] * p[CV_AFW]) * (theta_cm - p[CV_TREF]);
     cv->f_e = e_mod;
     cv->f_br = b;
@@ -156,9 +116,16 @@ static void frame(CcCover *cv, const Table *tb, double theta_cs, double theta_cm
     cv->m_solid = m_solid;
     cv->fto_solid = (m_solid - cv->fc_solid * cv->L_pp) / cv->L_b;
     cv->x_solid = cv->xc - kb * cv->s_solid - comp * cv->fto_solid;
-    fk = cushion_value(&b, 0.0, cv->hint_k);
+    fk = cushion_value(&b, 0.0, &cv->hint_k);
     cv->fto_kiss = (moment(cv, cv->s_kiss, e_mod) - fk * cv->L_pp) / cv->L_b;
     cv->x_kiss = cv->xc - kb * cv->s_kiss - comp * cv->fto_kiss;
+    {   /* P(s)'s coefficients (operation for operation as the solver had them: the same root to the last bit
+           where it matters, e.g. at the cushion's first contact, where F has a kink) */
+        const double t = p[CV_T], h = p[CV_H], tt = t * t, km = cv->ck * cv->fal * e_mod * cv->e / t;
+        cv->p1 = -kb - km * (1.0 + h * h / tt);
+        cv->p2 = km * 1.5 * h / tt;
+        cv->p3 = -km * 0.5 / tt;
+    }
     cv->f_theta_cs = theta_cs;
     cv->f_theta_cm = theta_cm;
     cv->f_wear = wear;
@@ -170,7 +137,7 @@ int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
     const double *p = cv->p;
     double kb = cv->kb, kp = cv->kp, comp = p[CV_C];
     double lo, hi, s, r, fc, fto, dfc, d2fc;
-    CurvePt pt[2] = {{NULL, 0.0}, {NULL, 0.0}}; /* pt[1]: used only where w != 0, which sets it */
+    CellPt pt;
     int k;
     if (!(theta_cs == cv->f_theta_cs && theta_cm == cv->f_theta_cm && wear == cv->f_wear))
         frame(cv, tb, theta_cs, theta_cm, wear);
@@ -190,16 +157,13 @@ int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
     }
     {
         /* the residual r(s) = x_to(s) - x_to = P(s) + ck L_pp F_c(u(s)), P(s) = X_c - x_to - kb s - ck M(s) a cubic
-           (ck = c / L_b; M(s) = F_AL(s) e expanded in powers of s): r, dr/ds and d2r/ds2 by Horner */
-        const TBracket b = cv->f_br;
-        const double s_kiss = cv->s_kiss, xc = cv->xc, L_pp = cv->L_pp, L_b = cv->L_b, e = cv->e;
-        const double t = p[CV_T], h = p[CV_H], tt = t * t;
-        const double tol_r = 1e-15 * (1.0 + fabs(x_to)), ck = comp / L_b, ckl = ck * L_pp, ckp = ckl * kp;
-        const double km = ck * cv->fal * cv->f_e * e / t;
-        const double p0 = xc - x_to, p1 = -kb - km * (1.0 + h * h / tt), p2 = km * 1.5 * h / tt, p3 = -km * 0.5 / tt;
-        int hint[2];
-        hint[0] = cv->hint[0];
-        hint[1] = cv->hint[1];
+           (ck = c / L_b; M(s) = F_AL(s) e expanded in powers of s: p1..p3 of the frame): r, dr/ds and d2r/ds2 by
+           Horner */
+        const TBracket *b = &cv->f_br;
+        const double s_kiss = cv->s_kiss, xc = cv->xc;
+        const double tol_r = 1e-15 * (1.0 + fabs(x_to)), ckl = cv->ckl, ckp = cv->ckp;
+        const double p0 = xc - x_to, p1 = cv->p1, p2 = cv->p2, p3 = cv->p3;
+        int hint = cv->hint;
         lo = cv->s_solid;
         hi = (xc - x_to) / kb;
         /* start (from the inputs only, so the result never depends on the call history): the chord of
@@ -209,13 +173,13 @@ int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
             s = cv->s_solid + (s_kiss - cv->s_solid) * (cv->x_solid - x_to) / (cv->x_solid - cv->x_kiss);
         else s = (xc - x_to - comp * cv->fto_kiss) / kb;
         if (!(s > lo && s < hi)) s = hi;
-        fc = cushion(&b, (s_kiss - s) * kp, hint, pt);
+        fc = cushion(b, (s_kiss - s) * kp, &hint, &pt);
         r = p0 + s * (p1 + s * (p2 + s * p3)) + ckl * fc;
         for (k = 0; k < 100; ++k) {
             double slope, s_new;
             if (fabs(r) <= tol_r || hi - lo <= 1e-15 * (1.0 + hi)) break;
             if (r > 0.0) lo = s; else hi = s;
-            cushion_deriv(&b, pt, &dfc, &d2fc);
+            cushion_deriv(b, &pt, &dfc, &d2fc);
             slope = p1 + s * (2.0 * p2 + 3.0 * p3 * s) - ckp * dfc;
             if (slope < 0.0) {
                 /* Halley's step 2 r r' / (2 r'^2 - r r'') (third order where x(s) is smooth; one division), or
@@ -225,13 +189,12 @@ int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
                 s_new = den > s2 && den < 4.0 * s2 ? s - 2.0 * r * slope / den : s - r / slope;
             } else s_new = 0.5 * (lo + hi);
             s = (s_new > lo && s_new < hi) ? s_new : 0.5 * (lo + hi);
-            fc = cushion(&b, (s_kiss - s) * kp, hint, pt);
+            fc = cushion(b, (s_kiss - s) * kp, &hint, &pt);
             r = p0 + s * (p1 + s * (p2 + s * p3)) + ckl * fc;
         }
         /* the bearing force at the answer as cover.py writes it */
-        fto = (moment(cv, s, cv->f_e) - fc * L_pp) / L_b;
-        cv->hint[0] = hint[0];
-        cv->hint[1] = hint[1];
+        fto = (moment(cv, s, cv->f_e) - fc * cv->L_pp) / cv->L_b;
+        cv->hint = hint;
         out->clamp = fc;
         out->bearing = fto;
         out->cushion = fc;

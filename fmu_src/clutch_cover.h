@@ -20,12 +20,14 @@ typedef struct {
     double e, L_pp, L_b, kb, kp, fal; /* arms (m), bearing/pp travel per unit s, F_AL factor without E */
     double u_full_ref;                /* cushion full compression at the reference temperature, m */
     double xc;                        /* bearing-system constant X_c, m */
-    int hint[2], hint_k[2];           /* last intervals of the two curves, solver and kiss point (search starts) */
+    double ck, ckl, ckp;              /* c / L_b, c L_pp / L_b, c L_pp kp / L_b, m/N */
+    int hint, hint_k;                 /* last cells of the bracket's CurvePair, solver and kiss point (search starts) */
     int hint_t;                       /* last interval of the table temperatures (the frame's bracket) */
     /* the frame of the last (theta_cs K, theta_cm K, wear m): bracket, E, positions and forces */
     double f_theta_cs, f_theta_cm, f_wear, f_e;
     TBracket f_br;
     double s_kiss, s_solid, fc_solid, m_solid, fto_solid, fto_kiss, x_solid, x_kiss;
+    double p1, p2, p3;                /* the solver's P(s) = X_c - x_to + p1 s + p2 s^2 + p3 s^3, m */
 } CcCover;
 
 typedef struct {

@@ -84,6 +84,84 @@ static int curve_buckets(Curve *c) {
     return 0;
 }
 
+static int cmp_double(const void *a, const void *b);
+
+/* curve c in cell [lo, hi) of phi, where x = x_first + phi S (S = x[n-1] - x_first > 0): the cubic in
+   tau = phi - org of the interval holding the cell (or the clamped constant), coefficients into f[4] */
+static void cell_cubic(const Curve *c, double S, double lo, double hi, double org, double *f) {
+    double mid = 0.5 * (lo + hi), xm, h, beta, t, q0, q1, q2;
+    int i;
+    f[1] = f[2] = f[3] = 0.0;
+    if (S <= 0.0) { f[0] = c->y[0]; return; } /* a constant curve */
+    xm = c->x_first + mid * S;
+    if (!(lo > -INFINITY) || xm <= c->x[0]) { f[0] = c->y[0]; return; }
+    if (!(hi < INFINITY) || xm >= c->x[c->n - 1]) { f[0] = c->y[c->n - 1]; return; }
+    i = curve_bsearch(c, xm);
+    h = c->x[i + 1] - c->x[i];
+    q0 = c->pc[4 * i]; q1 = c->pc[4 * i + 1]; q2 = c->pc[4 * i + 2];
+    beta = S / h;
+    t = (c->x_first + org * S - c->x[i]) / h;
+    f[0] = c->y[i] + t * (q0 + t * (q1 + t * q2));
+    f[1] = beta * (q0 + t * (2.0 * q1 + 3.0 * q2 * t));
+    f[2] = beta * beta * (q1 + 3.0 * q2 * t);
+    f[3] = beta * beta * beta * q2;
+}
+
+/* the CurvePair of curve a alone (b NULL) or of curves a, b; -1 if out of memory */
+static int pair_build(CurvePair *p, const Curve *a, const Curve *b) {
+    const Curve *cv[2] = {a, b};
+    double S[2], *k, span, dmin, bw;
+    int nk = 0, j, q, m;
+    memset(p, 0, sizeof *p);
+    k = (double *)malloc(sizeof(double) * (a->n + (b ? b->n : 0) + 1));
+    if (!k) return -1;
+    for (q = 0; q < 2 && cv[q]; ++q) {
+        S[q] = cv[q]->x[cv[q]->n - 1] - cv[q]->x_first;
+        if (S[q] > 0.0)
+            for (j = 0; j < cv[q]->n; ++j) k[nk++] = (cv[q]->x[j] - cv[q]->x_first) / S[q];
+    }
+    qsort(k, nk, sizeof(double), cmp_double);
+    for (j = 0, m = 0; j < nk; ++j)
+        if (m == 0 || k[j] != k[m - 1]) k[m++] = k[j];
+    p->m = m;
+    p->cell = (PairCell *)malloc(sizeof(PairCell) * (m + 2));
+    if (!p->cell) { free(k); return -1; }
+    for (j = 0; j <= m + 1; ++j) {
+        PairCell *c = &p->cell[j];
+        double lo = j == 0 ? -INFINITY : j <= m ? k[j - 1] : INFINITY, hi = j < m ? k[j] : INFINITY, f0[4], f1[4];
+        int r;
+        c->lo = lo;
+        c->org = j == 0 ? (m ? k[0] : 0.0) : j <= m ? lo : 0.0;
+        if (j == m + 1) { memset(c->a, 0, sizeof c->a); memset(c->d, 0, sizeof c->d); break; }
+        cell_cubic(a, S[0], lo, hi, c->org, f0);
+        if (b) cell_cubic(b, S[1], lo, hi, c->org, f1);
+        for (r = 0; r < 4; ++r) {
+            c->a[r] = f0[r];
+            c->d[r] = b ? f1[r] - f0[r] : 0.0;
+        }
+    }
+    /* buckets over [k[0], k[m-1]], none wider than the narrowest cell */
+    span = m > 1 ? k[m - 1] - k[0] : 1.0;
+    dmin = span;
+    for (j = 1; j < m; ++j)
+        if (k[j] - k[j - 1] < dmin) dmin = k[j] - k[j - 1];
+    p->nb = dmin > 0.0 && span / dmin < 4095.0 ? (int)ceil(span / dmin) : 4096;
+    if (p->nb < 1) p->nb = 1;
+    bw = span / p->nb;
+    p->zmax = p->nb - 1;
+    p->phi0 = m ? k[0] : 0.0;
+    p->inv_bw = 1.0 / bw;
+    p->bk = (unsigned short *)malloc(sizeof(unsigned short) * p->nb);
+    if (!p->bk || m > 65000) { free(k); return -1; }
+    for (j = 0, q = 0; j < p->nb; ++j) { /* the cell of the bucket's lower edge (q: of the edge before) */
+        double e = p->phi0 + bw * j;
+        while (q <= m && p->cell[q + 1].lo <= e) ++q;
+        p->bk[j] = (unsigned short)q;
+    }
+    free(k);
+    return 0;
+}
+
 static double curve_eval(const Curve *c, double u) {
     int i;
     double h, t, t2, t3;
@@ -96,6 +174,15 @@ static double curve_eval(const Curve *c, double u) {
     t3 = t * t * t;
     return (2 * t3 - 3 * t2 + 1) * c->y[i] + (t3 - 2 * t2 + t) * h * c->d[i] + (-2 * t3 + 3 * t2) * c->y[i + 1] +
            (t3 - t2) * h * c->d[i + 1];
+}
+
+int cc_table_search(const double *g, int n, double v) {
+    int lo = 0, hi = n - 1;
+    while (hi - lo > 1) {
+        int mid = (lo + hi) / 2;
+        if (g[mid] <= v) lo = mid; else hi = mid;
+    }
+    return lo;
 }
 
 /* grid index and weight of v in g[0..n-1] (clamped) */
@@ -130,12 +217,10 @@ static void table_index(const Table *tb, double theta, int *i, double *w, int *h
     if (*w == 1.0) { *i += 1; *w = 0.0; }
 }
 
-void cc_table_bracket(const Table *tb, double theta, TBracket *br) { cc_table_bracket_hint(tb, theta, br, NULL); }
-
-void cc_table_bracket_hint(const Table *tb, double theta, TBracket *br, int *hint) {
+void cc_table_bracket(const Table *tb, double theta, TBracket *br) {
     int i;
     double w, span;
-    table_index(tb, theta, &i, &w, hint);
+    table_index(tb, theta, &i, &w, NULL);
     br->i = i;
     br->c0 = &tb->curves[i];
     br->w = w;
@@ -145,6 +230,8 @@ void cc_table_bracket_hint(const Table *tb, double theta, TBracket *br, int *hin
         br->full = br->c0->x[br->c0->n - 1];
         br->r0 = 1.0;
         br->r1 = 0.0;
+        br->pr = &tb->pairs[i];
+        br->inv_span = br->full > br->first ? 1.0 / (br->full - br->first) : 0.0;
         return;
     }
     br->c1 = &tb->curves[i + 1];
@@ -153,6 +240,8 @@ void cc_table_bracket_hint(const Table *tb, double theta, TBracket *br, int *hin
     span = br->full - br->first;
     br->r0 = span > 0.0 ? (br->c0->x[br->c0->n - 1] - br->c0->x_first) / span : 0.0;
     br->r1 = span > 0.0 ? (br->c1->x[br->c1->n - 1] - br->c1->x_first) / span : 0.0;
+    br->pr = &tb->pairs[tb->nt + i];
+    br->inv_span = span > 0.0 ? 1.0 / span : 0.0;
 }
 
 /* compression from which F no longer grows at theta (linear in theta between the tables) */
@@ -175,12 +264,6 @@ double cc_table_force(const Table *tb, double u, double theta) {
 double cc_table_delta(const Table *tb, double theta) {
     int i; double w;
     table_index(tb, theta, &i, &w, NULL);
-    return w == 0.0 ? tb->delta[i] : (1.0 - w) * tb->delta[i] + w * tb->delta[i + 1];
-}
-
-double cc_table_delta_at(const Table *tb, const TBracket *br) {
-    int i = br->i;
-    double w = br->w;
     return w == 0.0 ? tb->delta[i] : (1.0 - w) * tb->delta[i] + w * tb->delta[i + 1];
 }
 
@@ -220,6 +303,9 @@ void cc_table_free(Table *tb) {
         for (k = 0; k < tb->nt; ++k) {
             free(tb->curves[k].x); free(tb->curves[k].y); free(tb->curves[k].d); free(tb->curves[k].bk); free(tb->curves[k].pc);
         }
+    if (tb->pairs)
+        for (k = 0; k < 2 * tb->nt - 1; ++k) { free(tb->pairs[k].cell); free(tb->pairs[k].bk); }
+    free(tb->pairs);
     free(tb->curves); free(tb->theta); free(tb->delta);
     free(tb->f_theta); free(tb->f_omega); free(tb->f_mu);
     memset(tb, 0, sizeof *tb);
@@ -394,6 +480,13 @@ int cc_table_load(Table *tb, const char *dir, char *err, size_t errlen) {
         for (j = 0, c->x_first = c->x[0]; j < n; ++j)
             if (c->y[j] == c->y[0]) c->x_first = c->x[j];
     }
+    tb->pairs = (CurvePair *)calloc(2 * nt - 1, sizeof(CurvePair));
+    if (!tb->pairs) { snprintf(err, errlen, "out of memory"); goto fail; }
+    for (t = 0; t < 2 * nt - 1; ++t)
+        if (pair_build(&tb->pairs[t], &tb->curves[t < nt ? t : t - nt], t < nt ? NULL : &tb->curves[t - nt + 1])) {
+            snprintf(err, errlen, "out of memory");
+            goto fail;
+        }
     free(fd); free(kp); free(fdl); free(kpl);
     fd = kp = NULL;
     fdl = kpl = NULL;

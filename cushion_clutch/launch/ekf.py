@@ -85,7 +85,9 @@ State (K for each network node and the cushion spring, m, 1, 1, 1)::
 A torque residual larger than ``gate_sd`` standard deviations is rejected.
 
 **Friction that depends on slip speed and fades** (docs/explanation/production_tcu.md, section 5).
-The friction is ``mu_scale + slope (|slip| - SLIP_REF_RAD_S) / SLIP_UNIT_RAD_S`` at the measured slip:
+The friction is the calibration's at the measured slip (``calibration``, the facing's nominal slip-speed
+shape, ``[tcu] facing_mu_slope_per_100_rad_s``; 1 for a constant mu) times
+``mu_scale + slope (|slip| - SLIP_REF_RAD_S) / SLIP_UNIT_RAD_S``:
 the slope is a state (prior 0, sd ``mu_slope_sd``), corrected with ``mu_scale`` and applied beyond
 ``mu_slope_evidence_sd`` of its standard deviation. ``mu_scale`` follows the estimated facings above
 ``mu_reference_max_degC``: the prediction adds ``k_fade d(theta_cm) / FADE_UNIT_K``, with the fade slope

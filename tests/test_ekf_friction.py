@@ -151,3 +151,59 @@ def test_a_trade_of_friction_touch_point_and_offset_is_no_friction_evidence(tabl
     for _ in range(10):
         ekf.update_evidence()
     assert not ekf.mu_evidence and ekf.mu_used == 1.0
+
+
+def test_the_calibrations_slip_speed_shape_of_mu_is_applied_from_the_first_launch(table):
+    """The organic facing of ``fade`` at 20 degC (mu 0.300 at lock-up falling 3 % of it per 100 rad/s: 7 %
+    above the nominal 0.28 at lock-up), ECU +4 %, +3 N.m. A calibration that knows the facing supplier's
+    nominal shape (-2.5 % per 100 rad/s, 0.28 at 190 rad/s: 0.293 at lock-up) is within 2.3 % of the
+    facing from the first launch and needs no slope of its own; without it the slope must be learned and
+    is applied shrunk by its sd (measured worst 3.9 N.m every launch against 11.5, 8.6, 7.0, 6.3)."""
+    from cushion_clutch.launch.scenario import Tcu
+    p = ClutchParameters()
+    mu = lambda w: (0.300 / 0.28) * (1.0 - 0.0003 * w)     # noqa: E731
+    cal = Tcu(facing_mu_slope_per_100_rad_s=-0.025, facing_mu_reference_slip_rad_s=190.0).mu_calibration
+    errs = {}
+    for name, c in (("calibrated", cal), ("nominal", None)):
+        ekf = ClutchEkf(TcuNetworkParams(), EkfParams(temperature_update=False), table, p, TA, TA, c)
+        errs[name] = [launch(ekf, table, p, mu, gain=0.04, offset=3.0) for _ in range(4)]
+        if c is not None:
+            assert ekf.slope_used == 0.0 and abs(ekf.s[IX_SLOPE]) < 0.015 and not ekf.evidence
+    assert max(errs["calibrated"]) < 0.5 * errs["nominal"][0]              # N.m
+    assert max(errs["calibrated"]) < 0.8 * errs["nominal"][-1]
+
+
+def test_the_calibrations_mu_shape_is_relative_to_the_nominal_mu_at_its_reference_slip():
+    """``tcu.mu_calibration``: exactly 1 for a constant mu (the default: other scenarios unchanged), 1 at the
+    reference slip, linear in |slip|; a shape whose mu would fall below half the nominal is refused, naming
+    the key."""
+    from cushion_clutch.errors import ParameterError
+    from cushion_clutch.launch.scenario import Tcu
+    assert all(Tcu().mu_calibration(w) == 1.0 for w in (0.0, 150.0, -300.0))
+    c = Tcu(facing_mu_slope_per_100_rad_s=-0.025, facing_mu_reference_slip_rad_s=190.0).mu_calibration
+    assert c(190.0) == pytest.approx(1.0) and c(-190.0) == pytest.approx(1.0)
+    assert c(0.0) == pytest.approx(1.0475) and c(390.0) == pytest.approx(0.95)
+    with pytest.raises(ParameterError) as err:
+        Tcu(facing_mu_slope_per_100_rad_s=0.15, facing_mu_reference_slip_rad_s=900.0)
+    assert "tcu.facing_mu_slope_per_100_rad_s" in str(err.value)
+
+
+def test_every_tcu_variant_applies_the_calibrations_mu_at_the_measured_slip(table):
+    """The naive TCU (the nominal calibration) believes and commands through the calibration's mu at the
+    slip its speed sensors give; ``fade`` names the organic facing's nominal shape."""
+    import dataclasses
+
+    from cushion_clutch.launch.scenario import load_scenario, scenario_path
+    from cushion_clutch.launch.tcu import VARIANTS, TcuController
+    sc = load_scenario(scenario_path("fade"))
+    assert sc.tcu.facing_mu_slope_per_100_rad_s < 0.0
+    p = ClutchParameters()
+    for slope, expected in ((sc.tcu.facing_mu_slope_per_100_rad_s, sc.tcu.mu_calibration(40.0)), (0.0, 1.0)):
+        s = dataclasses.replace(sc, tcu=dataclasses.replace(sc.tcu, facing_mu_slope_per_100_rad_s=slope))
+        ctl = TcuController(VARIANTS["naive"], s, table, p, TA, 10.0, 50.0)
+        ctl.cycle(1, 0.0, False, 140.0, 100.0, 0.0, TA)          # pre-fill: 40 rad/s of slip measured
+        x = x_to_for_torque(100.0, ctl.theta_used(), table, p)
+        nominal = outputs(x, ctl.theta_used(), table, p).torque
+        assert ctl.model_torque(x) == pytest.approx(expected * nominal, rel=1e-12)
+        assert ctl.command(expected * nominal) == pytest.approx(x, abs=1e-12)
+    assert expected == 1.0 and sc.tcu.mu_calibration(40.0) > 1.03

@@ -85,7 +85,9 @@ State (K for each network node and the cushion spring, m, 1, 1, 1)::
 A torque residual larger than ``gate_sd`` standard deviations is rejected.
 
 **Friction that depends on slip speed and fades** (docs/explanation/production_tcu.md, section 5).
-The friction is ``mu_scale + slope (|slip| - SLIP_REF_RAD_S) / SLIP_UNIT_RAD_S`` at the measured slip:
+The friction is the calibration's at the measured slip (``calibration``, the facing's nominal slip-speed
+shape, ``[tcu] facing_mu_slope_per_100_rad_s``; 1 for a constant mu) times
+``mu_scale + slope (|slip| - SLIP_REF_RAD_S) / SLIP_UNIT_RAD_S``:
 the slope is a state (prior 0, sd ``mu_slope_sd``), corrected with ``mu_scale`` and applied beyond
 ``mu_slope_evidence_sd`` of its standard deviation. ``mu_scale`` follows the estimated facings above
 ``mu_reference_max_degC``: the prediction adds ``k_fade d(theta_cm) / FADE_UNIT_K``, with the fade slope
@@ -320,11 +322,18 @@ class ClutchEkf:
         The TCU's clutch parameters (nominal mu, lever ratio, kiss point at reference).
     theta_a, theta0 : float
         Measured ambient and starting temperature, K.
+    calibration : callable, optional
+        The calibration's friction at a slip speed (rad/s) relative to the nominal mu (the facing's nominal
+        slip-speed shape, :meth:`~.scenario.Tcu.mu_calibration`); default: mu constant. The friction states
+        are relative to it.
     """
 
     def __init__(self, net: TcuNetworkParams, e: EkfParams, table: SpringTable, p: ClutchParameters,
-                 theta_a: float, theta0: float):
+                 theta_a: float, theta0: float, calibration=None):
         self.net, self.e, self.table, self.p = net, e, table, p
+        self.calibration = calibration if calibration is not None else (lambda w: 1.0)
+        #: the calibration's friction at the measured slip (:meth:`set_slip`) and at SLIP_REF_RAD_S, 1
+        self.cal = self.cal_ref = float(self.calibration(SLIP_REF_RAD_S))
         self.model = ThermalNetwork(net, theta_a, theta0)
         self.theta_a = theta_a
         self.s = np.array([theta0] * N_T + [0.0, 1.0, 1.0, 1.0])
@@ -489,7 +498,8 @@ class ClutchEkf:
                 self._ecu_cache.clear()
             self._ecu_cache[key] = hit
         t0, t1 = hit
-        return (float(s[IX_MU]) * t1 + float(s[IX_OFF])) / t0
+        c = self.cal_ref
+        return (c * float(s[IX_MU]) * t1 + float(s[IX_OFF])) / (c * t0)
 
     def friction_ratio(self) -> float:
         """The friction relative to the one on cool facings: :meth:`ecu_ratio` over its cool reference
@@ -504,9 +514,9 @@ class ClutchEkf:
 
     @property
     def mu_applied(self) -> float:
-        """The friction relative to the nominal mu the TCU applies at the measured slip: :attr:`mu_used` plus
-        the slip-speed slope's term (:meth:`mu_factor`), 1."""
-        return self.mu_used + self.slope_used * (abs(self.slip) - SLIP_REF_RAD_S) / SLIP_UNIT_RAD_S
+        """The friction relative to the nominal mu the TCU applies at the measured slip: the calibration's
+        (:attr:`cal`) times :attr:`mu_used` plus the slip-speed slope's term (:meth:`mu_factor`), 1."""
+        return self.cal * (self.mu_used + self.slope_used * (abs(self.slip) - SLIP_REF_RAD_S) / SLIP_UNIT_RAD_S)
 
     @property
     def slope_used(self) -> float:
@@ -517,34 +527,38 @@ class ClutchEkf:
                                                                                                    IX_SLOPE]), 0.0))
         return d - band if d > band else (d + band if d < -band else 0.0)
 
-    def model_torque(self, x_m: float, s: np.ndarray | None = None, mu: float | None = None) -> float:
+    def model_torque(self, x_m: float, s: np.ndarray | None = None, mu: float | None = None,
+                     factor: float | None = None) -> float:
         """The TCU's torque at bearing position ``x_m`` (m) with state ``s`` (default: the estimate), N.m.
 
-        ``mu`` replaces the state's friction scale (e.g. :attr:`mu_used`).
+        ``mu`` replaces the state's friction scale (e.g. :attr:`mu_used`); ``factor`` the whole friction
+        relative to the nominal mu (:meth:`mu_factor`).
         """
         s = self.s if s is None else s
         th = min(max(float(s[IX_CS]), self.table.theta_min_K), self.table.theta_max_K)
         theta_cm = min(max(float(0.5 * (s[F1] + s[F2])), THETA_MIN_K), THETA_MAX_K)   # the stack's growth there
-        return self.mu_factor(s, mu) * outputs(x_m - float(s[IX_DX]), th, self.table, self.p, theta_cm).torque
+        f = self.mu_factor(s, mu) if factor is None else factor
+        return f * outputs(x_m - float(s[IX_DX]), th, self.table, self.p, theta_cm).torque
 
     def mu_factor(self, s: np.ndarray | None = None, mu: float | None = None) -> float:
-        """Friction relative to the nominal mu at the measured slip :attr:`slip`: the scale (``mu`` if given)
-        plus the slip-speed slope times ``(|slip| - SLIP_REF_RAD_S) / SLIP_UNIT_RAD_S``, 1."""
+        """Friction relative to the nominal mu at the measured slip :attr:`slip`: the calibration's there
+        (:attr:`cal`) times the scale (``mu`` if given) plus the slip-speed slope times
+        ``(|slip| - SLIP_REF_RAD_S) / SLIP_UNIT_RAD_S``, 1."""
         s = self.s if s is None else s
-        return ((float(s[IX_MU]) if mu is None else mu)
-                + float(s[IX_SLOPE]) * (abs(self.slip) - SLIP_REF_RAD_S) / SLIP_UNIT_RAD_S)
+        return self.cal * ((float(s[IX_MU]) if mu is None else mu)
+                           + float(s[IX_SLOPE]) * (abs(self.slip) - SLIP_REF_RAD_S) / SLIP_UNIT_RAD_S)
 
     def set_slip(self, w_slip_rad_s: float) -> None:
         """The measured slip speed (rad/s) at which the characteristic is evaluated from now on."""
         self.slip = abs(w_slip_rad_s)
+        self.cal = float(self.calibration(self.slip))
 
     def used_torque(self, x_m: float, mu: float | None = None) -> float:
         """The torque the TCU applies at the measured bearing position ``x_m`` (m): :attr:`dx_used` and
-        :attr:`mu_applied` (``mu`` replaces the latter), N.m."""
+        :attr:`mu_applied` (``mu`` replaces the latter: the whole friction relative to the nominal mu), N.m."""
         s = self.s.copy()
         s[IX_DX] = self.dx_used
-        s[IX_SLOPE] = 0.0 if mu is not None else self.slope_used
-        return self.model_torque(x_m, s, mu=self.mu_used if mu is None else mu)
+        return self.model_torque(x_m, s, factor=self.mu_applied if mu is None else mu)
 
     def update_evidence(self) -> bool:
         """Compare the learned characteristic with the nominal one; set and return :attr:`evidence`.
@@ -751,9 +765,9 @@ class ClutchEkf:
             sp[i] += d
             hrow[i] = (self.model_torque(x_meas_m, sp) - h0) / d
         hrow[F2] = hrow[F1]                   # the stack grows with the facings' mean: both enter alike
-        t_nominal = h0 / max(self.mu_factor(), 1e-6)
-        hrow[IX_MU] = t_nominal
-        hrow[IX_SLOPE] = t_nominal * (self.slip - SLIP_REF_RAD_S) / SLIP_UNIT_RAD_S
+        t_cal = h0 * self.cal / max(self.mu_factor(), 1e-6)       # the calibration's torque (mu_scale 1, no slope)
+        hrow[IX_MU] = t_cal
+        hrow[IX_SLOPE] = t_cal * (self.slip - SLIP_REF_RAD_S) / SLIP_UNIT_RAD_S
         hrow[IX_OFF] = 1.0
         r = (e.torque_sd_Nm if torque_sd_Nm is None else torque_sd_Nm) ** 2
         s_inn = float(hrow @ self.P @ hrow) + r

@@ -73,7 +73,7 @@ class ProductionTcu(TcuController):
             table.friction = None
         self.sens = TcuSensors(sensors)
         theta_a_meas = self.sens.ambient(p.theta_a)
-        self.ekf = ClutchEkf(net, ekf, table, p, theta_a_meas, theta0)
+        self.ekf = ClutchEkf(net, ekf, table, p, theta_a_meas, theta0, sc.tcu.mu_calibration)
         self.rls = MassGradeEstimator(mass_grade, *ratios)
         self.i_tot, self.r = ratios[0], ratios[1]
         self.t = 0.0
@@ -235,7 +235,7 @@ def key_on(ctl: ProductionTcu, sc, fmu: Path, clutch_start: dict[str, float], j_
         e = ctl.ekf
         result = learn_touch_point(fmu, clutch_start, st, sc.tcu_sensors, ctl.table, ctl.p, e.theta_cs, e.theta_cm,
                                    e.dx_used, j_disc_kg_m2, w_idle_rad_s, sc.tcu.period_s,
-                                   sc.tcu.actuator_time_constant_s, sc.run.step_s)
+                                   sc.tcu.actuator_time_constant_s, sc.run.step_s, sc.tcu.mu_calibration)
         if result.ok:
             e.set_prior(result.dx_kiss_m, st.accuracy_m, e.mu_prior, e.loss_scale, e.heat_scale)
             since, learned = 0, True

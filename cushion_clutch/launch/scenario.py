@@ -146,6 +146,11 @@ class Tcu(Checked):
     characteristic is inverted and the actuator's first-order lag
     (``actuator_time_constant_s``, known to the TCU) inverted over one period.
     After lock-up the bearing closes at ``close_rate_m_per_s`` to ``x_to_closed_m``.
+
+    The calibration's friction (every TCU variant's): the nominal mu of the clutch parameters at the slip
+    speed ``facing_mu_reference_slip_rad_s``, falling by ``facing_mu_slope_per_100_rad_s`` of it per
+    100 rad/s of slip (the facing supplier's nominal slip-speed shape; 0: mu constant, the default facing),
+    ``mu(w) = mu (1 + slope (|w| - w_ref) / 100 rad/s)`` at the measured slip.
     """
 
     period_s: float = 0.01
@@ -161,6 +166,10 @@ class Tcu(Checked):
     actuator_time_constant_s: float = 0.02
     drive_time_s: float = 8.0
     prefill_s: float = 0.3
+    facing_mu_slope_per_100_rad_s: float = 0.0
+    """the calibration's relative change of mu per 100 rad/s of slip (the facing's nominal shape), 1"""
+    facing_mu_reference_slip_rad_s: float = 190.0
+    """slip speed at which the calibration's mu is the nominal mu, rad/s"""
 
     _section = "tcu"
 
@@ -172,7 +181,21 @@ class Tcu(Checked):
             "sync_slip_rad_s": (1.0, 500.0), "lockup_slip_rate_rad_s2": (0.1, 1000.0),
             "x_to_closed_m": (0.0, 0.05),
             "close_rate_m_per_s": (1e-4, 1.0), "actuator_time_constant_s": (0.0, 1.0),
-            "drive_time_s": (0.5, 100.0), "prefill_s": (0.0, 5.0)})
+            "drive_time_s": (0.5, 100.0), "prefill_s": (0.0, 5.0),
+            "facing_mu_slope_per_100_rad_s": (-0.2, 0.2), "facing_mu_reference_slip_rad_s": (0.0, 1000.0)})
+        k, w_ref = self.facing_mu_slope_per_100_rad_s, self.facing_mu_reference_slip_rad_s
+        if not all(isinstance(v, (int, float)) for v in (k, w_ref)):
+            return
+        low = min(1.0 + k * (w - w_ref) / 100.0 for w in (0.0, 1000.0))
+        if low < 0.5:
+            yield (f"tcu.facing_mu_slope_per_100_rad_s = {k!r}: the calibration's mu falls to {low:.3g} of the "
+                   f"nominal between 0 and 1000 rad/s of slip (reference {w_ref:g} rad/s); must stay >= 0.5")
+
+    def mu_calibration(self, w_slip_rad_s: float) -> float:
+        """The calibration's friction at the slip speed ``w_slip_rad_s`` (rad/s) relative to the nominal mu, 1
+        (exactly 1 when the calibration's mu is constant)."""
+        k = self.facing_mu_slope_per_100_rad_s
+        return 1.0 + k * (abs(w_slip_rad_s) - self.facing_mu_reference_slip_rad_s) / 100.0 if k else 1.0
 
 
 #: the driver's demand levels

@@ -156,6 +156,9 @@ class TcuController:
         self.inhibited = self.limited = False
         #: the protection level the current launch runs at (decided at its start; 3: inhibited)
         self.launch_level = 0
+        #: the calibration's friction at the last measured slip speed, relative to the nominal mu
+        #: (``tcu.facing_mu_slope_per_100_rad_s``; 1: mu constant)
+        self.mu_cal = 1.0
         #: the assumed theta_cs (K) and believed kiss point (m) after the last cycle
         self.theta_now, self.kiss_now = self.theta_used(), self.kiss()
 
@@ -210,21 +213,22 @@ class TcuController:
             torque_Nm, theta, self.table, self.p, theta_cm=theta_cm))
 
     def command(self, torque_Nm: float) -> float:
-        """Bearing position for ``torque_Nm``, m."""
-        return self.x_for_torque(torque_Nm, self.theta_used(), self.theta_cm_used()) + self.offset
+        """Bearing position for ``torque_Nm`` (the calibration's friction at the measured slip, :attr:`mu_cal`), m."""
+        return self.x_for_torque(torque_Nm / self.mu_cal, self.theta_used(), self.theta_cm_used()) + self.offset
 
     def model_torque(self, x_m: float) -> float:
-        """Torque the TCU's model expects at bearing position ``x_m``, N.m.
+        """Torque the TCU's model expects at bearing position ``x_m`` (the calibration's friction at the
+        measured slip, :attr:`mu_cal`), N.m.
 
         Remembered per exact inputs (:func:`_memo`): the closed position is asked every launch cycle.
         """
         theta, theta_cm = self.theta_used(), self.theta_cm_used()
-        return _memo(self._torque_memo, (x_m, theta, theta_cm, self.offset), lambda: outputs(
+        return self.mu_cal * _memo(self._torque_memo, (x_m, theta, theta_cm, self.offset), lambda: outputs(
             x_m - self.offset, theta, self.table, self.p, theta_cm).torque)
 
     def _learn(self, torque_Nm: float, x_mean: float) -> None:
         theta = self.theta_used()
-        distance = (x_to_for_torque(torque_Nm, theta, self.table, self.p, theta_cm=self.theta_cm_used())
+        distance = (x_to_for_torque(torque_Nm / self.mu_cal, theta, self.table, self.p, theta_cm=self.theta_cm_used())
                     - self.model_kiss(theta))
         estimate = x_mean - distance
         self.learner.estimates.append((self.launch, estimate))
@@ -287,6 +291,7 @@ class TcuController:
         """
         tc = self.sc.tcu
         prot = self.protection
+        self.mu_cal = tc.mu_calibration(w_e - w_d)
         if self.v.temperature == "ideal":
             self.theta_ideal = thermal_step(self.theta_ideal, theta_cm_true, self.period, self.p)
             self.theta_cm_ideal = theta_cm_true

@@ -56,6 +56,7 @@ import math
 import statistics
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Callable
 
 from ..model import ClutchParameters, SpringTable, kiss_point, x_to_for_torque
 from .fmu_client import ClutchFmu
@@ -95,7 +96,8 @@ class StandstillResult:
 def learn_touch_point(fmu: Path, start: dict[str, float], st: Standstill, sens: ProductionSensors,
                       table: SpringTable, p: ClutchParameters, theta_cs: float, theta_cm: float,
                       dx_prior_m: float, j_disc_kg_m2: float, w_idle_rad_s: float, period_s: float,
-                      actuator_time_constant_s: float, step_s: float = 1e-3) -> StandstillResult:
+                      actuator_time_constant_s: float, step_s: float = 1e-3,
+                      mu_calibration: Callable[[float], float] | None = None) -> StandstillResult:
     """Run the standstill routine on the plant FMU and return the learned touch-point offset.
 
     Parameters
@@ -114,6 +116,10 @@ def learn_touch_point(fmu: Path, start: dict[str, float], st: Standstill, sens: 
         The plant's disc-side inertia in neutral (kg m2) and the engine's idle speed (rad/s).
     period_s, actuator_time_constant_s, step_s
         TCU period, actuator lag and simulation step, s.
+    mu_calibration
+        The calibration's friction at a slip speed (rad/s) relative to the nominal mu
+        (:meth:`~.scenario.Tcu.mu_calibration`); each sample is inverted at its measured slip
+        (idle speed less the shaft's); default: mu constant.
     """
     th = min(max(theta_cs, table.theta_min_K), table.theta_max_K)
     nominal_kiss = kiss_point(th, table, p, theta_cm)
@@ -191,7 +197,8 @@ def learn_touch_point(fmu: Path, start: dict[str, float], st: Standstill, sens: 
         if torque < st.min_torque_Nm:
             continue
         x_mean = sum(r[2] for r in rec[i - HALF_WINDOW:i + HALF_WINDOW + 1]) / (2 * HALF_WINDOW + 1)
-        dxs.append(x_mean - x_to_for_torque(torque, th, table, p, theta_cm=theta_cm))
+        cal = mu_calibration(w_idle_rad_s - rec[i][1]) if mu_calibration is not None else 1.0
+        dxs.append(x_mean - x_to_for_torque(torque / cal, th, table, p, theta_cm=theta_cm))
         torques.append(torque)
     if not dxs:
         return StandstillResult(False, f"no sample reached {st.min_torque_Nm} N.m", math.nan, before, before,

@@ -12,7 +12,13 @@ and differs in what it knows:
 * **clutch torque** from the engine side: ``T_c = T_est - J_e dw_e/dt`` over a
   window of ``WINDOW`` TCU periods (speed difference of the crank readings,
   mean torque estimate and bearing position over the same window);
-* **slip power** for the thermal model: ``T_c`` times the measured slip speed;
+* **slip power** for the thermal model: ``T_c`` over the torque signal's gain as the EKF
+  referenced it on cool facings (``gain_ref``; 1 before a reference) times the measured slip speed.
+  ``k_heat`` is the network's inverse heat capacity and scales its cooling as much as its heating:
+  a gain error left in the heat would be learned into ``k_heat`` on the heat-up and then bias every
+  cool-down (``docs/explanation/tcu_thermal_estimate.md``). The learned offset is not taken out: its
+  torque signature is nearly that of the facings' temperature, and its errors would feed back into the
+  heat;
 * **temperatures, touch point and friction** from the EKF (:mod:`.ekf`) on
   the TCU's own thermal network, whose heat-loss and heat-input scales the
   EKF learns from the torque across launches (the network stays mismatched
@@ -163,7 +169,8 @@ class ProductionTcu(TcuController):
         v = h1[1] * self.r / self.i_tot               # wheel speed at the disc (ABS sensors)
         a = (h1[1] - h0[1]) / span * self.r / self.i_tot
         self.rls.update(t_c, v, a)
-        e.accumulate(self.period, max(t_c, 0.0) * abs(slip) if launching else 0.0)
+        g_ref = e.gain_ref if e.gain_ref is not None else 1.0    # the torque signal's gain, referenced cool
+        e.accumulate(self.period, max(t_c, 0.0) / g_ref * abs(slip) if launching else 0.0)
         if e.due():
             e.predict(w_e, w_d, True)
             if launching:

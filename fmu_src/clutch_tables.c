@@ -52,7 +52,17 @@ static int curve_bsearch(const Curve *c, double u) {
     return lo;
 }
 
-int cc_curve_locate(const Curve *c, double u) { return cc_curve_locate_inline(c, u); }
+int cc_curve_locate(const Curve *c, double u) {
+    const double *x = c->x;
+    int k = (int)((u - x[0]) * c->inv_bw), i;
+    if (k > c->nb - 1) k = c->nb - 1;
+    if (k < 0) k = 0;
+    i = c->bk[k];
+    i += u >= x[i + 1];
+    while (u < x[i]) --i;
+    while (u >= x[i + 1]) ++i;
+    return i;
+}
 
 /* the buckets of a loaded curve (n >= 2, x increasing); -1 if out of memory */
 static int curve_buckets(Curve *c) {

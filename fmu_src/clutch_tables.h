@@ -19,7 +19,7 @@ typedef struct {
     double inv_bw;
     unsigned short *bk;
     /* the cubic of interval i in t = (u - x[i]) / (x[i+1] - x[i]): F = y[i] + t (q0 + t (q1 + t q2)), and
-       q3 = 1 / (x[i+1] - x[i]); pc[4 i + k] = qk (the cover's solver: value, slope and curvature at once) */
+       q3 = 1 / (x[i+1] - x[i]); pc[4 i + k] = qk (read when the table loads, to build the CurvePairs' cells) */
     double *pc;
 } Curve;
 
@@ -68,22 +68,11 @@ int cc_table_load(Table *tb, const char *dir, char *err, size_t errlen);
 void cc_table_free(Table *tb);
 double cc_table_force(const Table *tb, double u, double theta_degC);
 double cc_table_delta(const Table *tb, double theta_degC);
-/* the interval i of x[0] < u < x[n-1]: x[i] <= u < x[i+1] (the binary search's; found from a bucket) */
+/* the interval i of x[0] < u < x[n-1]: x[i] <= u < x[i+1] (the binary search's), from the bucket of u, corrected
+   until x[i] <= u < x[i+1] holds, so it is the one interval the binary search finds whatever the rounding of the
+   bucket index (buckets are no wider than the narrowest interval: at most one step up from the bucket's start in
+   exact arithmetic) */
 int cc_curve_locate(const Curve *c, double u);
-/* the same, inline (the cover's solver): the interval from the bucket of u, corrected until x[i] <= u < x[i+1]
-   holds, so it is the one interval the binary search finds whatever the rounding of the bucket index (buckets
-   are no wider than the narrowest interval: at most one step up from the bucket's start in exact arithmetic) */
-static inline int cc_curve_locate_inline(const Curve *c, double u) {
-    const double *x = c->x;
-    int k = (int)((u - x[0]) * c->inv_bw), i;
-    if (k > c->nb - 1) k = c->nb - 1;
-    if (k < 0) k = 0;
-    i = c->bk[k];
-    i += u >= x[i + 1];
-    while (u < x[i]) --i;
-    while (u >= x[i + 1]) ++i;
-    return i;
-}
 /* the cell j of phi in a CurvePair: cell[j].lo <= phi < cell[j + 1].lo (the one cell; from its bucket) */
 static inline int cc_pair_locate(const CurvePair *p, double phi) {
     const double z = (phi - p->phi0) * p->inv_bw;

@@ -37,22 +37,39 @@ def zig_available() -> bool:
     return importlib.util.find_spec("ziglang") is not None
 
 
-def compile_command(platform: str, fmi_version: int, src: Path, files: tuple[str, ...], out: Path,
-                    linux_libs: tuple[str, ...] = ()) -> list[str]:
-    """The zig (or, for the host without ziglang, gcc) command building one platform's library."""
-    target, suffix = TARGETS[fmi_version][platform]
+def compile_command(platform: str | None, fmi_version: int, src: Path, files: tuple[str, ...], out: Path,
+                    linux_libs: tuple[str, ...] = (), extra_flags: tuple[str, ...] = ()) -> list[str]:
+    """The zig (or, for the host without ziglang, gcc) command building one platform's library.
+
+    ``platform`` None: a library for the machine this Python runs on (not an FMU platform folder): zig's
+    Linux x86_64 FMU target on such a machine (its libc is in zig's cache), zig's native target elsewhere.
+    ``extra_flags`` follow the common flags (e.g. ``-ffp-contract=off``).
+    """
+    if platform is None:
+        linux_x86 = sys.platform.startswith("linux") and _machine() == "x86_64"
+        target = TARGETS[2][HOST[2]][0] if linux_x86 else None
+        host = True
+    else:
+        target, _ = TARGETS[fmi_version][platform]
+        host = platform == HOST[fmi_version]
+    native = target is None
     srcs = [str(src / f) for f in files]
-    libs = ["-lm", *linux_libs] if "linux" in target else []
-    pic = [] if "windows" in target else ["-fPIC"]
+    libs = ["-lm", *linux_libs] if native or "linux" in target else []
+    pic = ["-fPIC"] if native or "windows" not in target else []
     if zig_available():
-        return [sys.executable, "-m", "ziglang", "cc", "-target", target, *CFLAGS, *pic, f"-I{src}", *srcs,
-                "-o", str(out), *libs]
-    if platform != HOST[fmi_version]:
+        return [sys.executable, "-m", "ziglang", "cc", *([] if native else ["-target", target]), *CFLAGS, *pic,
+                *extra_flags, f"-I{src}", *srcs, "-o", str(out), *libs]
+    if not host:
         raise RuntimeError(f"cross-compiling for {platform} needs ziglang (pip install ziglang)")
     cc = shutil.which("gcc") or shutil.which("cc")
     if cc is None:
         raise RuntimeError("no C compiler: pip install ziglang, or install gcc")
-    return [cc, *CFLAGS, *pic, f"-I{src}", *srcs, "-o", str(out), *libs]
+    return [cc, *CFLAGS, *pic, *extra_flags, f"-I{src}", *srcs, "-o", str(out), *libs]
+
+
+def _machine() -> str:
+    import platform
+    return platform.machine()
 
 
 def build_binaries(src: Path, files: tuple[str, ...], fmi_version: int, out_dir: Path,

@@ -10,29 +10,19 @@ fused multiply-adds, libm's ``pow``), so both paths give the same results to the
 ``tests/test_launch_plant_block.py`` checks series, metrics, energy and events against the reference.
 
 The library is compiled once per source version with zig (``ziglang``; the FMU's compiler) or the system
-C compiler, and cached under ``$XDG_CACHE_HOME/cushion_clutch`` (default ``~/.cache``).
+C compiler, and cached under ``$XDG_CACHE_HOME/cushion_clutch`` (default ``~/.cache``; :mod:`..fmu.hostlib`).
 """
 from __future__ import annotations
 
-import hashlib
-import os
-import platform
-import shutil
-import subprocess
-import sys
-import tempfile
 from pathlib import Path
 
 import cffi
 
 from ..data import fmu_sources
 from ..errors import FmuCallError
-from ..fmu.crossbuild import HOST, TARGETS
+from ..fmu.hostlib import host_library
 
 SOURCE, HEADER = "launch_plant.c", "launch_plant.h"
-#: exact IEEE arithmetic as Python's: no contraction into FMAs, no builtin rewriting of pow
-CFLAGS = ("-std=c99", "-O2", "-shared", "-fPIC", "-fvisibility=hidden", "-Wall", "-ffp-contract=off",
-          "-fno-builtin")
 #: the most points of an engine torque curve the C step takes (lp_consts.curve_w)
 MAX_CURVE = 32
 FMI_FUNCTIONS = {-1: "fmi2SetReal", -2: "fmi2DoStep", -3: "fmi2GetReal"}
@@ -41,54 +31,15 @@ ROW_FIELDS = ("w_e", "w_d", "v", "accel", "x_act", "t_dem", "t_cap", "t_c", "the
               "throttle", "locked", "t_shaft")
 
 
-def _cache_dir() -> Path:
-    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
-    return Path(base) / "cushion_clutch"
-
-
-def compile_command(src: Path, out: Path) -> list[str]:
-    """zig cc (``ziglang``) or the system C compiler, for this machine."""
-    import importlib.util
-    if importlib.util.find_spec("ziglang") is not None:
-        # on Linux x86_64 the FMU's target: zig's cache already holds its libc (the FMU build warmed it)
-        target = (["-target", TARGETS[2][HOST[2]][0]]
-                  if sys.platform.startswith("linux") and platform.machine() == "x86_64" else [])
-        return [sys.executable, "-m", "ziglang", "cc", *target, *CFLAGS, f"-I{src.parent}", str(src), "-o", str(out),
-                "-lm"]
-    cc = shutil.which("gcc") or shutil.which("cc")
-    if cc is None:
-        raise RuntimeError("no C compiler for the native launch plant: pip install ziglang, or install gcc")
-    return [cc, *CFLAGS, f"-I{src.parent}", str(src), "-o", str(out), "-lm"]
-
-
 def library() -> Path:
-    """The compiled plant step (built on first use, cached by the sources' hash).
+    """The compiled plant step (built on first use, cached by the sources' hash; :func:`.hostlib.host_library`).
 
     Raises
     ------
     RuntimeError
         If no compiler is found or the build fails (with the compiler's message).
     """
-    src = fmu_sources()
-    digest = hashlib.sha256((src / SOURCE).read_bytes() + (src / HEADER).read_bytes()
-                            + " ".join(compile_command(Path(SOURCE), Path("lib"))).encode()).hexdigest()[:16]
-    suffix = ".dll" if sys.platform == "win32" else (".dylib" if sys.platform == "darwin" else ".so")
-    for folder in (_cache_dir(), Path(tempfile.gettempdir()) / "cushion_clutch"):
-        out = folder / f"launch_plant_{digest}{suffix}"
-        if out.exists():
-            return out
-        try:
-            folder.mkdir(parents=True, exist_ok=True)
-        except OSError:
-            continue
-        tmp = out.with_name(f"{out.stem}.{os.getpid()}{suffix}")
-        proc = subprocess.run(compile_command(src / SOURCE, tmp), capture_output=True, text=True)
-        if proc.returncode != 0 or not tmp.exists():
-            tmp.unlink(missing_ok=True)
-            raise RuntimeError(f"building the native launch plant failed:\n{proc.stderr}")
-        os.replace(tmp, out)                        # atomic: a parallel build leaves one whole library
-        return out
-    raise RuntimeError("no writable cache folder for the native launch plant")
+    return host_library("launch_plant", (SOURCE,), (HEADER,))
 
 
 _FFI = None

@@ -225,12 +225,12 @@ static void net_due(lp_consts *c, lp_state *s, double w_engine, double w_disc, i
     s->net_e = 0.0;
 }
 
-/* the network's figures in a step's row: the hotter metal friction surface (Python's max), the last node */
-static void net_figures(const lp_consts *c, const lp_state *s, lp_step_out *o)
+/* the network's figures in a row: the hotter metal friction surface (Python's max), the last node */
+static void net_figures(const lp_consts *c, const lp_state *s, double *surface, double *last)
 {
     double a = s->theta[c->net_surface[0]], b = s->theta[c->net_surface[1]];
-    o->theta_surface = b > a ? b : a;
-    o->theta_last = s->theta[c->net_n_nodes - 1];
+    *surface = b > a ? b : a;
+    *last = s->theta[c->net_n_nodes - 1];
 }
 
 /* the clutch FMU over one step of h from t, inputs held (fmu_client.ClutchFmu.step: fmi2SetReal only when they
@@ -266,8 +266,8 @@ static int clutch_step(const lp_consts *c, lp_state *s, double t, double h, doub
     return 0;
 }
 
-LP_EXPORT int lp_run_block(lp_consts *c, lp_state *s, const lp_block *blk, lp_step_out *out, int max_steps,
-                           int *fmi_status)
+LP_EXPORT int lp_run_block(lp_consts *c, lp_state *s, const lp_block *blk, lp_step_out *out, double *accel_out,
+                           int max_steps, int *fmi_status)
 {
     double h = c->h;
     int countdown = (int)blk->countdown;
@@ -329,20 +329,22 @@ LP_EXPORT int lp_run_block(lp_consts *c, lp_state *s, const lp_block *blk, lp_st
         o->w_e = s->w_e;
         o->w_d = s->w_d;
         o->v = s->v;
-        o->accel = accel;
+        o->accel = accel_out[j] = accel;
         o->t_c = s->t_c;
         o->theta_cm_step = theta_cm_step;
         o->throttle = s->throttle;
         o->locked = s->locked;
         o->t_shaft = c->k * s->phi + c->c * (s->w_d - s->v * c->i_tot / c->r);
         o->t_dem = t_dem;
-        net_figures(c, s, o);
+        net_figures(c, s, &o->theta_surface, &o->theta_last);
     }
+    if (j > 0)
+        s->theta_cm_step = out[j - 1].theta_cm_step;
+    s->steps = j;
     return j;
 }
 
-LP_EXPORT int lp_run_quiet(lp_consts *c, lp_state *s, double t, double h_quiet, double act_quiet, lp_step_out *out,
-                           int *fmi_status)
+LP_EXPORT int lp_run_quiet(lp_consts *c, lp_state *s, double t, double h_quiet, double act_quiet, int *fmi_status)
 {
     s->x_act *= act_quiet;
     int st = clutch_step(c, s, t, h_quiet, s->w_e, fmi_status);
@@ -350,17 +352,14 @@ LP_EXPORT int lp_run_quiet(lp_consts *c, lp_state *s, double t, double h_quiet, 
         return st;
     if (s->t_cap != 0.0)
         return -4;
-    out->theta_cm_step = s->theta_cm;
+    s->steps = 1.0;
+    s->n_events = 0.0;
+    s->theta_cm_step = s->theta_cm;
     double t_e = s->t_e = engine_torque(c, s, s->w_e, 0.0, 0, h_quiet);
     driveline_step(c, s, t_e, 0.0, 0, 1, h_quiet);
     s->net_n += c->tcu_every;
     if (s->net_n >= c->net_every)
         net_due(c, s, s->w_e, 0.0, 0);
-    out->w_e = s->w_e;
-    out->x_act = s->x_act;
-    out->theta_cs = s->theta_cs;
-    out->x_kiss = s->x_kiss;
-    out->throttle = s->throttle;
-    net_figures(c, s, out);
+    net_figures(c, s, &s->theta_surface, &s->theta_last);
     return 0;
 }

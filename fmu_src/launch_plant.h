@@ -46,14 +46,17 @@ typedef struct {
  * caller fills and reads at once. It lives in C over a run: the caller reads the head after every call and
  * the rest at a launch slot's end and the run's end. */
 typedef struct {
-    /* the head */
+    /* the head: after the last call's last step */
+    double steps;                   /* the last call's steps */
+    double n_events;                /* its lock/unlock events (0: the steps' event fields are all 0) */
     double w_e, w_d, v, phi, locked, t_e, x_act, theta_cm, t_cap, theta_cs, x_kiss, stalled, has_lock, lock_time;
-    double n_events;                /* lock/unlock events in the last call (0: the steps' event fields are all 0) */
+    double throttle, theta_cm_step; /* the engine's throttle, the facing temperature the FMU saw in the step */
+    double theta_surface, theta_last; /* the network: the hotter friction surface, the last node (quiet periods) */
     /* driveline */
     double engine_work, potential, slip, damping, resistance, brake;
     double t_c, slip_J, slip_W;
     /* engine */
-    double integral, throttle;
+    double integral;
     /* loop */
     double held0, held1, held2;     /* the FMU inputs last set: x_to, theta_cm, omega_slip */
     double lifted, net_n, net_e;
@@ -80,13 +83,13 @@ typedef struct {
 } lp_step_out;
 
 /* Run steps from blk->k0 until (exclusive) the next TCU cycle, the slot switch or the run's end; at most
- * max_steps. The thermal network steps every net_every steps. Returns the number of steps done (>= 1 unless
- * an error), or -1, -2, -3 if fmi2SetReal, fmi2DoStep, fmi2GetReal failed (its status in *fmi_status). */
-int lp_run_block(lp_consts *c, lp_state *s, const lp_block *blk, lp_step_out *out, int max_steps,
+ * max_steps. The thermal network steps every net_every steps. out: the steps' figures, accel: their
+ * accelerations (m/s2) once more, contiguous. Returns the number of steps done (>= 1 unless an error), or -1,
+ * -2, -3 if fmi2SetReal, fmi2DoStep, fmi2GetReal failed (its status in *fmi_status). */
+int lp_run_block(lp_consts *c, lp_state *s, const lp_block *blk, lp_step_out *out, double *accel, int max_steps,
                  int *fmi_status);
 /* One quiet TCU period (simulate.py: the car stands braked, the clutch open and retracted) of tcu_every steps
  * as one step of h_quiet = tcu_every h from t: the actuator's decay act_quiet, the clutch FMU, the idle engine,
- * the network. out: the period's figures (w_e, x_act, theta_cm_step, theta_cs, x_kiss, throttle, the network's).
- * Returns 0, -1..-3 as lp_run_block, or -4 if the FMU returned a torque (s->t_cap) with the bearing retracted. */
-int lp_run_quiet(lp_consts *c, lp_state *s, double t, double h_quiet, double act_quiet, lp_step_out *out,
-                 int *fmi_status);
+ * the network; the period's figures are in the state's head. Returns 0, -1..-3 as lp_run_block, or -4 if the
+ * FMU returned a torque (s->t_cap) with the bearing retracted. */
+int lp_run_quiet(lp_consts *c, lp_state *s, double t, double h_quiet, double act_quiet, int *fmi_status);

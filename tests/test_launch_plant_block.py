@@ -134,8 +134,40 @@ def test_fmu_refusal_raises_naming_the_function(fmu):
         native.start(LaunchRecord(1, False, h), 0.0, 400.0, 0.0, 0.0, 400.0, 0.0)
         args = dict(k0=0, n_steps=100, next_switch=1.0, slot_start=0.0, slot_end=1.0, countdown=10, x_cmd=1e-3,
                     pedal_level=0.5, t_dem=0.0, t_rate=0.0, engaged=True, braking=False, launching=True)
-        assert native.block(**args) == 10                    # ten steps to the next TCU cycle
+        assert native.block(**args)[0] == 10                 # ten steps to the next TCU cycle
         with pytest.raises(FmuCallError, match="fmi2DoStep"):
             native.block(**{**args, "k0": 10, "x_cmd": math.nan})
+    finally:
+        clutch.close()
+
+
+def test_quiet_period_refusals(fmu):
+    """lp_run_quiet: a torque with the bearing not retracted is reported (None: the loop raises), an input the
+    FMU refuses raises FmuCallError naming the function."""
+    from cushion_clutch.errors import FmuCallError
+    from cushion_clutch.launch.driveline import Driveline
+    from cushion_clutch.launch.engine import EngineGovernor
+    from cushion_clutch.launch.fmu_client import ClutchFmu
+    from cushion_clutch.launch.metrics import LaunchRecord
+    from cushion_clutch.launch.plant_block import HEAD, NativePlant
+    from cushion_clutch.model.thermal_network import ThermalNetwork
+
+    sc = _scenario("creep", 1)
+    h = sc.run.step_s
+    engine = EngineGovernor(sc.engine, h)
+    dl = Driveline(sc, engine.w_idle)
+    clutch = ClutchFmu(fmu, {})
+    try:
+        native = NativePlant(clutch, engine, dl, ThermalNetwork(sc.plant_thermal, 293.15, 300.0), h, 0.9, 300.0,
+                             0.3, 10, 10, 0.05, 30.0)
+        rec = LaunchRecord(1, False, h)
+        native.start(rec, 0.0, 300.0, 0.0, 0.0, 300.0, 0.0)
+        head = dict(zip(HEAD, native.quiet(0.0, 10 * h, 1.0)))       # retracted: no torque, the network stepped
+        assert head["t_cap"] == 0.0 and head["theta_cm"] != 300.0 and head["steps"] == 1.0
+        native.start(rec, 8e-3, 300.0, 0.0, 0.0, 300.0, 0.0)           # the bearing 8 mm in: the clutch grips
+        assert native.quiet(0.01, 10 * h, 1.0) is None and native.s.t_cap > 0.0
+        native.start(rec, math.nan, 300.0, 0.0, 0.0, 300.0, 0.0)
+        with pytest.raises(FmuCallError, match="fmi2DoStep"):
+            native.quiet(0.02, 10 * h, 1.0)
     finally:
         clutch.close()

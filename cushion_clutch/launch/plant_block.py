@@ -34,8 +34,8 @@ FMI_FUNCTIONS = {-1: "fmi2SetReal", -2: "fmi2DoStep", -3: "fmi2GetReal"}
 ROW_FIELDS = ("w_e", "w_d", "v", "accel", "x_act", "t_dem", "t_cap", "t_c", "theta_cm_step", "theta_cs", "x_kiss",
               "throttle", "locked", "t_shaft", "theta_surface", "theta_last")
 #: the first fields of ``lp_state``: what the loop reads after every call
-HEAD = ("w_e", "w_d", "v", "phi", "locked", "t_e", "x_act", "theta_cm", "t_cap", "theta_cs", "x_kiss", "stalled",
-        "has_lock", "lock_time", "n_events")
+HEAD = ("steps", "n_events", "w_e", "w_d", "v", "phi", "locked", "t_e", "x_act", "theta_cm", "t_cap", "theta_cs",
+        "x_kiss", "stalled", "has_lock", "lock_time", "throttle", "theta_cm_step", "theta_surface", "theta_last")
 #: the most nodes of a thermal network the C step takes (lp_state.theta)
 MAX_NODES = 16
 
@@ -117,11 +117,15 @@ class NativePlant:
         self.b = ffi.new("lp_block *")
         self.max_steps = tcu_every
         self.out = ffi.new("lp_step_out[]", tcu_every)
+        self.accel = ffi.new("double[]", tcu_every)
         self.status = ffi.new("int *")
         # the same memory as double[] (the structs are doubles only): filled and read with one call each
         self._s = ffi.cast("double *", self.s)
         self._b = ffi.cast("double *", self.b)
         self._o = ffi.cast("double *", self.out)
+        #: the last block's figures as one double array (``lp_step_out`` after ``lp_step_out``, :attr:`ix`)
+        self.values = self._o
+        self._unpack = getattr(ffi, "_backend", ffi).unpack        # cffi's own, without api.py's wrapper
         self._nb = ffi.sizeof("lp_block") // 8
         self.width = ffi.sizeof("lp_step_out") // 8
         #: index of each ``lp_step_out`` field in a step's values
@@ -131,6 +135,9 @@ class NativePlant:
         if tuple(name for name, _ in ffi.typeof("lp_state").fields)[:len(HEAD)] != HEAD:
             raise RuntimeError(f"{HEADER}: lp_state must start with {', '.join(HEAD)}")
         self.n_head = len(HEAD)
+        #: the start of each step's figures, for :meth:`row`
+        self._rows = [self._o + j * self.width for j in range(tcu_every)]
+        self.n_row = len(ROW_FIELDS)
 
     def _network(self, net, dt: float) -> None:
         """The network's constants for both clamp states, the fixed nodes' decay factors at the step ``dt``
@@ -203,18 +210,22 @@ class NativePlant:
 
     def head(self) -> list:
         """The state's head (:data:`HEAD`), as after the last call."""
-        return self.ffi.unpack(self._s, self.n_head)
+        return self._unpack(self._s, self.n_head)
 
-    def steps(self, m: int) -> list:
-        """The last call's ``m`` steps' figures, ``lp_step_out`` after ``lp_step_out`` (:attr:`width` values
-        each, in the struct's order) in one flat list."""
-        return self.ffi.unpack(self._o, m * self.width)
+    def row(self, j: int) -> list:
+        """Step ``j``'s figures of the last block in the series' rows (:data:`ROW_FIELDS`)."""
+        return self._unpack(self._rows[j], self.n_row)
+
+    def accels(self, m: int) -> list:
+        """The accelerations of the last block's ``m`` steps, m/s2."""
+        return self._unpack(self.accel, m)
 
     def block(self, k0: int, n_steps: int, next_switch: float, slot_start: float, slot_end: float, countdown: int,
               x_cmd: float, pedal_level: float, t_dem: float, t_rate: float, engaged: bool, braking: bool,
-              launching: bool) -> int:
-        """Run the steps from ``k0`` to the next TCU cycle (see ``lp_run_block``); returns their number
-        (:meth:`head` and :meth:`steps` give the state and their figures).
+              launching: bool) -> list:
+        """Run the steps from ``k0`` to the next TCU cycle (see ``lp_run_block``); returns the state's head
+        (:data:`HEAD`: ``steps`` their number; :meth:`row`, :meth:`accels` and :attr:`values` their
+        figures).
 
         Raises
         ------
@@ -223,24 +234,24 @@ class NativePlant:
         """
         self._b[0:self._nb] = (k0, n_steps, next_switch, slot_start, slot_end, countdown, x_cmd, pedal_level, t_dem,
                                t_rate, engaged, braking, launching)
-        n = self.run_block(self.c, self.s, self.b, self.out, self.max_steps, self.status)
+        n = self.run_block(self.c, self.s, self.b, self.out, self.accel, self.max_steps, self.status)
         if n < 0:
             raise FmuCallError(FMI_FUNCTIONS[n], self.status[0], f"t={k0 * self.c.h!r} (native launch plant)")
-        return n
+        return self._unpack(self._s, self.n_head)
 
-    def quiet(self, t: float, h_quiet: float, act_quiet: float) -> bool:
-        """One quiet TCU period from ``t`` (see ``lp_run_quiet``); False if the clutch FMU returned a torque
-        with the bearing retracted (the caller raises), else True (:meth:`head` and ``steps(1)`` give the state
-        and the period's figures).
+    def quiet(self, t: float, h_quiet: float, act_quiet: float) -> list | None:
+        """One quiet TCU period from ``t`` (see ``lp_run_quiet``); the state's head (:data:`HEAD`, with the
+        period's figures), or None if the clutch FMU returned a torque with the bearing retracted (the caller
+        raises; :meth:`head` gives it).
 
         Raises
         ------
         FmuCallError
             Naming the FMI function that failed.
         """
-        n = self.run_quiet(self.c, self.s, t, h_quiet, act_quiet, self.out, self.status)
+        n = self.run_quiet(self.c, self.s, t, h_quiet, act_quiet, self.status)
         if n == -4:
-            return False
+            return None
         if n < 0:
             raise FmuCallError(FMI_FUNCTIONS[n], self.status[0], f"t={t!r}, h={h_quiet!r} (native launch plant)")
-        return True
+        return self._unpack(self._s, self.n_head)

@@ -204,12 +204,10 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
         native = _native_plant(clutch, engine, dl, net, h, act, w_lift, prefill, tcu_every, net_every,
                                recs[0].alpha)
     if native is not None:               # the plant's state moves into C; where a step's figures are in its list
-        from .plant_block import ROW_FIELDS
         native.start(rec, x_act, theta_cm, t_e, t_cap, theta_cs, x_kiss)
-        native_block, native_quiet, native_head, native_steps = native.block, native.quiet, native.head, native.steps
-        width, n_row, ix = native.width, len(ROW_FIELDS), native.ix
-        o_kiss, o_theta_cs, o_t_cap, o_accel = ix["x_kiss"], ix["theta_cs"], ix["t_cap"], ix["accel"]
-        o_event = ix["event"]
+        native_block, native_quiet, native_row, native_accels = native.block, native.quiet, native.row, native.accels
+        values, width, ix = native.values, native.width, native.ix
+        o_kiss, o_theta_cs, o_t_cap, o_event = ix["x_kiss"], ix["theta_cs"], ix["t_cap"], ix["event"]
     wall0, cpu0 = time.perf_counter(), time.process_time()
     try:
         k = 0
@@ -252,12 +250,12 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
                 # (the clutch FMU's theta_cs and the facing decay are exact exponentials for held inputs; the
                 # idle engine is the same explicit step, stable and settled long before the next launch)
                 if native is not None:                  # the same period in C (plant_block)
-                    if not native_quiet(t, h_quiet, act_quiet):
-                        hd = native_head()
-                        raise _retracted_error(t, hd[8], hd[6], hd[10])
-                    (dl.w_e, _, _, _, _, t_e, x_act, theta_cm, t_cap, theta_cs, x_kiss, _, _, _, _) = native_head()
-                    (_, _, _, _, _, _, _, _, theta_cm_step, _, _, throttle, _, _, theta_surface,
-                     theta_last) = native_steps(1)[:n_row]
+                    head = native_quiet(t, h_quiet, act_quiet)
+                    if head is None:
+                        st = native.s
+                        raise _retracted_error(t, st.t_cap, st.x_act, st.x_kiss)
+                    (_, _, dl.w_e, _, _, _, _, t_e, x_act, theta_cm, t_cap, theta_cs, x_kiss, _, _, _, throttle,
+                     theta_cm_step, theta_surface, theta_last) = head
                 else:
                     x_act *= act_quiet
                     t_cap, theta_cs, x_kiss = clutch_step(t, h_quiet, x_act, theta_cm, dl.w_e)
@@ -296,44 +294,42 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
                 if cycled and sampling:                  # at the actual bearing position of the first step
                     x_cmd = ctl.x_cmd
                     believed = ctl.model_torque(x_cmd + (x_act - x_cmd) * act)
-                m = native_block(k, n_steps, next_switch, slot_start, slot_end, countdown, ctl.x_cmd, pedal_level,
-                                 ctl.t_dem, ctl.t_rate, engaged, braking, launching)
-                (dl.w_e, dl.w_d, dl.v, dl.phi, locked, t_e, x_act, theta_cm, t_cap, theta_cs, x_kiss, stalled,
-                 has_lock, lock_time, n_events) = native_head()
+                (m, n_events, dl.w_e, dl.w_d, dl.v, dl.phi, locked, t_e, x_act, theta_cm, t_cap, theta_cs, x_kiss,
+                 stalled, has_lock, lock_time, _, _, _, _) = native_block(
+                    k, n_steps, next_switch, slot_start, slot_end, countdown, ctl.x_cmd, pedal_level, ctl.t_dem,
+                    ctl.t_rate, engaged, braking, launching)
+                m = int(m)
                 dl.locked, stalled = locked != 0.0, stalled != 0.0
                 if has_lock and rec.lock_time is None:
                     rec.lock_time = lock_time
-                row_due = rec_countdown < m
-                if engaged or n_events or row_due or (cycled and sampling):
-                    out = native_steps(m)
-                    if engaged:
-                        if not rec.started:
-                            rec.start(ctl.kiss_now - out[o_kiss], out[o_theta_cs], ctl.theta_now - out[o_theta_cs])
-                        if not rec.acc:
-                            rec.t_first = tl + h - prefill
-                        rec.acc.extend(out[o_accel:m * width:width])
-                    if cycled and sampling:
-                        rec.characteristic(believed, out[o_t_cap])
-                    if n_events:
-                        for j in range(m):
-                            ev = out[j * width + o_event]
-                            if ev != 0.0:
-                                events.append((n + 1, "lock" if ev > 0 else "unlock",
-                                               (k + j) * h + h if ev != -1.0 else (k + j) * h))
-                    if row_due:
-                        theta_estimate = ctl.theta_cm_estimate()
-                        protection_level = ctl.protection.level if ctl.protection is not None else 0.0
-                        for j in range(rec_countdown, m, record_every):
-                            b = j * width
-                            t = (k + j) * h
-                            (w_e_o, w_d_o, v_o, accel_o, x_act_o, t_dem_o, t_cap_o, t_c_o, theta_cm_o, theta_cs_o,
-                             x_kiss_o, throttle_o, locked_o, t_shaft_o, theta_surface, theta_last) = out[b:b + n_row]
-                            rows.append((t, n + 1, w_e_o, w_d_o, v_o, accel_o, ctl.x_cmd, x_act_o, t_dem_o, t_cap_o,
-                                         t_c_o, theta_cm_o, theta_cs_o, ctl.theta_now, x_kiss_o, ctl.kiss_now,
-                                         throttle_o, locked_o, theta_estimate, believed if sampling else math.nan,
-                                         t_shaft_o, theta_surface, theta_last, protection_level))
-                            if progress is not None and (k + j) % 10000 == 0:
-                                progress(t)
+                if engaged:
+                    if not rec.started:
+                        theta_cs_0 = values[o_theta_cs]            # the block's first step
+                        rec.start(ctl.kiss_now - values[o_kiss], theta_cs_0, ctl.theta_now - theta_cs_0)
+                    if not rec.acc:
+                        rec.t_first = tl + h - prefill
+                    rec.acc.extend(native_accels(m))
+                if cycled and sampling:
+                    rec.characteristic(believed, values[o_t_cap])
+                if n_events:
+                    for j in range(m):
+                        ev = values[j * width + o_event]
+                        if ev != 0.0:
+                            events.append((n + 1, "lock" if ev > 0 else "unlock",
+                                           (k + j) * h + h if ev != -1.0 else (k + j) * h))
+                if rec_countdown < m:
+                    theta_estimate = ctl.theta_cm_estimate()
+                    protection_level = ctl.protection.level if ctl.protection is not None else 0.0
+                    for j in range(rec_countdown, m, record_every):
+                        t = (k + j) * h
+                        (w_e_o, w_d_o, v_o, accel_o, x_act_o, t_dem_o, t_cap_o, t_c_o, theta_cm_o, theta_cs_o,
+                         x_kiss_o, throttle_o, locked_o, t_shaft_o, theta_surface, theta_last) = native_row(j)
+                        rows.append((t, n + 1, w_e_o, w_d_o, v_o, accel_o, ctl.x_cmd, x_act_o, t_dem_o, t_cap_o,
+                                     t_c_o, theta_cm_o, theta_cs_o, ctl.theta_now, x_kiss_o, ctl.kiss_now,
+                                     throttle_o, locked_o, theta_estimate, believed if sampling else math.nan,
+                                     t_shaft_o, theta_surface, theta_last, protection_level))
+                        if progress is not None and (k + j) % 10000 == 0:
+                            progress(t)
                 rec_countdown = (rec_countdown - m) % record_every
                 countdown -= m
                 k += m

@@ -18,9 +18,10 @@ speed held over the step, the engine (:mod:`.engine`) and the compliant
 driveline (:mod:`.driveline`) advance, the facings heat up
 (:mod:`.thermal`) and the metrics are collected (:mod:`.metrics`).
 
-With the plant's thermal network (every shipped scenario) the steps from one TCU cycle to the next run in
-one compiled call by default (``plant="native"``, :mod:`.plant_block`): the same step, written out in C
-with the Python expressions' order of operations; the Python per-step code below stays the reference
+With the plant's thermal network (every shipped scenario) the steps from one TCU cycle to the next, the
+network's step among them, and each quiet period run in one compiled call by default (``plant="native"``,
+:mod:`.plant_block`; the plant's state stays in C over the run): the same steps, written out in C with the
+Python expressions' order of operations; the Python per-step code below stays the reference
 (``plant="python"``) and both give the same results (``tests/test_launch_plant_block.py``).
 """
 from __future__ import annotations

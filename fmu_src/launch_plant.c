@@ -6,8 +6,11 @@
  *
  * Per step: first-order actuator, the clutch FMU (inputs held over the step; fmi2SetReal only when they
  * change), the engine with its idle governor (engine.EngineGovernor.torque), the compliant driveline with
- * slip/lock and its energy books (driveline.Driveline.step), the slip energy into the thermal network's
- * accumulator, and the launch record's per-step metrics (metrics.LaunchRecord.step). */
+ * slip/lock and its energy books (driveline.Driveline.step), the slip energy into the thermal network, the
+ * network's step every net_every steps (model.thermal_network.ThermalNetwork.step: libm's exp and pow, as
+ * Python's math.exp and **), and the launch record's per-step metrics (metrics.LaunchRecord.step). A quiet TCU
+ * period (the car braked at rest, the clutch open) is one step of a TCU period (lp_run_quiet). The state
+ * (lp_state) stays here over a run; the caller reads its head after each call. */
 #include <math.h>
 #include <stddef.h>
 #include "launch_plant.h"
@@ -19,7 +22,7 @@
 #endif
 
 /* engine.EngineGovernor.torque */
-static double engine_torque(const lp_consts *c, lp_state *s, double w_e, double pedal, int stalled)
+static double engine_torque(const lp_consts *c, lp_state *s, double w_e, double pedal, int stalled, double h)
 {
     const double *w = c->curve_w, *t = c->curve_t;
     int n = c->n_curve;
@@ -38,7 +41,7 @@ static double engine_torque(const lp_consts *c, lp_state *s, double w_e, double 
     double gov = (c->kp * err + c->ki * s->integral + c->drag * w_e) / t_max;
     gov = gov > 1.0 ? 1.0 : (gov < 0.0 ? 0.0 : gov);
     if (pedal < gov && (gov < 1.0 || err < 0.0) && (gov > 0.0 || err > 0.0))
-        s->integral += err * c->h;
+        s->integral += err * h;
     double thr = pedal > gov ? pedal : gov;
     if (w_e > c->w_max || w_e <= c->w_stall || stalled)
         thr = 0.0;
@@ -48,9 +51,9 @@ static double engine_torque(const lp_consts *c, lp_state *s, double w_e, double 
 
 /* driveline.Driveline._shaft */
 static double shaft(const lp_consts *c, const lp_state *s, double j1, double t1, double w_v, double t_veh,
-                    int held)
+                    int held, double h)
 {
-    double h = c->h, kappa = c->kappa;
+    double kappa = c->kappa;
     if (held)
         return (c->k * s->phi + kappa * (s->w_d - 0.5 * w_v + 0.5 * h * t1 / j1)) / (1.0 + 0.5 * kappa * h / j1);
     return (c->k * s->phi + kappa * (s->w_d - w_v + 0.5 * h * (t1 / j1 + t_veh / c->j_v))) /
@@ -58,9 +61,9 @@ static double shaft(const lp_consts *c, const lp_state *s, double j1, double t1,
 }
 
 /* driveline.Driveline.step */
-static int driveline_step(const lp_consts *c, lp_state *s, double t_e, double t_cap, int engaged, int braking)
+static int driveline_step(const lp_consts *c, lp_state *s, double t_e, double t_cap, int engaged, int braking,
+                          double h)
 {
-    double h = c->h;
     double w_e = s->w_e, w_d = s->w_d, v = s->v;
     if (v == 0.0 && t_cap == 0.0 && w_d == 0.0 && s->phi == 0.0 && !s->locked) {
         double w_e_new = w_e + t_e / c->j_e * h;
@@ -80,7 +83,7 @@ static int driveline_step(const lp_consts *c, lp_state *s, double t_e, double t_
     double t_brake = braking && v > 0.0 ? c->brake_torque : 0.0;
     double t_s, t_c = 0.0, j1, t1;
     if (locked) {
-        t_s = shaft(c, s, j_lock, t_e, w_v, t_res + t_brake, 0);
+        t_s = shaft(c, s, j_lock, t_e, w_v, t_res + t_brake, 0, h);
         t_c = (c->j_disc * t_e + j_e * t_s) / j_lock;
         if (fabs(t_c) > t_cap) {
             locked = 0;
@@ -95,10 +98,10 @@ static int driveline_step(const lp_consts *c, lp_state *s, double t_e, double t_
         j1 = j_lock;
         t1 = t_e;
     }
-    t_s = shaft(c, s, j1, t1, w_v, t_res + t_brake, 0);
+    t_s = shaft(c, s, j1, t1, w_v, t_res + t_brake, 0, h);
     double w_v_new = w_v + h / j_v * (eta * t_s - t_res - t_brake);
     if (w_v_new < 0.0) {
-        t_s = shaft(c, s, j1, t1, w_v, 0.0, 1);
+        t_s = shaft(c, s, j1, t1, w_v, 0.0, 1, h);
         w_v_new = 0.0;
         t_brake = eta * t_s - t_res + j_v * w_v / h;
     }
@@ -167,7 +170,103 @@ static void record_step(const lp_consts *c, lp_state *s, double accel, double t_
     }
 }
 
-LP_EXPORT int lp_run_block(const lp_consts *c, lp_state *s, const lp_block *blk, lp_step_out *out,
+/* model.thermal_network.ThermalNetwork.step: advance the nodes th by dt with the slip power p_slip (W), the
+ * speeds (rad/s) and the clamp state held, node by node with the exact exponential for the neighbours held
+ * (the fixed nodes' decay factors are those of the step net_dt, recomputed as ThermalNetwork._prepare does
+ * for another step) */
+static void net_step(lp_consts *c, double *th, double dt, double p_slip, double w_engine, double w_disc,
+                     int clamped)
+{
+    lp_net_node *nodes = c->net[clamped];
+    int i, n = c->net_n_nodes;
+    if (dt != c->net_dt[clamped]) {
+        for (i = 0; i < n; i++)
+            if (nodes[i].fixed != 0.0)
+                nodes[i].decay = exp(-dt * nodes[i].gfix / nodes[i].cap);
+        c->net_dt[clamped] = dt;
+    }
+    double h_engine = c->net_h0 + c->net_hr * pow(fabs(w_engine) / c->net_wr, 0.8);
+    double h_disc = c->net_h0 + c->net_hr * pow(fabs(w_disc) / c->net_wr, 0.8);
+    double ta = c->net_ta, left = 0.0;
+    for (i = 0; i < n; i++) {
+        const lp_net_node *q = nodes + i;
+        double flow = q->share * p_slip + q->ge_te;
+        if (q->gl != 0.0)
+            flow += q->gl * left;
+        if (q->gr != 0.0)
+            flow += q->gr * th[i + 1];
+        double gs, decay = q->decay;
+        if (q->fixed == 0.0) {
+            double conv = q->area * (q->on_disc != 0.0 ? h_disc : h_engine);
+            gs = q->gfix + conv;
+            flow += conv * ta;
+            if (gs > 0.0)
+                decay = exp(-dt * gs / q->cap);
+        } else {
+            gs = q->gfix;
+        }
+        if (gs > 0.0) {
+            double inf = flow / gs;
+            left = th[i] = inf + (th[i] - inf) * decay;
+        } else {
+            left = th[i] = th[i] + flow * dt / q->cap;
+        }
+    }
+}
+
+/* the network is due after a step (simulate.py: after the driveline, with its speeds): step it with the slip
+ * energy gathered since its last step, theta_cm the facings' mean */
+static void net_due(lp_consts *c, lp_state *s, double w_engine, double w_disc, int clamped)
+{
+    double dt = s->net_n * c->h;
+    net_step(c, s->theta, dt, s->net_e / (s->net_n * c->h), w_engine, w_disc, clamped);
+    s->theta_cm = 0.5 * (s->theta[c->net_cm[0]] + s->theta[c->net_cm[1]]);
+    s->net_n = 0.0;
+    s->net_e = 0.0;
+}
+
+/* the network's figures in a row: the hotter metal friction surface (Python's max), the last node */
+static void net_figures(const lp_consts *c, const lp_state *s, double *surface, double *last)
+{
+    double a = s->theta[c->net_surface[0]], b = s->theta[c->net_surface[1]];
+    *surface = b > a ? b : a;
+    *last = s->theta[c->net_n_nodes - 1];
+}
+
+/* the clutch FMU over one step of h from t, inputs held (fmu_client.ClutchFmu.step: fmi2SetReal only when they
+ * changed); 0 or the failed function's code (lp_run_block) */
+static int clutch_step(const lp_consts *c, lp_state *s, double t, double h, double omega_slip, int *fmi_status)
+{
+    if (omega_slip != s->held2 || s->x_act != s->held0 || s->theta_cm != s->held1) {
+        double v_in[3] = {s->x_act, s->theta_cm, omega_slip};
+        s->held0 = s->x_act;
+        s->held1 = s->theta_cm;
+        s->held2 = omega_slip;
+        int st = c->set_real(c->comp, c->vr_in, 3, v_in);
+        if (st > 1) {
+            s->held0 = NAN;
+            *fmi_status = st;
+            return -1;
+        }
+    }
+    int st = c->do_step(c->comp, t, h, 1);
+    if (st > 1) {
+        *fmi_status = st;
+        return -2;
+    }
+    double v_out[3];
+    st = c->get_real(c->comp, c->vr_out, 3, v_out);
+    if (st > 1) {
+        *fmi_status = st;
+        return -3;
+    }
+    s->t_cap = v_out[0];
+    s->theta_cs = v_out[1];
+    s->x_kiss = v_out[2];
+    return 0;
+}
+
+LP_EXPORT int lp_run_block(lp_consts *c, lp_state *s, const lp_block *blk, lp_step_out *out, double *accel_out,
                            int max_steps, int *fmi_status)
 {
     double h = c->h;
@@ -175,6 +274,7 @@ LP_EXPORT int lp_run_block(const lp_consts *c, lp_state *s, const lp_block *blk,
     int engaged = blk->engaged != 0.0, braking = blk->braking != 0.0, launching = blk->launching != 0.0;
     int j = 0;
     long n_steps = (long)blk->n_steps;
+    s->n_events = 0.0;
     for (long k = (long)blk->k0; k < n_steps && j < max_steps; k++, j++) {
         double t = (double)k * h;
         if (j > 0 && (countdown == 0 || t >= blk->next_switch))
@@ -185,40 +285,16 @@ LP_EXPORT int lp_run_block(const lp_consts *c, lp_state *s, const lp_block *blk,
         double x_cmd = blk->x_cmd;
         s->x_act = x_cmd + (s->x_act - x_cmd) * c->act;
         double w_e = s->w_e;
-        /* the clutch FMU, inputs held over the step */
-        double omega_slip = w_e - s->w_d;
-        if (omega_slip != s->held2 || s->x_act != s->held0 || s->theta_cm != s->held1) {
-            double v_in[3] = {s->x_act, s->theta_cm, omega_slip};
-            s->held0 = s->x_act;
-            s->held1 = s->theta_cm;
-            s->held2 = omega_slip;
-            int st = c->set_real(c->comp, c->vr_in, 3, v_in);
-            if (st > 1) {
-                s->held0 = NAN;
-                *fmi_status = st;
-                return -1;
-            }
-        }
-        int st = c->do_step(c->comp, t, h, 1);
-        if (st > 1) {
-            *fmi_status = st;
-            return -2;
-        }
-        double v_out[3];
-        st = c->get_real(c->comp, c->vr_out, 3, v_out);
-        if (st > 1) {
-            *fmi_status = st;
-            return -3;
-        }
-        double t_cap = s->t_cap = v_out[0];
-        s->theta_cs = v_out[1];
-        s->x_kiss = v_out[2];
+        int st = clutch_step(c, s, t, h, w_e - s->w_d, fmi_status);
+        if (st < 0)
+            return st;
+        double t_cap = s->t_cap;
         if (engaged && !s->lifted && s->has_lock && w_e > c->w_lift)
             s->lifted = 1;
         double t_e = s->t_e = engine_torque(c, s, w_e, engaged && !s->lifted ? blk->pedal_level : 0.0,
-                                            s->stalled != 0.0);
+                                            s->stalled != 0.0, h);
         double v = s->v;
-        int ev = driveline_step(c, s, t_e, t_cap, engaged, braking);
+        int ev = driveline_step(c, s, t_e, t_cap, engaged, braking, h);
         o->event = ev;
         if (ev > 0 && !s->has_lock) {
             s->has_lock = 1;
@@ -228,9 +304,8 @@ LP_EXPORT int lp_run_block(const lp_consts *c, lp_state *s, const lp_block *blk,
         s->rec_slip_J += s->slip_J;
         s->net_e += s->slip_J;
         s->net_n += 1;
-        o->net_due = s->net_n == (double)c->net_every;
-        o->net_w_e = s->w_e;
-        o->net_w_d = s->w_d;
+        if (s->net_n == (double)c->net_every)
+            net_due(c, s, s->w_e, s->w_d, engaged);
         double accel = (s->v - v) / h;
         double t_dem = blk->t_dem + blk->t_rate * (double)(c->tcu_every - countdown) * h;
         if (engaged) {
@@ -241,6 +316,8 @@ LP_EXPORT int lp_run_block(const lp_consts *c, lp_state *s, const lp_block *blk,
             s->locked = 0;
             o->event = -2;
         }
+        if (o->event != 0.0)
+            s->n_events += 1;
         if (s->stalled && tl + h >= blk->slot_end - blk->slot_start - h) {    /* driveline.restart_engine */
             s->engine_work += 0.5 * c->j_e * (pow(c->w_idle, 2.0) - pow(s->w_e, 2.0));
             s->w_e = c->w_idle;
@@ -252,17 +329,37 @@ LP_EXPORT int lp_run_block(const lp_consts *c, lp_state *s, const lp_block *blk,
         o->w_e = s->w_e;
         o->w_d = s->w_d;
         o->v = s->v;
-        o->accel = accel;
+        o->accel = accel_out[j] = accel;
         o->t_c = s->t_c;
         o->theta_cm_step = theta_cm_step;
         o->throttle = s->throttle;
         o->locked = s->locked;
         o->t_shaft = c->k * s->phi + c->c * (s->w_d - s->v * c->i_tot / c->r);
         o->t_dem = t_dem;
-        if (o->net_due != 0.0) {
-            j++;
-            break;                                   /* the network steps (the caller's), theta_cm changes */
-        }
+        net_figures(c, s, &o->theta_surface, &o->theta_last);
     }
+    if (j > 0)
+        s->theta_cm_step = out[j - 1].theta_cm_step;
+    s->steps = j;
     return j;
+}
+
+LP_EXPORT int lp_run_quiet(lp_consts *c, lp_state *s, double t, double h_quiet, double act_quiet, int *fmi_status)
+{
+    s->x_act *= act_quiet;
+    int st = clutch_step(c, s, t, h_quiet, s->w_e, fmi_status);
+    if (st < 0)
+        return st;
+    if (s->t_cap != 0.0)
+        return -4;
+    s->steps = 1.0;
+    s->n_events = 0.0;
+    s->theta_cm_step = s->theta_cm;
+    double t_e = s->t_e = engine_torque(c, s, s->w_e, 0.0, 0, h_quiet);
+    driveline_step(c, s, t_e, 0.0, 0, 1, h_quiet);
+    s->net_n += c->tcu_every;
+    if (s->net_n >= c->net_every)
+        net_due(c, s, s->w_e, 0.0, 0);
+    net_figures(c, s, &s->theta_surface, &s->theta_last);
+    return 0;
 }

@@ -6,6 +6,14 @@ typedef int (*lp_set_real)(void *c, const unsigned int vr[], size_t nvr, const d
 typedef int (*lp_get_real)(void *c, const unsigned int vr[], size_t nvr, double value[]);
 typedef int (*lp_do_step)(void *c, double t, double h, int no_set_prior);
 
+/* one node of the plant's thermal network for one clamp state: the per-node constants of
+ * model.thermal_network.ThermalNetwork.step (ThermalNetwork._prepare), flags as 0/1 */
+typedef struct {
+    double cap, gl, gr, area, on_disc, ge_te, gfix, share; /* J/K, W/K, W/K, m2, 1, W, W/K, 1 */
+    double fixed;                   /* 1: no convection and gfix > 0, the decay factor is a constant of the step */
+    double decay;                   /* exp(-dt gfix / cap) at the step net_dt of its clamp state (fixed nodes) */
+} lp_net_node;
+
 /* constants of a run */
 typedef struct {
     /* the clutch FMU (FMI 2 co-simulation, loaded by fmpy): component, functions, value references */
@@ -25,23 +33,37 @@ typedef struct {
     /* loop (simulate.simulate_launches) and metrics (metrics.LaunchRecord.step) */
     double h, act, w_lift, prefill, alpha_jerk, creep_nm;
     int tcu_every, net_every;
+    /* the plant's thermal network (model.thermal_network.ThermalNetwork), nodes per clamp state (0 open, 1 clamped) */
+    int net_n_nodes;
+    int net_cm[2];                  /* the two facing nodes: theta_cm is their mean */
+    int net_surface[2];             /* the two metal friction surfaces: the series' theta_surface is the hotter */
+    double net_h0, net_hr, net_wr, net_ta; /* still air, rotating W/(m2 K), its reference speed rad/s, air K */
+    double net_dt[2];               /* the step the fixed nodes' decay factors are for, per clamp state, s */
+    lp_net_node net[2][16];
 } lp_consts;
 
-/* The state carried across steps (copied in and out around a block), the block's inputs and a step's figures:
- * doubles only (flags 0/1, counts exact), so that each is also a double[] the caller fills and reads at once. */
+/* The state carried across calls, doubles only (flags 0/1, counts exact), so that it is also a double[] the
+ * caller fills and reads at once. It lives in C over a run: the caller reads the head after every call and
+ * the rest at a launch slot's end and the run's end. */
 typedef struct {
+    /* the head: after the last call's last step */
+    double steps;                   /* the last call's steps */
+    double n_events;                /* its lock/unlock events (0: the steps' event fields are all 0) */
+    double w_e, w_d, v, phi, locked, t_e, x_act, theta_cm, t_cap, theta_cs, x_kiss, stalled, has_lock, lock_time;
+    double throttle, theta_cm_step; /* the engine's throttle, the facing temperature the FMU saw in the step */
+    double theta_surface, theta_last; /* the network: the hotter friction surface, the last node (quiet periods) */
     /* driveline */
-    double w_e, w_d, v, phi, locked;
     double engine_work, potential, slip, damping, resistance, brake;
     double t_c, slip_J, slip_W;
     /* engine */
-    double integral, throttle, t_e;
+    double integral;
     /* loop */
-    double x_act, theta_cm, t_cap, theta_cs, x_kiss;
     double held0, held1, held2;     /* the FMU inputs last set: x_to, theta_cm, omega_slip */
-    double lifted, stalled, net_n, net_e;
+    double lifted, net_n, net_e;
     /* the launch record */
-    double has_lock, rec_stall, lock_time, rec_slip_J, a_filt, jerk, sq_err, max_err, sum_creep, n_err, n_creep;
+    double rec_stall, rec_slip_J, a_filt, jerk, sq_err, max_err, sum_creep, n_err, n_creep;
+    /* the thermal network's node temperatures, K */
+    double theta[16];
 } lp_state;
 
 /* held over a block: set by the TCU cycle before it */
@@ -56,13 +78,18 @@ typedef struct {
 /* one step's figures (the series' row, the metrics' inputs) */
 typedef struct {
     double w_e, w_d, v, accel, x_act, t_dem, t_cap, t_c, theta_cm_step, theta_cs, x_kiss, throttle, locked, t_shaft;
+    double theta_surface, theta_last; /* the network after the step: the hotter friction surface, the last node */
     double event;                   /* 1 locked (at t + h), -1 unlocked in the step (at t), -2 unlocked as the TCU let go (at t + h) */
-    double net_due;                 /* the thermal network steps after this step, with net_w_e, net_w_d */
-    double net_w_e, net_w_d;
 } lp_step_out;
 
-/* Run steps from blk->k0 until (exclusive) the next TCU cycle, the slot switch, the run's end or after the
- * step that makes the thermal network due; at most max_steps. Returns the number of steps done (>= 1 unless
- * an error), or -1, -2, -3 if fmi2SetReal, fmi2DoStep, fmi2GetReal failed (its status in *fmi_status). */
-int lp_run_block(const lp_consts *c, lp_state *s, const lp_block *blk, lp_step_out *out, int max_steps,
+/* Run steps from blk->k0 until (exclusive) the next TCU cycle, the slot switch or the run's end; at most
+ * max_steps. The thermal network steps every net_every steps. out: the steps' figures, accel: their
+ * accelerations (m/s2) once more, contiguous. Returns the number of steps done (>= 1 unless an error), or -1,
+ * -2, -3 if fmi2SetReal, fmi2DoStep, fmi2GetReal failed (its status in *fmi_status). */
+int lp_run_block(lp_consts *c, lp_state *s, const lp_block *blk, lp_step_out *out, double *accel, int max_steps,
                  int *fmi_status);
+/* One quiet TCU period (simulate.py: the car stands braked, the clutch open and retracted) of tcu_every steps
+ * as one step of h_quiet = tcu_every h from t: the actuator's decay act_quiet, the clutch FMU, the idle engine,
+ * the network; the period's figures are in the state's head. Returns 0, -1..-3 as lp_run_block, or -4 if the
+ * FMU returned a torque (s->t_cap) with the bearing retracted. */
+int lp_run_quiet(lp_consts *c, lp_state *s, double t, double h_quiet, double act_quiet, int *fmi_status);

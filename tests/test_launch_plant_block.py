@@ -1,6 +1,8 @@
 """The compiled plant steps (launch/plant_block.py, fmu_src/launch_plant.c) against the Python loop, the reference.
 
-Both paths must give the same time series, per-launch metrics, energy terms, lock events and TCU estimates.
+Both paths must give the same time series, per-launch metrics, energy terms, lock events and TCU estimates
+(the plant's thermal network steps in C too, in the blocks and in the quiet periods: its temperatures are in
+the series and, through theta_cm, in everything else).
 The C step keeps the Python expressions' order of operations and is built without FMA contraction, so on
 this machine they agree bit for bit; the test allows 1e-12 relative (a compiler on another platform may
 round a libm call differently) and reports the largest difference.
@@ -66,6 +68,25 @@ def test_creep_native_equals_python(fmu, tcu):
     nat = simulate_launches(fmu, sc, table, tcu, plant="native")
     _assert_same(py, nat)
     assert py.lock_events and not any(m["engine_stall"] for m in py.metrics)
+    assert py.quiet_s > 5.0                    # quiet periods (the network stepped in lp_run_quiet) are covered
+
+
+def test_rows_off_the_tcu_period_native_equals_python(fmu):
+    """Rows every 3 steps (not a divisor of the 10-step TCU period): the rows due inside a block and inside a
+    quiet period are found by counting, in both loops; the network's temperatures in every row."""
+    sc = _scenario("creep", 1, 14.0)
+    table = load_table()
+    py = simulate_launches(fmu, sc, table, "naive", record_every=3, plant="python")
+    nat = simulate_launches(fmu, sc, table, "naive", record_every=3, plant="native")
+    _assert_same(py, nat)
+    assert len(py.series) == -(-round(sc.run.duration() / sc.run.step_s) // 3) and py.quiet_s > 0.0
+    assert np.all(np.diff(py.series["time_s"]) > 0.0)
+    assert not np.any(np.isnan(nat.series["theta_surface_K"]))
+
+
+def test_record_every_below_one_named(fmu):
+    with pytest.raises(ValueError, match="record_every = 0: must be at least 1"):
+        simulate_launches(fmu, _scenario("creep", 1, 14.0), load_table(), "naive", record_every=0)
 
 
 def test_stall_and_restart_native_equals_python(fmu):
@@ -100,6 +121,7 @@ def test_fmu_refusal_raises_naming_the_function(fmu):
     from cushion_clutch.launch.fmu_client import ClutchFmu
     from cushion_clutch.launch.metrics import LaunchRecord
     from cushion_clutch.launch.plant_block import NativePlant
+    from cushion_clutch.model.thermal_network import ThermalNetwork
 
     sc = _scenario("creep", 1)
     h = sc.run.step_s
@@ -107,13 +129,45 @@ def test_fmu_refusal_raises_naming_the_function(fmu):
     dl = Driveline(sc, engine.w_idle)
     clutch = ClutchFmu(fmu, {})
     try:
-        native = NativePlant(clutch, engine, dl, h, 0.9, 300.0, 0.3, 10, 10, 0.05, 30.0)
-        rec = LaunchRecord(1, False, h)
+        native = NativePlant(clutch, engine, dl, ThermalNetwork(sc.plant_thermal, 293.15, 400.0), h, 0.9, 300.0,
+                             0.3, 10, 10, 0.05, 30.0)
+        native.start(LaunchRecord(1, False, h), 0.0, 400.0, 0.0, 0.0, 400.0, 0.0)
         args = dict(k0=0, n_steps=100, next_switch=1.0, slot_start=0.0, slot_end=1.0, countdown=10, x_cmd=1e-3,
-                    pedal_level=0.5, t_dem=0.0, t_rate=0.0, engaged=True, braking=False, launching=True, x_act=0.0,
-                    theta_cm=400.0, lifted=False, stalled=False, net_n=0, net_e=0.0, rec=rec)
+                    pedal_level=0.5, t_dem=0.0, t_rate=0.0, engaged=True, braking=False, launching=True)
         assert native.block(**args)[0] == 10                 # ten steps to the next TCU cycle
         with pytest.raises(FmuCallError, match="fmi2DoStep"):
             native.block(**{**args, "k0": 10, "x_cmd": math.nan})
+    finally:
+        clutch.close()
+
+
+def test_quiet_period_refusals(fmu):
+    """lp_run_quiet: a torque with the bearing not retracted is reported (None: the loop raises), an input the
+    FMU refuses raises FmuCallError naming the function."""
+    from cushion_clutch.errors import FmuCallError
+    from cushion_clutch.launch.driveline import Driveline
+    from cushion_clutch.launch.engine import EngineGovernor
+    from cushion_clutch.launch.fmu_client import ClutchFmu
+    from cushion_clutch.launch.metrics import LaunchRecord
+    from cushion_clutch.launch.plant_block import HEAD, NativePlant
+    from cushion_clutch.model.thermal_network import ThermalNetwork
+
+    sc = _scenario("creep", 1)
+    h = sc.run.step_s
+    engine = EngineGovernor(sc.engine, h)
+    dl = Driveline(sc, engine.w_idle)
+    clutch = ClutchFmu(fmu, {})
+    try:
+        native = NativePlant(clutch, engine, dl, ThermalNetwork(sc.plant_thermal, 293.15, 300.0), h, 0.9, 300.0,
+                             0.3, 10, 10, 0.05, 30.0)
+        rec = LaunchRecord(1, False, h)
+        native.start(rec, 0.0, 300.0, 0.0, 0.0, 300.0, 0.0)
+        head = dict(zip(HEAD, native.quiet(0.0, 10 * h, 1.0)))       # retracted: no torque, the network stepped
+        assert head["t_cap"] == 0.0 and head["theta_cm"] != 300.0 and head["steps"] == 1.0
+        native.start(rec, 8e-3, 300.0, 0.0, 0.0, 300.0, 0.0)           # the bearing 8 mm in: the clutch grips
+        assert native.quiet(0.01, 10 * h, 1.0) is None and native.s.t_cap > 0.0
+        native.start(rec, math.nan, 300.0, 0.0, 0.0, 300.0, 0.0)
+        with pytest.raises(FmuCallError, match="fmi2DoStep"):
+            native.quiet(0.02, 10 * h, 1.0)
     finally:
         clutch.close()

@@ -18,9 +18,10 @@ speed held over the step, the engine (:mod:`.engine`) and the compliant
 driveline (:mod:`.driveline`) advance, the facings heat up
 (:mod:`.thermal`) and the metrics are collected (:mod:`.metrics`).
 
-With the plant's thermal network (every shipped scenario) the steps from one TCU cycle to the next run in
-one compiled call by default (``plant="native"``, :mod:`.plant_block`): the same step, written out in C
-with the Python expressions' order of operations; the Python per-step code below stays the reference
+With the plant's thermal network (every shipped scenario) the steps from one TCU cycle to the next, the
+network's step among them, and each quiet period run in one compiled call by default (``plant="native"``,
+:mod:`.plant_block`; the plant's state stays in C over the run): the same steps, written out in C with the
+Python expressions' order of operations; the Python per-step code below stays the reference
 (``plant="python"``) and both give the same results (``tests/test_launch_plant_block.py``).
 """
 from __future__ import annotations
@@ -97,15 +98,21 @@ def _facing_profile(path: str) -> Callable[[float], float]:
     return lambda x: float(np.interp(x, t, th))
 
 
-def _native_plant(clutch, engine, dl, h, act, w_lift, prefill, tcu_every, net_every, alpha):
+def _native_plant(clutch, engine, dl, net, h, act, w_lift, prefill, tcu_every, net_every, alpha):
     """The compiled plant steps (:mod:`.plant_block`), or None (logged) if the library cannot be built."""
     from .metrics import CREEP_NM
     from .plant_block import NativePlant
     try:
-        return NativePlant(clutch, engine, dl, h, act, w_lift, prefill, tcu_every, net_every, alpha, CREEP_NM)
+        return NativePlant(clutch, engine, dl, net, h, act, w_lift, prefill, tcu_every, net_every, alpha, CREEP_NM)
     except (RuntimeError, ValueError, OSError) as exc:
         log.warning("the native launch plant is not available, running the Python loop: %s", exc)
         return None
+
+
+def _retracted_error(t: float, t_cap: float, x_act: float, x_kiss: float) -> RuntimeError:
+    """A quiet period's clutch FMU returned a torque with the bearing retracted."""
+    return RuntimeError(f"t = {t:g} s: the clutch FMU returned {t_cap:g} N.m with the bearing "
+                        f"retracted to {x_act:g} m (kiss point {x_kiss:g} m)")
 
 
 def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bool = "naive",
@@ -125,6 +132,8 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
         raise ValueError(f"tcu = {tcu!r}: allowed {', '.join(VARIANTS)}")
     if plant not in PLANTS:
         raise ValueError(f"plant = {plant!r}: allowed {', '.join(PLANTS)}")
+    if record_every < 1:
+        raise ValueError(f"record_every = {record_every!r}: must be at least 1 (steps between the series' rows)")
     fac, tc, run, drv = sc.facing, sc.tcu, sc.run, sc.driver
     h = run.step_s
     theta_a, theta0 = fac.ambient_degC + KELVIN, fac.initial_degC + KELVIN
@@ -193,12 +202,13 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
     n_quiet = 0
     native = None
     if plant == "native" and net is not None:
-        native = _native_plant(clutch, engine, dl, h, act, w_lift, prefill, tcu_every, net_every, recs[0].alpha)
-    if native is not None:               # where a step's figures are in the native block's flat list
-        from .plant_block import ROW_FIELDS
-        width, n_row, ix = native.width, len(ROW_FIELDS), native.ix
-        o_kiss, o_theta_cs, o_t_cap, o_accel = ix["x_kiss"], ix["theta_cs"], ix["t_cap"], ix["accel"]
-        o_event, o_net_due, o_net_w_e, o_net_w_d = ix["event"], ix["net_due"], ix["net_w_e"], ix["net_w_d"]
+        native = _native_plant(clutch, engine, dl, net, h, act, w_lift, prefill, tcu_every, net_every,
+                               recs[0].alpha)
+    if native is not None:               # the plant's state moves into C; where a step's figures are in its list
+        native.start(rec, x_act, theta_cm, t_e, t_cap, theta_cs, x_kiss)
+        native_block, native_quiet, native_row, native_accels = native.block, native.quiet, native.row, native.accels
+        values, width, ix = native.values, native.width, native.ix
+        o_kiss, o_theta_cs, o_t_cap, o_event = ix["x_kiss"], ix["theta_cs"], ix["t_cap"], ix["event"]
     wall0, cpu0 = time.perf_counter(), time.process_time()
     try:
         k = 0
@@ -206,6 +216,8 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
             t = k * h
             if t >= next_switch:
                 n += 1
+                if native is not None:
+                    native.new_slot(rec, recs[n])
                 rec, slot_start, slot_end = recs[n], starts[n], ends[n]
                 next_switch = slot_end - 0.5 * h if n + 1 < n_slots else math.inf
                 stalled = lifted = False
@@ -238,35 +250,42 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
                 # engine's idle governor and the temperatures move: one step of h_quiet for all of them
                 # (the clutch FMU's theta_cs and the facing decay are exact exponentials for held inputs; the
                 # idle engine is the same explicit step, stable and settled long before the next launch)
-                x_act *= act_quiet
-                t_cap, theta_cs, x_kiss = clutch_step(t, h_quiet, x_act, theta_cm, dl.w_e)
-                if t_cap != 0.0:
-                    raise RuntimeError(f"t = {t:g} s: the clutch FMU returned {t_cap:g} N.m with the bearing "
-                                       f"retracted to {x_act:g} m (kiss point {x_kiss:g} m)")
-                theta_cm_step = theta_cm
-                engine.h = dl.h = h_quiet
-                t_e = engine_torque(dl.w_e, 0.0, False)
-                dl_step(t_e, 0.0, False, True)
-                engine.h = dl.h = h
-                if net is not None:
-                    net_n += tcu_every
-                    if net_n >= net_every:
-                        net.step(net_n * h, net_e / (net_n * h), dl.w_e, 0.0, False)
-                        theta_cm, net_n, net_e = net.theta_cm, 0, 0.0
-                elif profile is not None:
-                    theta_cm = profile(t + h_quiet)
+                if native is not None:                  # the same period in C (plant_block)
+                    head = native_quiet(t, h_quiet, act_quiet)
+                    if head is None:
+                        st = native.s
+                        raise _retracted_error(t, st.t_cap, st.x_act, st.x_kiss)
+                    (_, _, dl.w_e, _, _, _, _, t_e, x_act, theta_cm, t_cap, theta_cs, x_kiss, _, _, _, throttle,
+                     theta_cm_step, theta_surface, theta_last) = head
                 else:
-                    theta_cm = facing_quiet.step(theta_cm, 0.0)
-                for j in range(tcu_every):
-                    if rec_countdown == 0:
-                        rec_countdown = record_every
-                        rows.append((t + j * h, n + 1, dl.w_e, 0.0, 0.0, 0.0, 0.0, x_act, 0.0, 0.0, 0.0,
-                                     theta_cm_step, theta_cs, ctl.theta_now, x_kiss, ctl.kiss_now, engine.throttle,
-                                     0.0, ctl.theta_cm_estimate(), math.nan, 0.0, *net_temps(),
-                                     ctl.protection.level if ctl.protection is not None else 0.0))
-                        if progress is not None and (k + j) % 10000 == 0:
-                            progress(t + j * h)
-                    rec_countdown -= 1
+                    x_act *= act_quiet
+                    t_cap, theta_cs, x_kiss = clutch_step(t, h_quiet, x_act, theta_cm, dl.w_e)
+                    if t_cap != 0.0:
+                        raise _retracted_error(t, t_cap, x_act, x_kiss)
+                    theta_cm_step = theta_cm
+                    engine.h = dl.h = h_quiet
+                    t_e = engine_torque(dl.w_e, 0.0, False)
+                    dl_step(t_e, 0.0, False, True)
+                    engine.h = dl.h = h
+                    if net is not None:
+                        net_n += tcu_every
+                        if net_n >= net_every:
+                            net.step(net_n * h, net_e / (net_n * h), dl.w_e, 0.0, False)
+                            theta_cm, net_n, net_e = net.theta_cm, 0, 0.0
+                    elif profile is not None:
+                        theta_cm = profile(t + h_quiet)
+                    else:
+                        theta_cm = facing_quiet.step(theta_cm, 0.0)
+                    throttle = engine.throttle
+                    theta_surface, theta_last = net_temps()
+                for j in range(rec_countdown, tcu_every, record_every):      # the rows due in the period
+                    rows.append((t + j * h, n + 1, dl.w_e, 0.0, 0.0, 0.0, 0.0, x_act, 0.0, 0.0, 0.0,
+                                 theta_cm_step, theta_cs, ctl.theta_now, x_kiss, ctl.kiss_now, throttle,
+                                 0.0, ctl.theta_cm_estimate(), math.nan, 0.0, theta_surface, theta_last,
+                                 ctl.protection.level if ctl.protection is not None else 0.0))
+                    if progress is not None and (k + j) % 10000 == 0:
+                        progress(t + j * h)
+                rec_countdown = (rec_countdown - tcu_every) % record_every
                 countdown = 0
                 k += tcu_every
                 n_quiet += 1
@@ -276,43 +295,43 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
                 if cycled and sampling:                  # at the actual bearing position of the first step
                     x_cmd = ctl.x_cmd
                     believed = ctl.model_torque(x_cmd + (x_act - x_cmd) * act)
-                (m, x_act, lifted, stalled, net_n, net_e, t_e, t_cap, theta_cs, x_kiss, out) = native.block(
-                    k, n_steps, next_switch, slot_start, slot_end, countdown, ctl.x_cmd,
-                    pedal_level, ctl.t_dem, ctl.t_rate, engaged, braking, launching, x_act, theta_cm, lifted,
-                    stalled, net_n, net_e, rec)
-                if engaged and not rec.started:
-                    rec.start(ctl.kiss_now - out[o_kiss], out[o_theta_cs], ctl.theta_now - out[o_theta_cs])
-                if cycled and sampling:
-                    rec.characteristic(believed, out[o_t_cap])
+                (m, n_events, dl.w_e, dl.w_d, dl.v, dl.phi, locked, t_e, x_act, theta_cm, t_cap, theta_cs, x_kiss,
+                 stalled, has_lock, lock_time, _, _, _, _) = native_block(
+                    k, n_steps, next_switch, slot_start, slot_end, countdown, ctl.x_cmd, pedal_level, ctl.t_dem,
+                    ctl.t_rate, engaged, braking, launching)
+                m = int(m)
+                dl.locked, stalled = locked != 0.0, stalled != 0.0
+                if has_lock and rec.lock_time is None:
+                    rec.lock_time = lock_time
                 if engaged:
+                    if not rec.started:
+                        theta_cs_0 = values[o_theta_cs]            # the block's first step
+                        rec.start(ctl.kiss_now - values[o_kiss], theta_cs_0, ctl.theta_now - theta_cs_0)
                     if not rec.acc:
                         rec.t_first = tl + h - prefill
-                    rec.acc.extend(out[o_accel:m * width:width])
-                theta_estimate = protection_level = None
-                for j in range(m):
-                    b = j * width
-                    if out[b + o_event] != 0.0:
-                        ev = out[b + o_event]
-                        events.append((n + 1, "lock" if ev > 0 else "unlock", (k + j) * h + h if ev != -1.0
-                                       else (k + j) * h))
-                    if out[b + o_net_due] != 0.0:
-                        net.step(net_n * h, net_e / (net_n * h), out[b + o_net_w_e], out[b + o_net_w_d], engaged)
-                        theta_cm, net_n, net_e = net.theta_cm, 0, 0.0
-                    if rec_countdown == 0:
-                        rec_countdown = record_every
-                        if theta_estimate is None:
-                            theta_estimate = ctl.theta_cm_estimate()
-                            protection_level = ctl.protection.level if ctl.protection is not None else 0.0
+                    rec.acc.extend(native_accels(m))
+                if cycled and sampling:
+                    rec.characteristic(believed, values[o_t_cap])
+                if n_events:
+                    for j in range(m):
+                        ev = values[j * width + o_event]
+                        if ev != 0.0:
+                            events.append((n + 1, "lock" if ev > 0 else "unlock",
+                                           (k + j) * h + h if ev != -1.0 else (k + j) * h))
+                if rec_countdown < m:
+                    theta_estimate = ctl.theta_cm_estimate()
+                    protection_level = ctl.protection.level if ctl.protection is not None else 0.0
+                    for j in range(rec_countdown, m, record_every):
                         t = (k + j) * h
                         (w_e_o, w_d_o, v_o, accel_o, x_act_o, t_dem_o, t_cap_o, t_c_o, theta_cm_o, theta_cs_o,
-                         x_kiss_o, throttle_o, locked_o, t_shaft_o) = out[b:b + n_row]
+                         x_kiss_o, throttle_o, locked_o, t_shaft_o, theta_surface, theta_last) = native_row(j)
                         rows.append((t, n + 1, w_e_o, w_d_o, v_o, accel_o, ctl.x_cmd, x_act_o, t_dem_o, t_cap_o,
                                      t_c_o, theta_cm_o, theta_cs_o, ctl.theta_now, x_kiss_o, ctl.kiss_now,
                                      throttle_o, locked_o, theta_estimate, believed if sampling else math.nan,
-                                     t_shaft_o, *net_temps(), protection_level))
+                                     t_shaft_o, theta_surface, theta_last, protection_level))
                         if progress is not None and (k + j) % 10000 == 0:
                             progress(t)
-                    rec_countdown -= 1
+                rec_countdown = (rec_countdown - m) % record_every
                 countdown -= m
                 k += m
                 continue
@@ -375,6 +394,8 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
                     progress(t)
             rec_countdown -= 1
             k += 1
+        if native is not None:
+            native.finish(rec)
     finally:
         clutch.close()
     wall, cpu = time.perf_counter() - wall0, time.process_time() - cpu0

@@ -6,6 +6,7 @@
 #define CC_DEFINE_VARIABLE_TABLE /* CC_VARIABLES (cushion_variables.h) is defined in this file */
 #include "clutch_core.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdlib.h>
@@ -71,7 +72,7 @@ int cc_instantiate(CcModel *m, const char *dir, int me, CcLogger logger, void *c
     set_starts(m->r);
     m->phase = PH_INSTANTIATED;
     m->dirty = 1;
-    m->decay_arg = NAN;
+    m->decay_h = NAN;
     m->table_ok = cc_table_load(&m->table, dir, m->table_error, sizeof m->table_error) == 0;
     if (!m->table_ok) cc_log(m, CC_ERROR, "cannot load the F(u, theta) tables: %s", m->table_error);
     return m->table_ok ? 0 : -1;
@@ -86,6 +87,7 @@ void cc_reset(CcModel *m) {
     m->time = 0.0;
     m->dirty = 1;
     m->cover_ok = 0;
+    m->decay_h = NAN;
     m->phase = PH_INSTANTIATED;
 }
 
@@ -301,26 +303,39 @@ static int refresh(CcModel *m, const char *fn) {
     return update_outputs(m);
 }
 
+#if defined(__GNUC__)
+__attribute__((noinline))
+#endif
+static int set_real_checked(CcModel *m, const unsigned int vr[], size_t n, const double v[], const char *fn);
+
 int cc_set_real(CcModel *m, const unsigned int vr[], size_t n, const double v[], const char *fn) {
+#if !CC_THERMAL
+    /* the step's usual call: inputs only, in a phase that allows setting them (what the checks of set_real_checked
+       allow; anything else goes there) */
+    if ((m->phase & (PH_INSTANTIATED | PH_INIT | PH_STEP | PH_EVENT | PH_CONT)) && n && vr && v) {
+        size_t k;
+        if (n == 2 && vr[0] == VR_X_TO && vr[1] == VR_THETA_CM) { /* the usual pair, as the loop below does it */
+            m->r[VR_X_TO] = v[0];
+            m->r[VR_THETA_CM] = v[1];
+            m->dirty = 1;
+            return CC_OK;
+        }
+        for (k = 0; k < n && vr[k] < CC_NVARS && CC_VARIABLES[vr[k]].causality == CC_INPUT; ++k) {}
+        if (k == n) {
+            for (k = 0; k < n; ++k) m->r[vr[k]] = v[k];
+            m->dirty = 1;
+            return CC_OK;
+        }
+    }
+#endif
+    return set_real_checked(m, vr, n, v, fn);
+}
+
+static int set_real_checked(CcModel *m, const unsigned int vr[], size_t n, const double v[], const char *fn) {
     size_t k;
     int after_init = (m->phase & (PH_STEP | PH_EVENT | PH_CONT)) != 0;
     if (!cc_allowed(m, PH_INSTANTIATED | PH_INIT | PH_STEP | PH_EVENT | PH_CONT, fn)) return CC_ERROR;
     if (n && (!vr || !v)) { cc_log(m, CC_ERROR, "%s: NULL value reference or value array", fn); return CC_ERROR; }
-#if !CC_THERMAL
-    /* the step's usual call: inputs only (what the checks below allow in every phase) */
-    if (n == 2 && vr[0] == VR_X_TO && vr[1] == VR_THETA_CM) { /* the usual pair, as the loop below does it */
-        m->r[VR_X_TO] = v[0];
-        m->r[VR_THETA_CM] = v[1];
-        m->dirty = 1;
-        return CC_OK;
-    }
-    for (k = 0; k < n && vr[k] < CC_NVARS && CC_VARIABLES[vr[k]].causality == CC_INPUT; ++k) {}
-    if (k == n && n) {
-        for (k = 0; k < n; ++k) m->r[vr[k]] = v[k];
-        m->dirty = 1;
-        return CC_OK;
-    }
-#endif
     for (k = 0; k < n; ++k) { /* validate all first: a refused call changes nothing */
         if (vr[k] >= CC_NVARS) {
             cc_log(m, CC_ERROR, "%s: unknown value reference %u", fn, vr[k]);
@@ -338,7 +353,7 @@ int cc_set_real(CcModel *m, const unsigned int vr[], size_t n, const double v[],
     }
     for (k = 0; k < n; ++k) {
         m->r[vr[k]] = v[k];
-        if (is_parameter(vr[k])) m->cover_ok = 0;
+        if (is_parameter(vr[k])) { m->cover_ok = 0; m->decay_h = NAN; }
     }
 #if CC_THERMAL
     if (!after_init) cc_net_start(m->r); /* the nodes at theta_network_start until initialisation ends */
@@ -412,7 +427,7 @@ int cc_do_step(CcModel *m, double t, double h, const char *fn) {
     double g, theta_inf, theta_old, *r = m->r;
     int status = CC_OK;
     if (!cc_allowed(m, PH_STEP, fn)) return CC_ERROR;
-    if (!(h >= 0.0 && h < INFINITY && fabs(t) < INFINITY)) { /* finite, h >= 0 (false for NaN): two compares */
+    if (!(h >= 0.0 && h <= DBL_MAX && fabs(t) <= DBL_MAX)) { /* finite, h >= 0 (false for NaN): three compares */
         cc_log(m, CC_DISCARD, "%s: t = %g s: step size %g s must be finite and >= 0; step refused", fn, t, h);
         m->terminated = 1;
         return CC_DISCARD;
@@ -436,12 +451,11 @@ int cc_do_step(CcModel *m, double t, double h, const char *fn) {
     g = r[VR_U] + r[VR_H];
     theta_inf = (r[VR_U] * r[VR_THETA_CM] + r[VR_H] * r[VR_THETA_A]) / g;
     theta_old = r[VR_THETA_CS];
-    {   /* exp(-h g / C): kept with its argument (a pure function of it: the same bits as computing it) */
-        double a = -h * g / r[VR_C];
-        if (!(a == m->decay_arg)) {
-            m->decay_arg = a;
-            m->decay = exp(a);
-        }
+    if (!(h == m->decay_h)) { /* exp(-h g / C), kept with its step (parameters change: decay_h NaN) */
+        m->decay_h = h;
+        m->decay = exp(-h * g / r[VR_C]);
+    }
+    {
         r[VR_THETA_CS] = theta_inf + (r[VR_THETA_CS] - theta_inf) * m->decay;
     }
     if (update_outputs(m) != CC_OK) { /* a discarded step leaves state and time where they were */
@@ -601,6 +615,7 @@ void cc_state_load(CcModel *m, const CcState *s) {
     m->range_warned = s->range_warned;
     m->terminated = s->terminated;
     m->time = s->time;
+    m->decay_h = NAN;
     m->dirty = 1;
     m->cover_ok = 0;
 }

@@ -60,7 +60,8 @@ typedef struct {
     int range_warned; /* the validity of the last outputs (0, 1, 2): a warning is logged on each change to 1 or 2 */
     int terminated;   /* CS: the last step was refused (fmi2Terminated / terminateSimulation) */
     int logging_on;
-    double decay_arg, decay; /* the Co-Simulation step's exp(decay_arg) (decay_arg NaN: none yet) */
+    double decay_h, decay; /* the Co-Simulation step's exp(-h (U + H) / C) of step h (decay_h NaN: none yet; set
+                              NaN by every change of the parameters: set, reset, state load) */
     Table table;
     CcCover cover;
     int cover_ok;     /* cover prepared from the current parameters */

@@ -29,7 +29,7 @@ static double k1(double a, double b) {
 /* M(s) = F_AL(s) e (E folded into fal) and dM/ds */
 static double moment(const CcCover *cv, double s, double e_mod) {
     double t = cv->p[CV_T], h = cv->p[CV_H];
-    return cv->fal * e_mod * (s / t) * ((h - s) * (h - 0.5 * s) / (t * t) + 1.0) * cv->e;
+    return cv->fal * e_mod * (s / t) * ((h - s) * (h - 0.5 * s) / cv->tt + 1.0) * cv->e;
 }
 
 static double moment_slope(const CcCover *cv, double s, double e_mod) {
@@ -51,6 +51,9 @@ void cc_cover_prepare(CcCover *cv, const double *par, double lever_ratio, double
     cv->kp = cv->L_pp / cv->e;
     cv->fal = 4.0 / (1.0 - par[CV_NU] * par[CV_NU]) * pow(par[CV_T], 4) / (k1(par[CV_A], par[CV_B]) * 4.0 *
                                                                              par[CV_A] * par[CV_A]);
+    /* the frame's parameter-only subexpressions, each evaluated as the frame had it (the same bits) */
+    cv->tt = par[CV_T] * par[CV_T];
+    cv->dstack = par[CV_TF] * par[CV_AF] + par[CV_TPP] * par[CV_APP] + par[CV_LFW] * par[CV_AFW];
     th_ref = par[CV_TREF] - KELVIN;
     cv->u_full_ref = cc_table_full(tb, th_ref);
     s_k0 = par[CV_SINST] + cv->u_full_ref / cv->kp;
@@ -60,6 +63,8 @@ void cc_cover_prepare(CcCover *cv, const double *par, double lever_ratio, double
     cv->ck = par[CV_C] / cv->L_b;
     cv->ckl = cv->ck * cv->L_pp;
     cv->ckp = cv->ckl * cv->kp;
+    cv->ck_fal = cv->ck * cv->fal;
+    cv->p1h = 1.0 + par[CV_H] * par[CV_H] / cv->tt;
     cv->f_theta_cs = NAN; /* no frame yet */
     cv->hint = cv->hint_k = cv->hint_t = 0;
 }
@@ -101,7 +106,7 @@ static void frame(CcCover *cv, const Table *tb, double theta_cs, double theta_cm
     TBracket b;
     e_mod = youngs(cv, theta_cs);
     stack = cc_table_bracket_hint(tb, theta_cs - KELVIN, &b, &cv->hint_t) +
-            (p[CV_TF] * p[CV_AF] + p[CV_TPP] * p[CV_APP] + p[CV_LFW] * p[CV_AFW]) * (theta_cm - p[CV_TREF]);
+            cv->dstack * (theta_cm - p[CV_TREF]);
     cv->f_e = e_mod;
     cv->f_br = b;
     cv->s_kiss = p[CV_SINST] + (cv->u_full_ref + stack - wear) / kp;
@@ -121,8 +126,8 @@ static void frame(CcCover *cv, const Table *tb, double theta_cs, double theta_cm
     cv->x_kiss = cv->xc - kb * cv->s_kiss - comp * cv->fto_kiss;
     {   /* P(s)'s coefficients (operation for operation as the solver had them: the same root to the last bit
            where it matters, e.g. at the cushion's first contact, where F has a kink) */
-        const double t = p[CV_T], h = p[CV_H], tt = t * t, km = cv->ck * cv->fal * e_mod * cv->e / t;
-        cv->p1 = -kb - km * (1.0 + h * h / tt);
+        const double t = p[CV_T], h = p[CV_H], tt = cv->tt, km = cv->ck_fal * e_mod * cv->e / t;
+        cv->p1 = -kb - km * cv->p1h;
         cv->p2 = km * 1.5 * h / tt;
         cv->p3 = -km * 0.5 / tt;
     }

@@ -21,6 +21,7 @@ typedef struct {
     double u_full_ref;                /* cushion full compression at the reference temperature, m */
     double xc;                        /* bearing-system constant X_c, m */
     double ck, ckl, ckp;              /* c / L_b, c L_pp / L_b, c L_pp kp / L_b, m/N */
+    double tt, dstack, ck_fal, p1h;   /* t^2; the stack's expansion per K of theta_cm; ck fal; 1 + h^2 / t^2 */
     int hint, hint_k;                 /* last cells of the bracket's CurvePair, solver and kiss point (search starts) */
     int hint_t;                       /* last interval of the table temperatures (the frame's bracket) */
     /* the frame of the last (theta_cs K, theta_cm K, wear m): bracket, E, positions and forces */

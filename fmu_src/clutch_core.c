@@ -73,6 +73,7 @@ int cc_instantiate(CcModel *m, const char *dir, int me, CcLogger logger, void *c
     m->phase = PH_INSTANTIATED;
     m->dirty = 1;
     m->decay_h = NAN;
+    m->warm.x = NAN;
     m->table_ok = cc_table_load(&m->table, dir, m->table_error, sizeof m->table_error) == 0;
     if (!m->table_ok) cc_log(m, CC_ERROR, "cannot load the F(u, theta) tables: %s", m->table_error);
     return m->table_ok ? 0 : -1;
@@ -87,7 +88,7 @@ void cc_reset(CcModel *m) {
     m->time = 0.0;
     m->dirty = 1;
     m->cover_ok = 0;
-    m->decay_h = NAN;
+    m->warm.x = m->decay_h = NAN;
     m->phase = PH_INSTANTIATED;
 }
 
@@ -236,11 +237,15 @@ static int validity(const CcModel *m) {
 /* -------------------------------------------------------------------- model */
 static double facing_wear(const CcModel *m) { return m->r[VR_FACING_WEAR]; }
 
-/* outputs of the current inputs and state; CC_DISCARD (logged) if the diaphragm cannot hold the cushion */
+/* outputs of the current inputs and state; CC_DISCARD (logged) if the diaphragm cannot hold the cushion.
+   The cover's solve starts from the last answer (m->warm) when the bearing moved by at most CC_WARM_DX: the answer
+   passes the same residual test as a cold solve, so it agrees with it to that residual, not bit for bit (the
+   outputs depend on the inputs and the saved state, which holds the warm start) */
 static int update_outputs(CcModel *m) {
     double *r = m->r;
     const Table *tb = &m->table;
     CcCoverState st;
+    int status;
     double mu = tb->f_mu ? cc_table_mu(tb, r[VR_THETA_CM] - KELVIN, r[VR_OMEGA_SLIP]) : r[VR_MU];
     double g = r[VR_U] + r[VR_H];
     if (!m->cover_ok) {
@@ -248,7 +253,9 @@ static int update_outputs(CcModel *m) {
         m->cover_ok = 1;
     }
     r[CC_VR_DER_THETA_CS] = (r[VR_U] * r[VR_THETA_CM] + r[VR_H] * r[VR_THETA_A] - g * r[VR_THETA_CS]) / r[VR_C];
-    if (cc_cover_state(&m->cover, tb, r[VR_X_TO], r[VR_THETA_CS], r[VR_THETA_CM], facing_wear(m), &st) != 0) {
+    /* warm start: the last answer moved along its tangent (in a launch 1.9 instead of 3.0 evaluations per step) */
+    status = cc_cover_solve(&m->cover, tb, r[VR_X_TO], r[VR_THETA_CS], r[VR_THETA_CM], facing_wear(m), &m->warm, &st);
+    if (status != 0) {
         cc_log(m, CC_DISCARD, "t = %g s: the diaphragm cannot hold the cushion at theta_cs = %g K, theta_cm = %g K, "
                "facing_wear = %g m (bearing force %g N < 0); outputs not updated", m->time, r[VR_THETA_CS],
                r[VR_THETA_CM], facing_wear(m), st.bearing);
@@ -353,7 +360,7 @@ static int set_real_checked(CcModel *m, const unsigned int vr[], size_t n, const
     }
     for (k = 0; k < n; ++k) {
         m->r[vr[k]] = v[k];
-        if (is_parameter(vr[k])) { m->cover_ok = 0; m->decay_h = NAN; }
+        if (is_parameter(vr[k])) { m->cover_ok = 0; m->warm.x = m->decay_h = NAN; }
     }
 #if CC_THERMAL
     if (!after_init) cc_net_start(m->r); /* the nodes at theta_network_start until initialisation ends */
@@ -419,6 +426,7 @@ int cc_exit_init(CcModel *m, const char *fn) {
     m->phase = m->me ? PH_EVENT : PH_STEP;
     m->dirty = 1;
     m->cover_ok = 0;
+    m->warm.x = NAN;
     if (inputs_ok(m->r)) update_outputs(m);
     return CC_OK;
 }
@@ -568,6 +576,7 @@ void cc_state_save(const CcModel *m, CcState *s) {
     s->terminated = m->terminated;
     s->time = m->time;
     memcpy(s->r, m->r, sizeof s->r);
+    s->warm = m->warm;
     s->checksum = fnv1a(s, offsetof(CcState, checksum));
 }
 
@@ -600,8 +609,9 @@ int cc_state_check(CcModel *m, const void *bytes, size_t size, const char *fn) {
             return 0;
         }
     if (!isfinite(s.time) || !(s.r[VR_THETA_CS] >= THETA_MIN_K && s.r[VR_THETA_CS] <= THETA_MAX_K) ||
-        !(s.range_warned >= 0 && s.range_warned <= 2) || !(s.terminated == 0 || s.terminated == 1)) {
-        cc_log(m, CC_ERROR, "%s: the state's time, theta_cs or flags are out of range", fn);
+        !(s.range_warned >= 0 && s.range_warned <= 2) || !(s.terminated == 0 || s.terminated == 1) ||
+        !(isnan(s.warm.x) || isfinite(s.warm.x)) || !isfinite(s.warm.s) || !isfinite(s.warm.slope)) {
+        cc_log(m, CC_ERROR, "%s: the state's time, theta_cs, flags or warm start are out of range", fn);
         return 0;
     }
     if (s.phase != PH_INSTANTIATED && s.phase != PH_INIT && s.phase != PH_ERROR && !check_parameters(m, s.r, fn))
@@ -615,6 +625,7 @@ void cc_state_load(CcModel *m, const CcState *s) {
     m->range_warned = s->range_warned;
     m->terminated = s->terminated;
     m->time = s->time;
+    m->warm = s->warm;
     m->decay_h = NAN;
     m->dirty = 1;
     m->cover_ok = 0;

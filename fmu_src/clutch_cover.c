@@ -9,9 +9,12 @@
  *   x_to >= x_solid: s = s_solid, F_to = max(0, F_to(s_solid) - (x_to - x_solid)/c),
  *                    F_pp = (M(s_solid) - F_to L_b)/L_pp                           (solid phase)
  *
- * The forward map is a safeguarded Newton iteration on s in [s_solid, s_rigid] from a chord start
- * (3-4 iterations); the start depends on the inputs only, so results are reproducible bit for bit
- * (saved and restored states, any call history).
+ * The forward map is a safeguarded Halley iteration on s in [s_solid, s_rigid]. cc_cover_state starts it from a
+ * chord (3.1 evaluations per call on average): the start depends on the inputs only, so its results are the same
+ * bits whatever the call history. cc_cover_solve starts from the last answer moved along its tangent when the
+ * bearing moved by at most CC_WARM_DX (2.0 evaluations per call in a launch's 1 ms steps); its answer passes the
+ * same residual test, so it agrees with cc_cover_state's to that residual, and depends on the CcWarm passed in
+ * (the FMU keeps it in its saved state).
  */
 #include "clutch_cover.h"
 
@@ -137,11 +140,18 @@ static void frame(CcCover *cv, const Table *tb, double theta_cs, double theta_cm
 }
 
 
-int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, double theta_cm, double wear,
-                   CcCoverState *out) {
+#ifdef CC_COUNT_EVALS /* tests/test_native_speed.py counts the solver's cushion evaluations */
+long cc_count_evals;
+#define COUNT_EVAL() (++cc_count_evals)
+#else
+#define COUNT_EVAL() ((void)0)
+#endif
+
+int cc_cover_solve(CcCover *cv, const Table *tb, double x_to, double theta_cs, double theta_cm, double wear,
+                   CcWarm *w, CcCoverState *out) {
     const double *p = cv->p;
     double kb = cv->kb, kp = cv->kp, comp = p[CV_C];
-    double lo, hi, s, r, fc, fto, dfc, d2fc;
+    double lo, hi, s, r, fc, fto, dfc, d2fc, slope = 0.0;
     CellPt pt;
     int k;
     if (!(theta_cs == cv->f_theta_cs && theta_cm == cv->f_theta_cm && wear == cv->f_wear))
@@ -149,7 +159,7 @@ int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
     out->x_solid = cv->x_solid;
     out->x_lift = cv->x_solid + comp * (cv->fto_solid > 0.0 ? cv->fto_solid : 0.0);
     out->x_kiss = cv->x_kiss;
-    if (cv->fto_solid < 0.0) { out->bearing = cv->fto_solid; return -1; }
+    if (cv->fto_solid < 0.0) { out->bearing = cv->fto_solid; w->x = NAN; return -1; }
     if (x_to >= cv->x_solid) {
         fto = comp > 0.0 ? cv->fto_solid - (x_to - cv->x_solid) / comp : 0.0;
         if (fto < 0.0) fto = 0.0;
@@ -158,6 +168,7 @@ int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
         out->cushion = cv->fc_solid;
         out->u = (cv->s_kiss - cv->s_solid) * kp;
         out->s = cv->s_solid;
+        w->x = NAN;
         return 0;
     }
     {
@@ -168,20 +179,26 @@ int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
         const double s_kiss = cv->s_kiss, xc = cv->xc;
         const double tol_r = 1e-15 * (1.0 + fabs(x_to)), ckl = cv->ckl, ckp = cv->ckp;
         const double p0 = xc - x_to, p1 = cv->p1, p2 = cv->p2, p3 = cv->p3;
+        const double d = x_to - w->x; /* the bearing's travel since the warm start (NaN: none) */
         int hint = cv->hint;
         lo = cv->s_solid;
         hi = (xc - x_to) / kb;
-        /* start (from the inputs only, so the result never depends on the call history): the chord of
-           x(s) between the solid and kiss points (cushion phase) or the rigid lever shifted by the
-           kiss-point compliance (open) */
-        if (x_to >= cv->x_kiss)
-            s = cv->s_solid + (s_kiss - cv->s_solid) * (cv->x_solid - x_to) / (cv->x_solid - cv->x_kiss);
-        else s = (xc - x_to - comp * cv->fto_kiss) / kb;
-        if (!(s > lo && s < hi)) s = hi;
+        /* start: the warm start's answer moved along its tangent, if the bearing moved by at most CC_WARM_DX and it
+           lies in the bracket (false for a slope of 0: inf or NaN); else (from the inputs only) the chord of x(s)
+           between the solid and kiss points (cushion phase) or the rigid lever shifted by the kiss-point
+           compliance (open) */
+        if (fabs(d) <= CC_WARM_DX && (s = w->s + d / w->slope, s > lo && s < hi)) {
+        } else {
+            if (x_to >= cv->x_kiss)
+                s = cv->s_solid + (s_kiss - cv->s_solid) * (cv->x_solid - x_to) / (cv->x_solid - cv->x_kiss);
+            else s = (xc - x_to - comp * cv->fto_kiss) / kb;
+            if (!(s > lo && s < hi)) s = hi;
+        }
         fc = cushion(b, (s_kiss - s) * kp, &hint, &pt);
         r = p0 + s * (p1 + s * (p2 + s * p3)) + ckl * fc;
+        COUNT_EVAL();
         for (k = 0; k < 100; ++k) {
-            double slope, s_new;
+            double s_new;
             if (fabs(r) <= tol_r || hi - lo <= 1e-15 * (1.0 + hi)) break;
             if (r > 0.0) lo = s; else hi = s;
             cushion_deriv(b, &pt, &dfc, &d2fc);
@@ -196,6 +213,7 @@ int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
             s = (s_new > lo && s_new < hi) ? s_new : 0.5 * (lo + hi);
             fc = cushion(b, (s_kiss - s) * kp, &hint, &pt);
             r = p0 + s * (p1 + s * (p2 + s * p3)) + ckl * fc;
+            COUNT_EVAL();
         }
         /* the bearing force at the answer as cover.py writes it */
         fto = (moment(cv, s, cv->f_e) - fc * cv->L_pp) / cv->L_b;
@@ -205,8 +223,17 @@ int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
         out->cushion = fc;
         out->u = (s_kiss - s) * kp;
         out->s = s;
+        w->x = x_to;
+        w->s = s;
+        w->slope = slope;
     }
     return fto < 0.0 ? -1 : 0;
+}
+
+int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, double theta_cm, double wear,
+                   CcCoverState *out) {
+    CcWarm w = {NAN, 0.0, 0.0};
+    return cc_cover_solve(cv, tb, x_to, theta_cs, theta_cm, wear, &w, out);
 }
 
 /* ---- what the cover can hold (cover.py: temperature_grid, _holds, hold_problem, wear_limit) */

@@ -188,6 +188,7 @@ int cc_cover_solve(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
            between the solid and kiss points (cushion phase) or the rigid lever shifted by the kiss-point
            compliance (open) */
         if (fabs(d) <= CC_WARM_DX && (s = w->s + d / w->slope, s > lo && s < hi)) {
+            slope = w->slope; /* the tangent kept if this start passes the test at once */
         } else {
             if (x_to >= cv->x_kiss)
                 s = cv->s_solid + (s_kiss - cv->s_solid) * (cv->x_solid - x_to) / (cv->x_solid - cv->x_kiss);

@@ -6,6 +6,7 @@
 #define CC_DEFINE_VARIABLE_TABLE /* CC_VARIABLES (cushion_variables.h) is defined in this file */
 #include "clutch_core.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdlib.h>
@@ -71,7 +72,8 @@ int cc_instantiate(CcModel *m, const char *dir, int me, CcLogger logger, void *c
     set_starts(m->r);
     m->phase = PH_INSTANTIATED;
     m->dirty = 1;
-    m->decay_arg = NAN;
+    m->decay_h = NAN;
+    m->warm.x = NAN;
     m->table_ok = cc_table_load(&m->table, dir, m->table_error, sizeof m->table_error) == 0;
     if (!m->table_ok) cc_log(m, CC_ERROR, "cannot load the F(u, theta) tables: %s", m->table_error);
     return m->table_ok ? 0 : -1;
@@ -86,6 +88,7 @@ void cc_reset(CcModel *m) {
     m->time = 0.0;
     m->dirty = 1;
     m->cover_ok = 0;
+    m->warm.x = m->decay_h = NAN;
     m->phase = PH_INSTANTIATED;
 }
 
@@ -234,11 +237,15 @@ static int validity(const CcModel *m) {
 /* -------------------------------------------------------------------- model */
 static double facing_wear(const CcModel *m) { return m->r[VR_FACING_WEAR]; }
 
-/* outputs of the current inputs and state; CC_DISCARD (logged) if the diaphragm cannot hold the cushion */
+/* outputs of the current inputs and state; CC_DISCARD (logged) if the diaphragm cannot hold the cushion.
+   The cover's solve starts from the last answer (m->warm) when the bearing moved by at most CC_WARM_DX: the answer
+   passes the same residual test as a cold solve, so it agrees with it to that residual, not bit for bit (the
+   outputs depend on the inputs and the saved state, which holds the warm start) */
 static int update_outputs(CcModel *m) {
     double *r = m->r;
     const Table *tb = &m->table;
     CcCoverState st;
+    int status;
     double mu = tb->f_mu ? cc_table_mu(tb, r[VR_THETA_CM] - KELVIN, r[VR_OMEGA_SLIP]) : r[VR_MU];
     double g = r[VR_U] + r[VR_H];
     if (!m->cover_ok) {
@@ -246,7 +253,9 @@ static int update_outputs(CcModel *m) {
         m->cover_ok = 1;
     }
     r[CC_VR_DER_THETA_CS] = (r[VR_U] * r[VR_THETA_CM] + r[VR_H] * r[VR_THETA_A] - g * r[VR_THETA_CS]) / r[VR_C];
-    if (cc_cover_state(&m->cover, tb, r[VR_X_TO], r[VR_THETA_CS], r[VR_THETA_CM], facing_wear(m), &st) != 0) {
+    /* warm start: the last answer moved along its tangent (in a launch 1.9 instead of 3.0 evaluations per step) */
+    status = cc_cover_solve(&m->cover, tb, r[VR_X_TO], r[VR_THETA_CS], r[VR_THETA_CM], facing_wear(m), &m->warm, &st);
+    if (status != 0) {
         cc_log(m, CC_DISCARD, "t = %g s: the diaphragm cannot hold the cushion at theta_cs = %g K, theta_cm = %g K, "
                "facing_wear = %g m (bearing force %g N < 0); outputs not updated", m->time, r[VR_THETA_CS],
                r[VR_THETA_CM], facing_wear(m), st.bearing);
@@ -301,26 +310,39 @@ static int refresh(CcModel *m, const char *fn) {
     return update_outputs(m);
 }
 
+#if defined(__GNUC__)
+__attribute__((noinline))
+#endif
+static int set_real_checked(CcModel *m, const unsigned int vr[], size_t n, const double v[], const char *fn);
+
 int cc_set_real(CcModel *m, const unsigned int vr[], size_t n, const double v[], const char *fn) {
+#if !CC_THERMAL
+    /* the step's usual call: inputs only, in a phase that allows setting them (what the checks of set_real_checked
+       allow; anything else goes there) */
+    if ((m->phase & (PH_INSTANTIATED | PH_INIT | PH_STEP | PH_EVENT | PH_CONT)) && n && vr && v) {
+        size_t k;
+        if (n == 2 && vr[0] == VR_X_TO && vr[1] == VR_THETA_CM) { /* the usual pair, as the loop below does it */
+            m->r[VR_X_TO] = v[0];
+            m->r[VR_THETA_CM] = v[1];
+            m->dirty = 1;
+            return CC_OK;
+        }
+        for (k = 0; k < n && vr[k] < CC_NVARS && CC_VARIABLES[vr[k]].causality == CC_INPUT; ++k) {}
+        if (k == n) {
+            for (k = 0; k < n; ++k) m->r[vr[k]] = v[k];
+            m->dirty = 1;
+            return CC_OK;
+        }
+    }
+#endif
+    return set_real_checked(m, vr, n, v, fn);
+}
+
+static int set_real_checked(CcModel *m, const unsigned int vr[], size_t n, const double v[], const char *fn) {
     size_t k;
     int after_init = (m->phase & (PH_STEP | PH_EVENT | PH_CONT)) != 0;
     if (!cc_allowed(m, PH_INSTANTIATED | PH_INIT | PH_STEP | PH_EVENT | PH_CONT, fn)) return CC_ERROR;
     if (n && (!vr || !v)) { cc_log(m, CC_ERROR, "%s: NULL value reference or value array", fn); return CC_ERROR; }
-#if !CC_THERMAL
-    /* the step's usual call: inputs only (what the checks below allow in every phase) */
-    if (n == 2 && vr[0] == VR_X_TO && vr[1] == VR_THETA_CM) { /* the usual pair, as the loop below does it */
-        m->r[VR_X_TO] = v[0];
-        m->r[VR_THETA_CM] = v[1];
-        m->dirty = 1;
-        return CC_OK;
-    }
-    for (k = 0; k < n && vr[k] < CC_NVARS && CC_VARIABLES[vr[k]].causality == CC_INPUT; ++k) {}
-    if (k == n && n) {
-        for (k = 0; k < n; ++k) m->r[vr[k]] = v[k];
-        m->dirty = 1;
-        return CC_OK;
-    }
-#endif
     for (k = 0; k < n; ++k) { /* validate all first: a refused call changes nothing */
         if (vr[k] >= CC_NVARS) {
             cc_log(m, CC_ERROR, "%s: unknown value reference %u", fn, vr[k]);
@@ -338,7 +360,7 @@ int cc_set_real(CcModel *m, const unsigned int vr[], size_t n, const double v[],
     }
     for (k = 0; k < n; ++k) {
         m->r[vr[k]] = v[k];
-        if (is_parameter(vr[k])) m->cover_ok = 0;
+        if (is_parameter(vr[k])) { m->cover_ok = 0; m->warm.x = m->decay_h = NAN; }
     }
 #if CC_THERMAL
     if (!after_init) cc_net_start(m->r); /* the nodes at theta_network_start until initialisation ends */
@@ -404,6 +426,7 @@ int cc_exit_init(CcModel *m, const char *fn) {
     m->phase = m->me ? PH_EVENT : PH_STEP;
     m->dirty = 1;
     m->cover_ok = 0;
+    m->warm.x = NAN;
     if (inputs_ok(m->r)) update_outputs(m);
     return CC_OK;
 }
@@ -412,7 +435,7 @@ int cc_do_step(CcModel *m, double t, double h, const char *fn) {
     double g, theta_inf, theta_old, *r = m->r;
     int status = CC_OK;
     if (!cc_allowed(m, PH_STEP, fn)) return CC_ERROR;
-    if (!(h >= 0.0 && h < INFINITY && fabs(t) < INFINITY)) { /* finite, h >= 0 (false for NaN): two compares */
+    if (!(h >= 0.0 && h <= DBL_MAX && fabs(t) <= DBL_MAX)) { /* finite, h >= 0 (false for NaN): three compares */
         cc_log(m, CC_DISCARD, "%s: t = %g s: step size %g s must be finite and >= 0; step refused", fn, t, h);
         m->terminated = 1;
         return CC_DISCARD;
@@ -436,12 +459,11 @@ int cc_do_step(CcModel *m, double t, double h, const char *fn) {
     g = r[VR_U] + r[VR_H];
     theta_inf = (r[VR_U] * r[VR_THETA_CM] + r[VR_H] * r[VR_THETA_A]) / g;
     theta_old = r[VR_THETA_CS];
-    {   /* exp(-h g / C): kept with its argument (a pure function of it: the same bits as computing it) */
-        double a = -h * g / r[VR_C];
-        if (!(a == m->decay_arg)) {
-            m->decay_arg = a;
-            m->decay = exp(a);
-        }
+    if (!(h == m->decay_h)) { /* exp(-h g / C), kept with its step (parameters change: decay_h NaN) */
+        m->decay_h = h;
+        m->decay = exp(-h * g / r[VR_C]);
+    }
+    {
         r[VR_THETA_CS] = theta_inf + (r[VR_THETA_CS] - theta_inf) * m->decay;
     }
     if (update_outputs(m) != CC_OK) { /* a discarded step leaves state and time where they were */
@@ -554,6 +576,7 @@ void cc_state_save(const CcModel *m, CcState *s) {
     s->terminated = m->terminated;
     s->time = m->time;
     memcpy(s->r, m->r, sizeof s->r);
+    s->warm = m->warm;
     s->checksum = fnv1a(s, offsetof(CcState, checksum));
 }
 
@@ -586,8 +609,9 @@ int cc_state_check(CcModel *m, const void *bytes, size_t size, const char *fn) {
             return 0;
         }
     if (!isfinite(s.time) || !(s.r[VR_THETA_CS] >= THETA_MIN_K && s.r[VR_THETA_CS] <= THETA_MAX_K) ||
-        !(s.range_warned >= 0 && s.range_warned <= 2) || !(s.terminated == 0 || s.terminated == 1)) {
-        cc_log(m, CC_ERROR, "%s: the state's time, theta_cs or flags are out of range", fn);
+        !(s.range_warned >= 0 && s.range_warned <= 2) || !(s.terminated == 0 || s.terminated == 1) ||
+        !(isnan(s.warm.x) || isfinite(s.warm.x)) || !isfinite(s.warm.s) || !isfinite(s.warm.slope)) {
+        cc_log(m, CC_ERROR, "%s: the state's time, theta_cs, flags or warm start are out of range", fn);
         return 0;
     }
     if (s.phase != PH_INSTANTIATED && s.phase != PH_INIT && s.phase != PH_ERROR && !check_parameters(m, s.r, fn))
@@ -601,6 +625,8 @@ void cc_state_load(CcModel *m, const CcState *s) {
     m->range_warned = s->range_warned;
     m->terminated = s->terminated;
     m->time = s->time;
+    m->warm = s->warm;
+    m->decay_h = NAN;
     m->dirty = 1;
     m->cover_ok = 0;
 }

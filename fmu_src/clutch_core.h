@@ -60,7 +60,11 @@ typedef struct {
     int range_warned; /* the validity of the last outputs (0, 1, 2): a warning is logged on each change to 1 or 2 */
     int terminated;   /* CS: the last step was refused (fmi2Terminated / terminateSimulation) */
     int logging_on;
-    double decay_arg, decay; /* the Co-Simulation step's exp(decay_arg) (decay_arg NaN: none yet) */
+    double decay_h, decay; /* the Co-Simulation step's exp(-h (U + H) / C) of step h (decay_h NaN: none yet; set
+                              NaN by every change of the parameters: set, reset, state load) */
+    /* the cover's warm start (update_outputs, cc_cover_solve): the last answer; x NaN (cold) after instantiation,
+       reset, exit-initialisation and any parameter change; part of the saved state */
+    CcWarm warm;
     Table table;
     CcCover cover;
     int cover_ok;     /* cover prepared from the current parameters */
@@ -78,12 +82,13 @@ typedef struct {
 
 /* the serialized (and saved) FMU state: versioned, checksummed, validated before use */
 #define CC_STATE_MAGIC 0x43434653u /* "CCFS" */
-#define CC_STATE_VERSION 4u /* 3: the cover variables; 4: validity (range_warned = last validity 0..2) */
+#define CC_STATE_VERSION 5u /* 3: the cover variables; 4: validity (range_warned = last validity 0..2); 5: warm start */
 typedef struct {
     uint32_t magic, version, size;
     int32_t phase, me, range_warned, terminated, reserved;
     double time;
     double r[CC_NVARS];
+    CcWarm warm; /* the cover's warm start (CcModel) */
     uint64_t checksum; /* FNV-1a 64 of every byte before it */
 } CcState;
 

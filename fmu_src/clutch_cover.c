@@ -9,9 +9,12 @@
  *   x_to >= x_solid: s = s_solid, F_to = max(0, F_to(s_solid) - (x_to - x_solid)/c),
  *                    F_pp = (M(s_solid) - F_to L_b)/L_pp                           (solid phase)
  *
- * The forward map is a safeguarded Newton iteration on s in [s_solid, s_rigid] from a chord start
- * (3-4 iterations); the start depends on the inputs only, so results are reproducible bit for bit
- * (saved and restored states, any call history).
+ * The forward map is a safeguarded Halley iteration on s in [s_solid, s_rigid]. cc_cover_state starts it from a
+ * chord (3.1 evaluations per call on average): the start depends on the inputs only, so its results are the same
+ * bits whatever the call history. cc_cover_solve starts from the last answer moved along its tangent when the
+ * bearing moved by at most CC_WARM_DX (2.0 evaluations per call in a launch's 1 ms steps); its answer passes the
+ * same residual test, so it agrees with cc_cover_state's to that residual, and depends on the CcWarm passed in
+ * (the FMU keeps it in its saved state).
  */
 #include "clutch_cover.h"
 
@@ -29,7 +32,7 @@ static double k1(double a, double b) {
 /* M(s) = F_AL(s) e (E folded into fal) and dM/ds */
 static double moment(const CcCover *cv, double s, double e_mod) {
     double t = cv->p[CV_T], h = cv->p[CV_H];
-    return cv->fal * e_mod * (s / t) * ((h - s) * (h - 0.5 * s) / (t * t) + 1.0) * cv->e;
+    return cv->fal * e_mod * (s / t) * ((h - s) * (h - 0.5 * s) / cv->tt + 1.0) * cv->e;
 }
 
 static double moment_slope(const CcCover *cv, double s, double e_mod) {
@@ -51,6 +54,9 @@ void cc_cover_prepare(CcCover *cv, const double *par, double lever_ratio, double
     cv->kp = cv->L_pp / cv->e;
     cv->fal = 4.0 / (1.0 - par[CV_NU] * par[CV_NU]) * pow(par[CV_T], 4) / (k1(par[CV_A], par[CV_B]) * 4.0 *
                                                                              par[CV_A] * par[CV_A]);
+    /* the frame's parameter-only subexpressions, each evaluated as the frame had it (the same bits) */
+    cv->tt = par[CV_T] * par[CV_T];
+    cv->dstack = par[CV_TF] * par[CV_AF] + par[CV_TPP] * par[CV_APP] + par[CV_LFW] * par[CV_AFW];
     th_ref = par[CV_TREF] - KELVIN;
     cv->u_full_ref = cc_table_full(tb, th_ref);
     s_k0 = par[CV_SINST] + cv->u_full_ref / cv->kp;
@@ -60,6 +66,8 @@ void cc_cover_prepare(CcCover *cv, const double *par, double lever_ratio, double
     cv->ck = par[CV_C] / cv->L_b;
     cv->ckl = cv->ck * cv->L_pp;
     cv->ckp = cv->ckl * cv->kp;
+    cv->ck_fal = cv->ck * cv->fal;
+    cv->p1h = 1.0 + par[CV_H] * par[CV_H] / cv->tt;
     cv->f_theta_cs = NAN; /* no frame yet */
     cv->hint = cv->hint_k = cv->hint_t = 0;
 }
@@ -101,7 +109,7 @@ static void frame(CcCover *cv, const Table *tb, double theta_cs, double theta_cm
     TBracket b;
     e_mod = youngs(cv, theta_cs);
     stack = cc_table_bracket_hint(tb, theta_cs - KELVIN, &b, &cv->hint_t) +
-            (p[CV_TF] * p[CV_AF] + p[CV_TPP] * p[CV_APP] + p[CV_LFW] * p[CV_AFW]) * (theta_cm - p[CV_TREF]);
+            cv->dstack * (theta_cm - p[CV_TREF]);
     cv->f_e = e_mod;
     cv->f_br = b;
     cv->s_kiss = p[CV_SINST] + (cv->u_full_ref + stack - wear) / kp;
@@ -121,8 +129,8 @@ static void frame(CcCover *cv, const Table *tb, double theta_cs, double theta_cm
     cv->x_kiss = cv->xc - kb * cv->s_kiss - comp * cv->fto_kiss;
     {   /* P(s)'s coefficients (operation for operation as the solver had them: the same root to the last bit
            where it matters, e.g. at the cushion's first contact, where F has a kink) */
-        const double t = p[CV_T], h = p[CV_H], tt = t * t, km = cv->ck * cv->fal * e_mod * cv->e / t;
-        cv->p1 = -kb - km * (1.0 + h * h / tt);
+        const double t = p[CV_T], h = p[CV_H], tt = cv->tt, km = cv->ck_fal * e_mod * cv->e / t;
+        cv->p1 = -kb - km * cv->p1h;
         cv->p2 = km * 1.5 * h / tt;
         cv->p3 = -km * 0.5 / tt;
     }
@@ -132,11 +140,18 @@ static void frame(CcCover *cv, const Table *tb, double theta_cs, double theta_cm
 }
 
 
-int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, double theta_cm, double wear,
-                   CcCoverState *out) {
+#ifdef CC_COUNT_EVALS /* tests/test_native_speed.py counts the solver's cushion evaluations */
+long cc_count_evals;
+#define COUNT_EVAL() (++cc_count_evals)
+#else
+#define COUNT_EVAL() ((void)0)
+#endif
+
+int cc_cover_solve(CcCover *cv, const Table *tb, double x_to, double theta_cs, double theta_cm, double wear,
+                   CcWarm *w, CcCoverState *out) {
     const double *p = cv->p;
     double kb = cv->kb, kp = cv->kp, comp = p[CV_C];
-    double lo, hi, s, r, fc, fto, dfc, d2fc;
+    double lo, hi, s, r, fc, fto, dfc, d2fc, slope = 0.0;
     CellPt pt;
     int k;
     if (!(theta_cs == cv->f_theta_cs && theta_cm == cv->f_theta_cm && wear == cv->f_wear))
@@ -144,7 +159,7 @@ int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
     out->x_solid = cv->x_solid;
     out->x_lift = cv->x_solid + comp * (cv->fto_solid > 0.0 ? cv->fto_solid : 0.0);
     out->x_kiss = cv->x_kiss;
-    if (cv->fto_solid < 0.0) { out->bearing = cv->fto_solid; return -1; }
+    if (cv->fto_solid < 0.0) { out->bearing = cv->fto_solid; w->x = NAN; return -1; }
     if (x_to >= cv->x_solid) {
         fto = comp > 0.0 ? cv->fto_solid - (x_to - cv->x_solid) / comp : 0.0;
         if (fto < 0.0) fto = 0.0;
@@ -153,6 +168,7 @@ int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
         out->cushion = cv->fc_solid;
         out->u = (cv->s_kiss - cv->s_solid) * kp;
         out->s = cv->s_solid;
+        w->x = NAN;
         return 0;
     }
     {
@@ -163,20 +179,27 @@ int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
         const double s_kiss = cv->s_kiss, xc = cv->xc;
         const double tol_r = 1e-15 * (1.0 + fabs(x_to)), ckl = cv->ckl, ckp = cv->ckp;
         const double p0 = xc - x_to, p1 = cv->p1, p2 = cv->p2, p3 = cv->p3;
+        const double d = x_to - w->x; /* the bearing's travel since the warm start (NaN: none) */
         int hint = cv->hint;
         lo = cv->s_solid;
         hi = (xc - x_to) / kb;
-        /* start (from the inputs only, so the result never depends on the call history): the chord of
-           x(s) between the solid and kiss points (cushion phase) or the rigid lever shifted by the
-           kiss-point compliance (open) */
-        if (x_to >= cv->x_kiss)
-            s = cv->s_solid + (s_kiss - cv->s_solid) * (cv->x_solid - x_to) / (cv->x_solid - cv->x_kiss);
-        else s = (xc - x_to - comp * cv->fto_kiss) / kb;
-        if (!(s > lo && s < hi)) s = hi;
+        /* start: the warm start's answer moved along its tangent, if the bearing moved by at most CC_WARM_DX and it
+           lies in the bracket (false for a slope of 0: inf or NaN); else (from the inputs only) the chord of x(s)
+           between the solid and kiss points (cushion phase) or the rigid lever shifted by the kiss-point
+           compliance (open) */
+        if (fabs(d) <= CC_WARM_DX && (s = w->s + d / w->slope, s > lo && s < hi)) {
+            slope = w->slope; /* the tangent kept if this start passes the test at once */
+        } else {
+            if (x_to >= cv->x_kiss)
+                s = cv->s_solid + (s_kiss - cv->s_solid) * (cv->x_solid - x_to) / (cv->x_solid - cv->x_kiss);
+            else s = (xc - x_to - comp * cv->fto_kiss) / kb;
+            if (!(s > lo && s < hi)) s = hi;
+        }
         fc = cushion(b, (s_kiss - s) * kp, &hint, &pt);
         r = p0 + s * (p1 + s * (p2 + s * p3)) + ckl * fc;
+        COUNT_EVAL();
         for (k = 0; k < 100; ++k) {
-            double slope, s_new;
+            double s_new;
             if (fabs(r) <= tol_r || hi - lo <= 1e-15 * (1.0 + hi)) break;
             if (r > 0.0) lo = s; else hi = s;
             cushion_deriv(b, &pt, &dfc, &d2fc);
@@ -191,6 +214,7 @@ int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
             s = (s_new > lo && s_new < hi) ? s_new : 0.5 * (lo + hi);
             fc = cushion(b, (s_kiss - s) * kp, &hint, &pt);
             r = p0 + s * (p1 + s * (p2 + s * p3)) + ckl * fc;
+            COUNT_EVAL();
         }
         /* the bearing force at the answer as cover.py writes it */
         fto = (moment(cv, s, cv->f_e) - fc * cv->L_pp) / cv->L_b;
@@ -200,8 +224,17 @@ int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
         out->cushion = fc;
         out->u = (s_kiss - s) * kp;
         out->s = s;
+        w->x = x_to;
+        w->s = s;
+        w->slope = slope;
     }
     return fto < 0.0 ? -1 : 0;
+}
+
+int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, double theta_cm, double wear,
+                   CcCoverState *out) {
+    CcWarm w = {NAN, 0.0, 0.0};
+    return cc_cover_solve(cv, tb, x_to, theta_cs, theta_cm, wear, &w, out);
 }
 
 /* ---- what the cover can hold (cover.py: temperature_grid, _holds, hold_problem, wear_limit) */

@@ -21,6 +21,7 @@ typedef struct {
     double u_full_ref;                /* cushion full compression at the reference temperature, m */
     double xc;                        /* bearing-system constant X_c, m */
     double ck, ckl, ckp;              /* c / L_b, c L_pp / L_b, c L_pp kp / L_b, m/N */
+    double tt, dstack, ck_fal, p1h;   /* t^2; the stack's expansion per K of theta_cm; ck fal; 1 + h^2 / t^2 */
     int hint, hint_k;                 /* last cells of the bracket's CurvePair, solver and kiss point (search starts) */
     int hint_t;                       /* last interval of the table temperatures (the frame's bracket) */
     /* the frame of the last (theta_cs K, theta_cm K, wear m): bracket, E, positions and forces */
@@ -36,7 +37,21 @@ typedef struct {
     double x_kiss, x_solid, x_lift; /* bearing positions, m */
 } CcCoverState;
 
+/* a warm start of the cover's solve (cc_cover_solve): the last answer's bearing position x (m; NaN: none),
+   diaphragm deflection s (m) and dx_to/ds near it (the last Halley step's slope; 0: none) */
+typedef struct {
+    double x, s, slope;
+} CcWarm;
+/* the largest bearing travel (m) between two solves for which the last answer, moved along its tangent, starts the
+   next; a larger jump starts from the chord, as cc_cover_state does */
+#define CC_WARM_DX 1e-4
+
 void cc_cover_prepare(CcCover *cv, const double *par, double lever_ratio, double x_kiss_ref, const Table *tb);
+/* cc_cover_state from the warm start *w (if the bearing moved by at most CC_WARM_DX since w->x and the start lies
+   in the bracket; else from the chord), then *w = this answer (x NaN in the solid phase and on refusal): the answer
+   passes the same residual test, so it agrees with cc_cover_state's to that residual, not bit for bit */
+int cc_cover_solve(CcCover *cv, const Table *tb, double x_to, double theta_cs, double theta_cm, double wear,
+                   CcWarm *w, CcCoverState *out);
 double cc_cover_slope_bound(const CcCover *cv);
 /* 0, or -1 if the diaphragm cannot hold the cushion (bearing force < 0); out is filled either way */
 int cc_cover_state(CcCover *cv, const Table *tb, double x_to, double theta_cs, double theta_cm, double wear,

@@ -152,15 +152,30 @@ def describe_pattern(rec: dict[str, np.ndarray], launches: int) -> str:
     slipping = (torque != 0.0) & (np.abs(w) > 1e-3)
     held_run = np.diff(np.flatnonzero(np.r_[changed, True]))          # steps per set call
     small = np.abs(np.diff(x)) <= 1e-4
+    peak = np.abs(w[slipping]).max() if slipping.any() else 0.0
     return (f"launch pattern: {n} steps of {rec['h'] * 1e3:g} ms, {launches} launch(es) of the default scenario "
             f"(naive TCU); inputs set (one fmi2SetReal of 3) in {changed.sum()} steps ({changed.mean():.0%}), "
             f"held up to {held_run.max()} steps; clutch transmitting torque in {(torque != 0).sum()} steps "
-            f"({(torque != 0).mean():.0%}), slipping with torque in {slipping.sum()} (peak {np.abs(w[slipping]).max() if slipping.any() else 0:.0f} rad/s, "
+            f"({(torque != 0).mean():.0%}), slipping with torque in {slipping.sum()} (peak {peak:.0f} rad/s, "
             f"{np.sum(np.abs(torque * w)[slipping]) * rec['h'] / 1e3:.0f} kJ); open with the bearing below 0.1 mm "
             f"(braked standstill and idle: the quiet phases) in {(x < 1e-4).sum()} steps; bearing moved <= 0.1 mm "
             f"in {small.mean():.1%} of the steps (max {np.abs(np.diff(x)).max() * 1e3:.2f} mm); "
             f"theta_cm {th.min():.1f}-{th.max():.1f} K, theta_cs {rec['outputs'][:, 1].min():.1f}-"
             f"{rec['outputs'][:, 1].max():.1f} K")
+
+
+def active_part(rec: dict[str, np.ndarray], launches: int) -> np.ndarray:
+    """The launch pattern's inputs without its quiet phases: of each launch's slot, the steps from its start to
+    0.5 s after the bearing was last at 0.1 mm or more (prefill, pedal, opening), the slots' parts joined."""
+    x = rec["inputs"][:, 0]
+    slot = len(x) // launches
+    pad = int(round(0.5 / rec["h"]))
+    parts = []
+    for i in range(launches):
+        out = np.flatnonzero(x[i * slot:(i + 1) * slot] >= 1e-4)
+        end = min(slot, (out[-1] + 1 + pad) if len(out) else 0)
+        parts.append(rec["inputs"][i * slot:i * slot + end])
+    return np.concatenate(parts)
 
 
 def time_c_host(host: Path, fmu: Path, n: int, python: bool, workdir: Path,
@@ -346,6 +361,12 @@ def native_patterns(page, host: Path, fmu: Path, n: int, tmp: Path, launches: in
     us["launch"] = got[0]
     print(f"C host, native FMU, launch pattern: set-if-changed+doStep+get {us['launch']:8.3f} us/step")
     ir = {pat: native_instructions(host, fmu, tmp, replay[pat]) for pat in PATTERNS}
+    active = write_pattern(tmp / "active.f64", active_part(rec, launches))
+    act_us = time_c_host(host, fmu, n, False, tmp, active)[0]
+    act_ir = native_instructions(host, fmu, tmp, active)
+    print(f"C host, native FMU, launch pattern without its quiet phases (each launch's first "
+          f"{active.stat().st_size // 24 // launches} steps on average: prefill, pedal, opening): {act_us:8.3f} us/step"
+          + ("" if act_ir is None else f", {act_ir:.0f} instructions per step (callgrind)"))
     rows = []
     for pat, what in PATTERNS.items():
         irs = "n/a (no valgrind)" if ir[pat] is None else f"{ir[pat]:.0f}"
@@ -356,7 +377,8 @@ def native_patterns(page, host: Path, fmu: Path, n: int, tmp: Path, launches: in
     page.markdown("## The native FMU in the C host: two input patterns\n\n"
                   + describe_pattern(rec, launches) + ".\n\n"
                   "| pattern | what it stands for | us per step | callgrind Ir per step |\n|---|---|---|---|\n"
-                  + "\n".join(rows))
+                  + "\n".join(rows) + f"\n| launch, no quiet phases | the launch pattern's prefill, pedal and opening "
+                  f"only | {act_us:.3f} | {'n/a' if act_ir is None else f'{act_ir:.0f}'} |")
 
 
 def time_builds(tmp: Path, cold: bool) -> None:
@@ -391,8 +413,11 @@ def time_builds(tmp: Path, cold: bool) -> None:
 #: the results page's intro
 PAGE_INTRO = ("Cost of one FMU step (set inputs, doStep, get outputs; 1 ms communication step) for the native and "
               "the pythonfmu FMU, through fmpy and in our C host (`fmu_src/hosts/fmi2_host.c`), the Python model "
-              "alone, and the time to build the native FMU for every platform. Per-step times on a shared, loaded "
-              "machine are noisy: compare figures from one run.")
+              "alone, and the time to build the native FMU for every platform. The native FMU runs in the C host "
+              "in two input patterns: the host's jump pattern (every step a cold solve) and a launch pattern "
+              "(the inputs a launch of the default scenario gives the FMU, set only when they change: what a "
+              "time-stepping host feeds). Per-step times on a shared, loaded machine are noisy: compare figures "
+              "from one run.")
 
 
 def main(argv=None) -> None:
@@ -406,7 +431,7 @@ def main(argv=None) -> None:
     ap.add_argument("--thermal-only", action="store_true",
                     help="only the thermal FMU's step against the plain FMU's in the C host")
     ap.add_argument("--ab", metavar="REF", help="only the native step of git ref REF's C sources against this "
-                    "checkout's (time, callgrind, bit-for-bit checksum)")
+                    "checkout's (time, callgrind, bit-for-bit checksum; both input patterns)")
     ap.add_argument("--steps", type=int, default=200_000)
     ap.add_argument("--launches", type=int, default=2,
                     help="launches of the default scenario recorded for the launch pattern (60 000 steps each)")

@@ -533,3 +533,60 @@ def test_fmu_warm_start_is_in_the_saved_state_and_reset_starts_cold():
     assert run(0, 900) == first + rest              # reset: cold again, the same bits
     s.terminate()
     s.freeInstance()
+
+
+def _fnv1a(data: bytes) -> str:
+    """The C host's checksum (FNV-1a 64) of ``data``."""
+    h = 14695981039346656037
+    for b in data:
+        h = ((h ^ b) * 1099511628211) & 0xFFFFFFFFFFFFFFFF
+    return f"{h:016x}"
+
+
+def test_c_host_replays_a_launch_as_the_launch_client_does(tmp_path):
+    """The C host's launch pattern (``--replay``, benchmarks/fmu.py): one launch of the default scenario recorded
+    at the clutch FMU's step (``record_launch``), replayed in the C host with the client's set-only-what-changed
+    calls, gives every output of every step bit for bit as in the launch (the checksum of torque, theta_cs and
+    x_kiss, the same binary), with as many fmi2SetReal calls as inputs changed; at sampled steps (slipping,
+    held, open) the outputs equal the Python model's within the tolerances of the scans above."""
+    import numpy as np
+
+    from cushion_clutch.benchmarks.fmu import check_replay_vrs, compile_host, record_launch, write_pattern
+    from cushion_clutch.fmu.crossbuild import HOST
+    from cushion_clutch.fmu.native import build_native_fmu
+    from cushion_clutch.model import ClutchParameters, load_table, outputs, thermal_step
+
+    if shutil.which("gcc") is None:
+        pytest.skip("gcc not installed")
+    fmu = build_native_fmu(DEFAULT_TABLES, tmp_path / "native.fmu", 2, platforms=(HOST[2],))
+    check_replay_vrs(fmu)
+    rec = record_launch(fmu, launches=1)
+    x, tcm, w = rec["inputs"].T
+    torque, tcs, x_kiss = rec["outputs"].T
+    n = len(x)
+    changed = np.r_[True, (np.diff(rec["inputs"], axis=0) != 0).any(axis=1)]
+    slipping = (torque > 0) & (np.abs(w) > 1.0)
+    assert rec["h"] == 1e-3 and n == 60_000 and 0.1 < changed.mean() < 0.9 and slipping.sum() > 500, (
+        n, changed.mean(), slipping.sum())
+    unzip = tmp_path / "fmu"
+    zipfile.ZipFile(fmu).extractall(unzip)
+    host = compile_host(tmp_path / "host")
+    pattern = write_pattern(tmp_path / "launch.f64", rec["inputs"])
+    out = subprocess.run([str(host), str(unzip / "binaries/linux64/CushionClutch.so"), (unzip / "resources").as_uri(),
+                          read_model_description(str(fmu)).guid, "0", "0.001", "checksum", "--replay", str(pattern)],
+                         capture_output=True, text=True, check=True, timeout=60).stdout
+    got = {ln.split()[0]: ln.split()[1:] for ln in out.splitlines()}
+    assert got["replay"] == [str(n), "sets", str(int(changed.sum()))], got["replay"]
+    assert [float(v) for v in got["outputs"]] == [torque[-1], tcs[-1], x_kiss[-1]]
+    assert got["checksum"] == [_fnv1a(np.ascontiguousarray(rec["outputs"], dtype="<f8").tobytes())]
+    # against the Python model: the same step of theta_cs, the cover at the step's inputs and new theta_cs
+    table, p = load_table(), ClutchParameters()
+    rng = np.random.default_rng(5)
+    picks = np.r_[rng.choice(np.flatnonzero(slipping), 15, replace=False),
+                  rng.choice(np.flatnonzero(~changed), 5, replace=False),
+                  rng.choice(np.flatnonzero(torque == 0), 5, replace=False)]
+    for k in picks:
+        assert tcs[k] == pytest.approx(thermal_step(tcs[k - 1], tcm[k], rec["h"], p), rel=1e-12), k
+        o = outputs(x[k], tcs[k], table, p, theta_cm=tcm[k])
+        assert torque[k] == pytest.approx(o.torque, rel=1e-11, abs=1e-10), k
+        assert abs(x_kiss[k] - o.x_kiss) <= 4e-15, k

@@ -13,6 +13,13 @@ The thermal FMU (``build-fmu --thermal``) against the plain one, both native in 
 also gets a theta_cm sweep, the thermal one an engine speed): median of 5 alternating runs and the ratio
 (target: at most 3x). ``--thermal-only`` runs only this comparison.
 
+The native FMU runs in the C host in two input patterns (:data:`PATTERNS`): the host's own *jump* pattern (x_to
+3-8 mm and theta_cm 300-600 K pseudo-random, set every step: every step a cold solve of the cover) and a *launch*
+pattern, what a time-stepping host feeds: the inputs the launch simulation gives the clutch FMU over the first
+``--launches`` launches of the shipped ``default`` scenario (recorded at run time, :func:`record_launch`; 1 ms
+steps throughout, also while the car stands braked), replayed with the launch client's set-only-what-changed
+calls (:func:`write_pattern`, the host's ``--replay``).
+
 ``--ab REF`` compares the native step of this checkout's C sources with those of git ref ``REF`` (e.g. ``main``):
 both built for linux64 with the FMU build's compiler and flags, from the same generated headers and tables, run
 alternately in the C host (median of 9 on the same machine state), their callgrind instructions per step (if
@@ -29,6 +36,8 @@ import tempfile
 import time
 import zipfile
 from pathlib import Path
+
+import numpy as np
 
 
 def time_fmpy(fmu: Path, n: int, h: float = 1e-3) -> tuple[float, float]:
@@ -72,8 +81,106 @@ def compile_host(dest: Path) -> Path:
     return dest
 
 
-def time_c_host(host: Path, fmu: Path, n: int, python: bool, workdir: Path) -> tuple[float, int, str]:
-    """(us per set+doStep+get in the C host, exit code, stderr tail)."""
+#: the C host's input patterns for the native FMU: name -> what it stands for
+PATTERNS = {"jump": "every step a cold solve", "launch": "what a time-stepping host feeds"}
+
+#: value references the C host's replay pattern uses (fmu_src/hosts/fmi2_host.c): set, then read
+REPLAY_VRS = {"x_to": 0, "theta_cm": 1, "omega_slip": 17, "torque": 2, "theta_cs": 4, "x_kiss": 6}
+
+
+def record_launch(fmu: Path, launches: int = 2, tcu: str = "naive") -> dict[str, np.ndarray]:
+    """The inputs the launch simulation gives the clutch FMU, step by step, and the outputs it gets back.
+
+    The shipped ``default`` scenario cut to its first ``launches`` launches (moderate and hard pedal alternating,
+    each a 60 s slot: prefill, 8 s of pedal, then braked standstill with the clutch open), with 1 ms steps
+    throughout (``quiet_steps`` off: a fixed-step host's pattern; the launch loop's quiet periods would step
+    10 ms) and the Python plant loop (the compiled one calls the FMU from C), through ``fmu`` (a native FMU with
+    a binary for this machine). Every call of the clutch FMU's step is recorded by a subclass of
+    :class:`~cushion_clutch.launch.fmu_client.ClutchFmu` put in for the run.
+
+    Returns
+    -------
+    dict
+        ``inputs`` (steps, 3): x_to [m], theta_cm [K], omega_slip [rad/s]; ``outputs`` (steps, 3): torque [N.m],
+        theta_cs [K], x_kiss [m]; ``h`` the step [s].
+    """
+    import dataclasses
+    from unittest import mock
+
+    from cushion_clutch.launch import simulate
+    from cushion_clutch.launch.fmu_client import ClutchFmu
+    from cushion_clutch.launch.scenario import load_scenario
+    from cushion_clutch.model import load_table
+
+    ins: list[tuple[float, float, float]] = []
+    outs: list[tuple[float, float, float]] = []
+    steps: set[float] = set()
+
+    class Recording(ClutchFmu):
+        def _make_step(self):
+            inner = super()._make_step()
+
+            def step(t, h, x_to, theta_cm, omega_slip):
+                o = inner(t, h, x_to, theta_cm, omega_slip)
+                ins.append((x_to, theta_cm, omega_slip))
+                outs.append(o)
+                steps.add(h)
+                return o
+            return step
+
+    sc = load_scenario()
+    sc = dataclasses.replace(sc, run=dataclasses.replace(sc.run, launches=launches, quiet_steps=False))
+    with mock.patch.object(simulate, "ClutchFmu", Recording):
+        simulate.simulate_launches(fmu, sc, load_table(), tcu, record_every=1000, plant="python")
+    if len(steps) != 1:
+        raise RuntimeError(f"the launch stepped the clutch FMU with steps {sorted(steps)} s, not one fixed step")
+    return {"inputs": np.array(ins, dtype=float), "outputs": np.array(outs, dtype=float), "h": steps.pop()}
+
+
+def write_pattern(path: Path, inputs: np.ndarray) -> Path:
+    """``inputs`` (steps, 3: x_to m, theta_cm K, omega_slip rad/s) as the C host's ``--replay`` file (doubles)."""
+    np.ascontiguousarray(inputs, dtype=float).tofile(path)
+    return path
+
+
+def describe_pattern(rec: dict[str, np.ndarray], launches: int) -> str:
+    """What the launch pattern contains (steps, set calls, slip, quiet phases), one paragraph."""
+    x, th, w = rec["inputs"].T
+    torque = rec["outputs"][:, 0]
+    n = len(x)
+    changed = np.r_[True, (np.diff(rec["inputs"], axis=0) != 0).any(axis=1)]
+    slipping = (torque != 0.0) & (np.abs(w) > 1e-3)
+    held_run = np.diff(np.flatnonzero(np.r_[changed, True]))          # steps per set call
+    small = np.abs(np.diff(x)) <= 1e-4
+    peak = np.abs(w[slipping]).max() if slipping.any() else 0.0
+    return (f"launch pattern: {n} steps of {rec['h'] * 1e3:g} ms, {launches} launch(es) of the default scenario "
+            f"(naive TCU); inputs set (one fmi2SetReal of 3) in {changed.sum()} steps ({changed.mean():.0%}), "
+            f"held up to {held_run.max()} steps; clutch transmitting torque in {(torque != 0).sum()} steps "
+            f"({(torque != 0).mean():.0%}), slipping with torque in {slipping.sum()} (peak {peak:.0f} rad/s, "
+            f"{np.sum(np.abs(torque * w)[slipping]) * rec['h'] / 1e3:.0f} kJ); open with the bearing below 0.1 mm "
+            f"(braked standstill and idle: the quiet phases) in {(x < 1e-4).sum()} steps; bearing moved <= 0.1 mm "
+            f"in {small.mean():.1%} of the steps (max {np.abs(np.diff(x)).max() * 1e3:.2f} mm); "
+            f"theta_cm {th.min():.1f}-{th.max():.1f} K, theta_cs {rec['outputs'][:, 1].min():.1f}-"
+            f"{rec['outputs'][:, 1].max():.1f} K")
+
+
+def active_part(rec: dict[str, np.ndarray], launches: int) -> np.ndarray:
+    """The launch pattern's inputs without its quiet phases: of each launch's slot, the steps from its start to
+    0.5 s after the bearing was last at 0.1 mm or more (prefill, pedal, opening), the slots' parts joined."""
+    x = rec["inputs"][:, 0]
+    slot = len(x) // launches
+    pad = int(round(0.5 / rec["h"]))
+    parts = []
+    for i in range(launches):
+        out = np.flatnonzero(x[i * slot:(i + 1) * slot] >= 1e-4)
+        end = min(slot, (out[-1] + 1 + pad) if len(out) else 0)
+        parts.append(rec["inputs"][i * slot:i * slot + end])
+    return np.concatenate(parts)
+
+
+def time_c_host(host: Path, fmu: Path, n: int, python: bool, workdir: Path,
+                replay: Path | None = None) -> tuple[float, int, str]:
+    """(us per set+doStep+get in the C host, exit code, stderr tail); ``replay``: the launch pattern's file."""
     from fmpy import read_model_description
 
     unzip = workdir / fmu.stem
@@ -84,8 +191,8 @@ def time_c_host(host: Path, fmu: Path, n: int, python: bool, workdir: Path) -> t
         import numpy
         env["PYTHONPATH"] = str(Path(numpy.__file__).parents[1])
     res = subprocess.run([str(host), str(unzip / "binaries/linux64/CushionClutch.so"),
-                          (unzip / "resources").as_uri(), read_model_description(str(fmu)).guid, str(n), "0.001"],
-                         capture_output=True, text=True, env=env)
+                          (unzip / "resources").as_uri(), read_model_description(str(fmu)).guid, str(n), "0.001",
+                          *_replay_args(replay)], capture_output=True, text=True, env=env)
     us = float("nan")
     for line in res.stdout.splitlines():
         if line.startswith("us_per_step"):
@@ -93,10 +200,25 @@ def time_c_host(host: Path, fmu: Path, n: int, python: bool, workdir: Path) -> t
     return us, res.returncode, res.stderr.strip()[-200:]
 
 
-def native_instructions(host: Path, fmu: Path, workdir: Path) -> float | None:
-    """Instructions per set+doStep+get of the native FMU in the C host (callgrind: 120 000 steps minus 20 000, so
-    start-up cancels; independent of the machine's load), or None without valgrind. ``fmu`` must have been
-    extracted into ``workdir`` by :func:`time_c_host`."""
+def _replay_args(replay: Path | None) -> list[str]:
+    return [] if replay is None else ["--replay", str(replay)]
+
+
+def check_replay_vrs(fmu: Path) -> None:
+    """The C host's replay value references are those of ``fmu``'s variables (ValueError naming the first not)."""
+    from fmpy import read_model_description
+
+    vr = {v.name: v.valueReference for v in read_model_description(str(fmu)).modelVariables}
+    for name, ref in REPLAY_VRS.items():
+        if vr.get(name) != ref:
+            raise ValueError(f"{fmu}: {name} has value reference {vr.get(name)}, the C host's replay uses {ref}")
+
+
+def native_instructions(host: Path, fmu: Path, workdir: Path, replay: Path | None = None) -> float | None:
+    """Instructions per set+doStep+get of the native FMU in the C host (callgrind, independent of the machine's
+    load), or None without valgrind. Jump pattern: 120 000 steps minus 20 000, so start-up cancels; ``replay``
+    (the launch pattern's file, N steps): 20 000 + N steps minus 20 000, every step of the file once. ``fmu`` must
+    have been extracted into ``workdir`` by :func:`time_c_host`."""
     from fmpy import read_model_description
 
     if not shutil.which("valgrind"):
@@ -104,7 +226,15 @@ def native_instructions(host: Path, fmu: Path, workdir: Path) -> float | None:
     unzip = workdir / fmu.stem
     cmd = [str(host), str(unzip / "binaries/linux64/CushionClutch.so"), (unzip / "resources").as_uri(),
            read_model_description(str(fmu)).guid]
-    return (_callgrind_ir(cmd + ["120000", "0.001"]) - _callgrind_ir(cmd + ["20000", "0.001"])) / 100_000
+    return _ir_per_step(cmd, replay)
+
+
+def _ir_per_step(cmd: list[str], replay: Path | None) -> float:
+    """callgrind instructions per step of host command ``cmd`` (library, URI, GUID) in a pattern (see above)."""
+    extra = _replay_args(replay)
+    span = 100_000 if replay is None else replay.stat().st_size // 24
+    return (_callgrind_ir(cmd + [str(20_000 + span), "0.001", *extra])
+            - _callgrind_ir(cmd + ["20000", "0.001", *extra])) / span
 
 
 def time_thermal(tmp: Path, n: int, repeats: int = 5) -> tuple[float, float]:
@@ -155,9 +285,10 @@ def _callgrind_ir(cmd: list[str]) -> int:
     return int(next(ln for ln in res.stderr.splitlines() if "Collected" in ln).split()[-1])
 
 
-def time_ab(tmp: Path, ref: str, n: int, repeats: int = 9) -> dict[str, float]:
-    """The native FMI 2.0 step of git ref ``ref``'s C sources against this checkout's: median us per
-    set+doStep+get in the C host (alternating runs), callgrind Ir per step, and the bit-for-bit checksum."""
+def time_ab(tmp: Path, ref: str, n: int, repeats: int = 9, launches: int = 2) -> dict[str, dict[str, float]]:
+    """The native FMI 2.0 step of git ref ``ref``'s C sources against this checkout's, in both patterns
+    (:data:`PATTERNS`): median us per step in the C host (alternating runs: ref and worktree, jump and launch),
+    callgrind Ir per step, and the bit-for-bit checksum per pattern. Returns {pattern: figures}."""
     import statistics
 
     from fmpy import read_model_description
@@ -168,9 +299,13 @@ def time_ab(tmp: Path, ref: str, n: int, repeats: int = 9) -> dict[str, float]:
     from cushion_clutch.fmu.native import build_native_fmu, sources
 
     fmu = build_native_fmu(DEFAULT_TABLES, tmp / "ab.fmu", 2, platforms=(HOST[2],))
+    check_replay_vrs(fmu)
     unzip = tmp / "ab"
     zipfile.ZipFile(fmu).extractall(unzip)
     guid = read_model_description(str(fmu)).guid
+    rec = record_launch(fmu, launches)          # the launch pattern, recorded through this checkout's FMU
+    print(describe_pattern(rec, launches))
+    replay = {"jump": None, "launch": write_pattern(tmp / "launch.f64", rec["inputs"])}
     files = sources(2)
     libs = {}
     for label in (ref, "worktree"):
@@ -188,24 +323,62 @@ def time_ab(tmp: Path, ref: str, n: int, repeats: int = 9) -> dict[str, float]:
         subprocess.run(compile_command(HOST[2], 2, src, files, libs[label]), check=True)
     host = compile_host(tmp / "ab_host")
     cmd = {k: [str(host), str(lib), (unzip / "resources").as_uri(), guid] for k, lib in libs.items()}
-    sums = {k: _host_run(c + [str(n), "0.001", "checksum"])["checksum"] for k, c in cmd.items()}
-    times: dict[str, list[float]] = {k: [] for k in cmd}
+    runs = {(pat, k): c + [str(n), "0.001", *_replay_args(replay[pat])] for pat in PATTERNS for k, c in cmd.items()}
+    sums = {key: _host_run(c + ["checksum"])["checksum"] for key, c in runs.items()}
+    times: dict[tuple[str, str], list[float]] = {key: [] for key in runs}
     for _ in range(repeats):
-        for k, c in cmd.items():
-            times[k].append(float(_host_run(c + [str(n), "0.001"])["us_per_step"]))
-    med = {k: statistics.median(v) for k, v in times.items()}
-    print(f"C host, {n} steps of 1 ms, median of {repeats} alternating runs: {ref} {med[ref]:.3f} us/step, "
-          f"worktree {med['worktree']:.3f} us/step, ratio {med[ref] / med['worktree']:.2f}")
-    if shutil.which("valgrind"):
-        ir = {k: (_callgrind_ir(c + ["120000", "0.001"]) - _callgrind_ir(c + ["20000", "0.001"])) / 100000
-              for k, c in cmd.items()}
-        print(f"callgrind: {ref} {ir[ref]:.0f} Ir/step, worktree {ir['worktree']:.0f} Ir/step, "
-              f"ratio {ir[ref] / ir['worktree']:.2f}")
-        med.update({f"ir_{k}": v for k, v in ir.items()})
-    same = sums[ref] == sums["worktree"]
-    print(f"every output of every step {'identical' if same else 'DIFFERENT'} bit for bit "
-          f"(checksums {sums[ref]}, {sums['worktree']})")
-    return med
+        for key, c in runs.items():
+            times[key].append(float(_host_run(c)["us_per_step"]))
+    result = {}
+    for pat, what in PATTERNS.items():
+        med = {k: statistics.median(times[pat, k]) for k in cmd}
+        print(f"{pat} pattern ({what}): C host, {n} steps of 1 ms, median of {repeats} alternating runs: "
+              f"{ref} {med[ref]:.3f} us/step, worktree {med['worktree']:.3f} us/step, "
+              f"ratio {med[ref] / med['worktree']:.2f}")
+        if shutil.which("valgrind"):
+            ir = {k: _ir_per_step(c, replay[pat]) for k, c in cmd.items()}
+            print(f"{pat} pattern: callgrind {ref} {ir[ref]:.0f} Ir/step, worktree {ir['worktree']:.0f} Ir/step, "
+                  f"ratio {ir[ref] / ir['worktree']:.2f}")
+            med.update({f"ir_{k}": v for k, v in ir.items()})
+        same = sums[pat, ref] == sums[pat, "worktree"]
+        print(f"{pat} pattern: every output of every step {'identical' if same else 'DIFFERENT'} bit for bit "
+              f"(checksums {sums[pat, ref]}, {sums[pat, 'worktree']})")
+        result[pat] = med
+    return result
+
+
+def native_patterns(page, host: Path, fmu: Path, n: int, tmp: Path, launches: int, jump_us: float) -> None:
+    """The native FMU in the C host in both patterns (:data:`PATTERNS`): us and callgrind Ir per step, printed and
+    as a table on the results page. ``jump_us``: the jump pattern's time, measured just before."""
+    check_replay_vrs(fmu)
+    rec = record_launch(fmu, launches)
+    print(describe_pattern(rec, launches))
+    replay = {"jump": None, "launch": write_pattern(tmp / "launch.f64", rec["inputs"])}
+    us = {"jump": jump_us}
+    got = time_c_host(host, fmu, n, False, tmp, replay["launch"])
+    if got[1] != 0:
+        raise RuntimeError(f"the C host's launch replay failed (exit code {got[1]}): {got[2]}")
+    us["launch"] = got[0]
+    print(f"C host, native FMU, launch pattern: set-if-changed+doStep+get {us['launch']:8.3f} us/step")
+    ir = {pat: native_instructions(host, fmu, tmp, replay[pat]) for pat in PATTERNS}
+    active = write_pattern(tmp / "active.f64", active_part(rec, launches))
+    act_us = time_c_host(host, fmu, n, False, tmp, active)[0]
+    act_ir = native_instructions(host, fmu, tmp, active)
+    print(f"C host, native FMU, launch pattern without its quiet phases (each launch's first "
+          f"{active.stat().st_size // 24 // launches} steps on average: prefill, pedal, opening): {act_us:8.3f} us/step"
+          + ("" if act_ir is None else f", {act_ir:.0f} instructions per step (callgrind)"))
+    rows = []
+    for pat, what in PATTERNS.items():
+        irs = "n/a (no valgrind)" if ir[pat] is None else f"{ir[pat]:.0f}"
+        if ir[pat] is not None:
+            print(f"C host, native FMU, {pat} pattern ({what}): {ir[pat]:8.0f} instructions per step "
+                  "(callgrind; load-independent)")
+        rows.append(f"| {pat} | {what} | {us[pat]:.3f} | {irs} |")
+    page.markdown("## The native FMU in the C host: two input patterns\n\n"
+                  + describe_pattern(rec, launches) + ".\n\n"
+                  "| pattern | what it stands for | us per step | callgrind Ir per step |\n|---|---|---|---|\n"
+                  + "\n".join(rows) + f"\n| launch, no quiet phases | the launch pattern's prefill, pedal and opening "
+                  f"only | {act_us:.3f} | {'n/a' if act_ir is None else f'{act_ir:.0f}'} |")
 
 
 def time_builds(tmp: Path, cold: bool) -> None:
@@ -240,8 +413,11 @@ def time_builds(tmp: Path, cold: bool) -> None:
 #: the results page's intro
 PAGE_INTRO = ("Cost of one FMU step (set inputs, doStep, get outputs; 1 ms communication step) for the native and "
               "the pythonfmu FMU, through fmpy and in our C host (`fmu_src/hosts/fmi2_host.c`), the Python model "
-              "alone, and the time to build the native FMU for every platform. Per-step times on a shared, loaded "
-              "machine are noisy: compare figures from one run.")
+              "alone, and the time to build the native FMU for every platform. The native FMU runs in the C host "
+              "in two input patterns: the host's jump pattern (every step a cold solve) and a launch pattern "
+              "(the inputs a launch of the default scenario gives the FMU, set only when they change: what a "
+              "time-stepping host feeds). Per-step times on a shared, loaded machine are noisy: compare figures "
+              "from one run.")
 
 
 def main(argv=None) -> None:
@@ -255,21 +431,25 @@ def main(argv=None) -> None:
     ap.add_argument("--thermal-only", action="store_true",
                     help="only the thermal FMU's step against the plain FMU's in the C host")
     ap.add_argument("--ab", metavar="REF", help="only the native step of git ref REF's C sources against this "
-                    "checkout's (time, callgrind, bit-for-bit checksum)")
+                    "checkout's (time, callgrind, bit-for-bit checksum; both input patterns)")
     ap.add_argument("--steps", type=int, default=200_000)
+    ap.add_argument("--launches", type=int, default=2,
+                    help="launches of the default scenario recorded for the launch pattern (60 000 steps each)")
     ap.add_argument("--cold", action="store_true", help="also time builds from an empty zig cache (minutes)")
     ap.add_argument("--markdown", action="store_true", help="with --out: the results page")
     ap.add_argument("--out", type=Path, help="write the results page (e.g. docs/results/benchmarks.md)")
     args = ap.parse_args(argv)
-    with results_page(args.out, "Benchmarks: the FMU", "cushion_clutch.benchmarks.fmu", argv, PAGE_INTRO):
-        _run(args, build_fmu, DEFAULT_TABLES, ClutchParameters, load_table, outputs, thermal_step)
+    if args.launches < 1:
+        ap.error(f"--launches {args.launches}: must be at least 1")
+    with results_page(args.out, "Benchmarks: the FMU", "cushion_clutch.benchmarks.fmu", argv, PAGE_INTRO) as page:
+        _run(args, page, build_fmu, DEFAULT_TABLES, ClutchParameters, load_table, outputs, thermal_step)
 
 
-def _run(args, build_fmu, DEFAULT_TABLES, ClutchParameters, load_table, outputs, thermal_step) -> None:
+def _run(args, page, build_fmu, DEFAULT_TABLES, ClutchParameters, load_table, outputs, thermal_step) -> None:
     n = args.steps
     if args.ab:
         with tempfile.TemporaryDirectory() as tmp:
-            time_ab(Path(tmp), args.ab, n * 5)
+            time_ab(Path(tmp), args.ab, n * 5, launches=args.launches)
         return
     if args.thermal_only:
         with tempfile.TemporaryDirectory() as tmp:
@@ -289,10 +469,8 @@ def _run(args, build_fmu, DEFAULT_TABLES, ClutchParameters, load_table, outputs,
         for b, path in fmus.items():
             ch[b] = time_c_host(host, path, n * (10 if b == "native" else 1), b == "python", tmp)
             note = "" if ch[b][1] == 0 else f"  (host exit code {ch[b][1]}: {ch[b][2]!r})"
-            print(f"C host, {b:>6} FMU: set+doStep+get {ch[b][0]:8.3f} us/step{note}")
-        ir = native_instructions(host, fmus["native"], tmp)
-        if ir is not None:
-            print(f"C host, native FMU: {ir:8.0f} instructions per set+doStep+get (callgrind; load-independent)")
+            print(f"C host, {b:>6} FMU: set+doStep+get {ch[b][0]:8.3f} us/step{note} (jump pattern)")
+        native_patterns(page, host, fmus["native"], n * 10, tmp, args.launches, ch["native"][0])
         print(f"native speed-up: {ch['python'][0] / ch['native'][0]:.0f}x in the C host, "
               f"{fm['python'][0] / fm['native'][0]:.1f}x through fmpy")
         # the duty slips at 100 rad/s without a pause: by about 840 s the thermal FMU's facings leave the 800 K

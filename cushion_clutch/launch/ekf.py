@@ -134,9 +134,10 @@ import numpy as np
 
 from ..config import Checked
 from ..model import x_to_for_torque
-from ..model import ClutchParameters, SpringTable, outputs
+from ..model import ClutchParameters, SpringTable
 from ..model.clutch_model import THETA_MAX_K, THETA_MIN_K
 from ..model.thermal_network import FACINGS, N_NODES, TcuNetworkBase, ThermalNetwork
+from .tcu_model import TcuClutchModel
 
 #: state indices: the network's nodes, then these
 IX_CS, IX_DX, IX_MU, IX_LOSS, IX_HEAT = N_NODES, N_NODES + 1, N_NODES + 2, N_NODES + 3, N_NODES + 4
@@ -326,11 +327,16 @@ class ClutchEkf:
         The calibration's friction at a slip speed (rad/s) relative to the nominal mu (the facing's nominal
         slip-speed shape, :meth:`~.scenario.Tcu.mu_calibration`); default: mu constant. The friction states
         are relative to it.
+    native : bool, optional
+        Evaluate the characteristic's torque with the native clutch model (:mod:`.tcu_model`; same figures to
+        round-off) or, False, with the Python model (the reference); default :data:`.tcu_model.NATIVE`.
     """
 
     def __init__(self, net: TcuNetworkParams, e: EkfParams, table: SpringTable, p: ClutchParameters,
-                 theta_a: float, theta0: float, calibration=None):
+                 theta_a: float, theta0: float, calibration=None, native: bool | None = None):
         self.net, self.e, self.table, self.p = net, e, table, p
+        #: the characteristic's torque T(x_to, theta_cs, theta_cm) (native or Python clutch model)
+        self.clutch = TcuClutchModel(table, p, native)
         self.calibration = calibration if calibration is not None else (lambda w: 1.0)
         #: the calibration's friction at the measured slip (:meth:`set_slip`) and at SLIP_REF_RAD_S, 1
         self.cal = self.cal_ref = float(self.calibration(SLIP_REF_RAD_S))
@@ -489,8 +495,8 @@ class ClutchEkf:
         if hit is None:
             try:
                 x = x_to_for_torque(FRICTION_TORQUE_NM, th, self.table, self.p, theta_cm=theta_cm)
-                t0 = outputs(x, th, self.table, self.p, theta_cm).torque
-                t1 = outputs(x + self.dx_prior - float(s[IX_DX]), th, self.table, self.p, theta_cm).torque
+                t0 = self.clutch.torque(x, th, theta_cm)
+                t1 = self.clutch.torque(x + self.dx_prior - float(s[IX_DX]), th, theta_cm)
                 hit = (t0, t1) if t0 >= 0.9 * FRICTION_TORQUE_NM else (math.nan, math.nan)
             except ValueError:
                 hit = (math.nan, math.nan)
@@ -538,7 +544,7 @@ class ClutchEkf:
         th = min(max(float(s[IX_CS]), self.table.theta_min_K), self.table.theta_max_K)
         theta_cm = min(max(float(0.5 * (s[F1] + s[F2])), THETA_MIN_K), THETA_MAX_K)   # the stack's growth there
         f = self.mu_factor(s, mu) if factor is None else factor
-        return f * outputs(x_m - float(s[IX_DX]), th, self.table, self.p, theta_cm).torque
+        return f * self.clutch.torque(x_m - float(s[IX_DX]), th, theta_cm)
 
     def mu_factor(self, s: np.ndarray | None = None, mu: float | None = None) -> float:
         """Friction relative to the nominal mu at the measured slip :attr:`slip`: the calibration's there
@@ -583,10 +589,10 @@ class ClutchEkf:
                     x = x_to_for_torque(t, th, self.table, self.p, theta_cm=theta_cm)
                 except ValueError:
                     continue
-                t0 = outputs(x, th, self.table, self.p, theta_cm).torque
+                t0 = self.clutch.torque(x, th, theta_cm)
                 if t0 < 0.9 * t:                    # beyond the closed capacity
                     continue
-                slope = (outputs(x + 10e-6, th, self.table, self.p, theta_cm).torque - t0) / 10e-6
+                slope = (self.clutch.torque(x + 10e-6, th, theta_cm) - t0) / 10e-6
                 pts.append((x, t0, e.mu_deadband * t0 + e.torque_offset_accuracy_Nm, slope))
             if len(self._ev_cache) > 4096:
                 self._ev_cache.clear()
@@ -598,7 +604,7 @@ class ClutchEkf:
         ratio = 0.0
         for x, t0, env0, slope in pts:                  # the prior's position for each nominal torque
             env = mu0 * (env0 + slope * self.x_accuracy)
-            d = abs(mu * outputs(x + dx0 - dx, th, self.table, self.p, theta_cm).torque - mu0 * t0)
+            d = abs(mu * self.clutch.torque(x + dx0 - dx, th, theta_cm) - mu0 * t0)
             ratio = max(ratio, d / env if env > 0.0 else math.inf)
         self.evidence_ratio = ratio
         self._over = self._over + 1 if ratio > e.evidence_threshold else 0

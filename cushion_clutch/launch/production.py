@@ -162,9 +162,9 @@ class ProductionTcu(TcuController):
             return readings
         span = WINDOW * self.period
         h0, h1 = self.hist[0], self.hist[-1]
-        items = list(self.hist)[1:]
-        t_est = sum(i[2] for i in items) / WINDOW
-        x_mean = sum(i[3] for i in items) / WINDOW
+        _, _, ts, xs = zip(*self.hist)
+        t_est = sum(ts[1:]) / WINDOW
+        x_mean = sum(xs[1:]) / WINDOW
         t_c = t_est - self.j_e * (h1[0] - h0[0]) / span
         v = h1[1] * self.r / self.i_tot               # wheel speed at the disc (ABS sensors)
         a = (h1[1] - h0[1]) / span * self.r / self.i_tot

@@ -398,6 +398,16 @@ class ClutchEkf:
         self._ecu_cache: dict = {}
         #: the friction scale's sd when the gain was last referenced, 1
         self.gain_ref_sd = e.mu_deadband
+        #: counts the changes of the estimate (state, covariance, evidence, references) made by
+        #: :meth:`predict`, :meth:`correct`, :meth:`update_evidence` and :meth:`set_prior`: what is derived
+        #: from the estimate alone is kept per revision (:attr:`mu_applied`'s parts, the production TCU's kiss
+        #: point); code that writes :attr:`s` or :attr:`P` directly calls :meth:`changed`
+        self.revision = 0
+        self._mu_parts = (-1, 0.0, 0.0)
+
+    def changed(self) -> None:
+        """Mark the estimate changed (after writing :attr:`s` or :attr:`P` directly)."""
+        self.revision += 1
 
     # --- estimates -----------------------------------------------------------------------------
     @property
@@ -458,6 +468,7 @@ class ClutchEkf:
         self.dx_prior, self.mu_prior, self.x_accuracy = dx_m, mu_scale, dx_sd_m
         self.evidence, self.evidence_ratio, self._over = False, 0.0, 0
         self.mu_evidence, self.mu_evidence_ratio, self._mu_over = False, 0.0, 0
+        self.revision += 1
 
     @property
     def dx_used(self) -> float:
@@ -526,7 +537,11 @@ class ClutchEkf:
     def mu_applied(self) -> float:
         """The friction relative to the nominal mu the TCU applies at the measured slip: the calibration's
         (:attr:`cal`) times :attr:`mu_used` plus the slip-speed slope's term (:meth:`mu_factor`), 1."""
-        return self.cal * (self.mu_used + self.slope_used * (abs(self.slip) - SLIP_REF_RAD_S) / SLIP_UNIT_RAD_S)
+        rev, mu, slope = self._mu_parts             # mu_used and slope_used depend on the estimate alone
+        if rev != self.revision:
+            mu, slope = self.mu_used, self.slope_used
+            self._mu_parts = (self.revision, mu, slope)
+        return self.cal * (mu + slope * (abs(self.slip) - SLIP_REF_RAD_S) / SLIP_UNIT_RAD_S)
 
     @property
     def slope_used(self) -> float:
@@ -623,6 +638,7 @@ class ClutchEkf:
             self.mu_evidence_ratio = r
             self._mu_over = self._mu_over + 1 if r > e.evidence_threshold else 0
             self.mu_evidence = self._mu_over >= e.evidence_confirm or (self.mu_evidence and r > e.evidence_release)
+        self.revision += 1
         return self.evidence
 
     # --- prediction ----------------------------------------------------------------------------
@@ -745,6 +761,7 @@ class ClutchEkf:
         p_new[_DIAG] += qn                       # + diag(qn)
         self.P = p_new
         self.energy_J = self.t_acc = 0.0
+        self.revision += 1
 
     # --- measurement ---------------------------------------------------------------------------
     def correct(self, torque_meas_Nm: float, x_meas_m: float, w_slip_rad_s: float, launching: bool,
@@ -806,4 +823,5 @@ class ClutchEkf:
                 self.ecu_ratio_ref = r_ref
         if mask[IX_DX] or mask[IX_MU]:
             self.update_evidence()
+        self.revision += 1
         return True

@@ -87,8 +87,9 @@ class ProductionTcu(TcuController):
         self.w_prev = (0.0, 0.0)
         self.hist: deque = deque(maxlen=WINDOW + 1)     # (w_e, w_v, T_est, x_meas)
         self.x_offset = sensors.position_offset_m
-        self._closed_key: tuple = ()
+        self._closed_key = -1                   # the EKF revision of the closed-position torque below
         self._closed_value = 0.0
+        self._kiss_rev, self._kiss_belief = -1, 0.0     # the EKF revision of the kiss point below
         super().__init__(variant, sc, table, p, theta0, self.rls.inertia_at_disc_kg_m2(),
                          self.rls.holding_torque_Nm(), j_e_kg_m2, w_idle_rad_s)
 
@@ -104,8 +105,12 @@ class ProductionTcu(TcuController):
         return self.ekf.theta_cm_model
 
     def kiss(self) -> float:
-        """The kiss point the TCU believes, in the true bearing frame, m."""
-        return self.model_kiss(self.ekf.theta_cs) + self.ekf.dx_used - self.x_offset
+        """The kiss point the TCU believes, in the true bearing frame, m (kept until the EKF's estimate changes,
+        :attr:`~.ekf.ClutchEkf.revision`)."""
+        e = self.ekf
+        if e.revision != self._kiss_rev:
+            self._kiss_rev, self._kiss_belief = e.revision, self.model_kiss(e.theta_cs) + e.dx_used - self.x_offset
+        return self._kiss_belief
 
     def command(self, torque_Nm: float) -> float:
         """Bearing position for ``torque_Nm`` (N.m) as the position sensor reads it, m."""
@@ -117,14 +122,13 @@ class ProductionTcu(TcuController):
         """Torque the TCU believes at the true bearing position ``x_m`` (it sees it through its sensor), N.m.
 
         The value at the closed position (asked every launch cycle for the capacity limit) is kept
-        until the EKF's estimate changes (every ``ekf.period_s`` at most), and scaled by the friction the TCU
-        applies at the measured slip.
+        until the EKF's estimate changes (every ``ekf.period_s`` at most, :attr:`~.ekf.ClutchEkf.revision`), and
+        scaled by the friction the TCU applies at the measured slip.
         """
         e = self.ekf
         if x_m == self.sc.tcu.x_to_closed_m:
-            key = (e.theta_cs, e.theta_cm, e.dx_used)
-            if key != self._closed_key:                 # the nominal-friction torque; the friction scales it
-                self._closed_key, self._closed_value = key, e.used_torque(x_m + self.x_offset, mu=1.0)
+            if e.revision != self._closed_key:          # the nominal-friction torque; the friction scales it
+                self._closed_key, self._closed_value = e.revision, e.used_torque(x_m + self.x_offset, mu=1.0)
             return self._closed_value * e.mu_applied
         return e.used_torque(x_m + self.x_offset)
 

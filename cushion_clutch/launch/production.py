@@ -90,6 +90,7 @@ class ProductionTcu(TcuController):
         self._closed_key = -1                   # the EKF revision of the closed-position torque below
         self._closed_value = 0.0
         self._kiss_rev, self._kiss_belief = -1, 0.0     # the EKF revision of the kiss point below
+        self._rls_n, self._rls_load = -1, (0.0, 0.0)     # the RLS's update count and its inertia and load then
         super().__init__(variant, sc, table, p, theta0, self.rls.inertia_at_disc_kg_m2(),
                          self.rls.holding_torque_Nm(), j_e_kg_m2, w_idle_rad_s)
 
@@ -195,7 +196,10 @@ class ProductionTcu(TcuController):
         the sensor's offset (the servo drives the measured position).
         """
         w_e_m, w_d_m, x_m, t_est = self._estimate(x_meas, w_d if w_v is None else w_v)
-        self.j_d, self.t_load = self.rls.inertia_at_disc_kg_m2(), self.rls.holding_torque_Nm()
+        rls = self.rls
+        if rls.updates != self._rls_n:                  # the estimates change only with an update
+            self._rls_n, self._rls_load = rls.updates, (rls.inertia_at_disc_kg_m2(), rls.holding_torque_Nm())
+        self.j_d, self.t_load = self._rls_load
         super().cycle(launch, tl, locked_once, w_e_m, w_d_m, x_m, theta_cm_true, t_est, level, w_d_m)
         if self.x_cmd != 0.0:
             self.x_cmd -= self.x_offset

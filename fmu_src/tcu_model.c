@@ -46,12 +46,3 @@ TM_EXPORT double tm_torque(TcuModel *m, double x_to, double theta_cs, double the
     if (cc_cover_state(&m->cover, &m->table, x_to, theta_cs, theta_cm, m->wear, &st) != 0) return NAN;
     return m->gain * st.clamp;
 }
-
-TM_EXPORT int tm_torques(TcuModel *m, int n, const double *x, double theta_cs, double theta_cm, double *out) {
-    int k, bad = 0;
-    for (k = 0; k < n; ++k) {
-        out[k] = tm_torque(m, x[k], theta_cs, theta_cm);
-        bad += isnan(out[k]);
-    }
-    return bad;
-}

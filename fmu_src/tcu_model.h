@@ -16,5 +16,3 @@ void tm_close(TcuModel *m);
 /* torque (N.m) at bearing position x_to (m), theta_cs and theta_cm (K): gain times the cover's clamp force;
    NaN if the diaphragm cannot hold the cushion there (the caller asks the Python model) */
 double tm_torque(TcuModel *m, double x_to, double theta_cs, double theta_cm);
-/* n torques at positions x[0..n-1] with the same temperatures into out; the count of NaN results */
-int tm_torques(TcuModel *m, int n, const double *x, double theta_cs, double theta_cm, double *out);

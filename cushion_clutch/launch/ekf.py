@@ -725,13 +725,17 @@ class ClutchEkf:
         k_loss, k_heat = s.item(IX_LOSS), s.item(IX_HEAT)
         phi, psi, (a_link, a_sink, b_sink, b_cs) = self._discrete(w_engine, w_disc, clamped, dt, k_loss, k_heat)
         th = s[:N_T]
-        q = np.zeros(N_T)
-        if p_mean != 0.0:
-            q[:N_NODES] = np.array(self.model.heat_inputs(p_mean)) / self._caps
         loss = a_sink * th + b_sink                 # the losses per J/K at k_loss = 1 (0 in the spring's row)
-        rate = a_link @ th + k_loss * loss + q      # the network's heat flow per J/K at k_heat = 1
+        if p_mean != 0.0:                           # the slip heat per J/K (without it, no zeros are added)
+            q = np.zeros(N_T)
+            q[:N_NODES] = np.array(self.model.heat_inputs(p_mean)) / self._caps
+            rate = a_link @ th + k_loss * loss + q  # the network's heat flow per J/K at k_heat = 1
+            b = k_heat * (k_loss * b_sink + q)
+        else:
+            q = None
+            rate = a_link @ th + k_loss * loss
+            b = k_heat * (k_loss * b_sink)
         rate[IX_CS] = 0.0                           # the spring's ODE is the clutch model's: not scaled
-        b = k_heat * (k_loss * b_sink + q)
         b[IX_CS] += b_cs
         s_new = s.copy()
         s_new[:N_T] = phi @ th + psi @ b
@@ -753,7 +757,8 @@ class ClutchEkf:
             f[IX_MU, :N_T] = k_fade * (dnew - dold) / FADE_UNIT_K
         self.s = s_new
         qn = self.q_rw * dt
-        qn[:N_T] += (self.e.heat_share_sd * k_heat * q * dt) ** 2
+        if q is not None:
+            qn[:N_T] += (self.e.heat_share_sd * k_heat * q * dt) ** 2
         qn[IX_MU] += self.e.mu_walk_per_K * max(d_cm, 0.0)
         if self.e.mu_fade_sd > 0.0:
             qn[IX_FADE] += self.e.mu_fade_walk_per_K * max(d_cm, 0.0)

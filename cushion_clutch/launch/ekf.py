@@ -134,9 +134,10 @@ import numpy as np
 
 from ..config import Checked
 from ..model import x_to_for_torque
-from ..model import ClutchParameters, SpringTable, outputs
+from ..model import ClutchParameters, SpringTable
 from ..model.clutch_model import THETA_MAX_K, THETA_MIN_K
 from ..model.thermal_network import FACINGS, N_NODES, TcuNetworkBase, ThermalNetwork
+from .tcu_model import TcuClutchModel
 
 #: state indices: the network's nodes, then these
 IX_CS, IX_DX, IX_MU, IX_LOSS, IX_HEAT = N_NODES, N_NODES + 1, N_NODES + 2, N_NODES + 3, N_NODES + 4
@@ -155,6 +156,8 @@ IX_SLOPE = IX_OFF + 1
 #: ``mu_reference_max_degC``): the last state
 IX_FADE = IX_SLOPE + 1
 N_STATE = IX_FADE + 1
+#: the diagonal of a state covariance (index arrays)
+_DIAG = (np.arange(N_STATE), np.arange(N_STATE))
 #: slip speed about which the friction scale is stated, and the unit of the slope, rad/s
 SLIP_REF_RAD_S = 150.0
 SLIP_UNIT_RAD_S = 100.0
@@ -326,15 +329,22 @@ class ClutchEkf:
         The calibration's friction at a slip speed (rad/s) relative to the nominal mu (the facing's nominal
         slip-speed shape, :meth:`~.scenario.Tcu.mu_calibration`); default: mu constant. The friction states
         are relative to it.
+    native : bool, optional
+        Evaluate the characteristic's torque with the native clutch model (:mod:`.tcu_model`; same figures to
+        round-off) or, False, with the Python model (the reference); default :data:`.tcu_model.NATIVE`.
     """
 
     def __init__(self, net: TcuNetworkParams, e: EkfParams, table: SpringTable, p: ClutchParameters,
-                 theta_a: float, theta0: float, calibration=None):
+                 theta_a: float, theta0: float, calibration=None, native: bool | None = None):
         self.net, self.e, self.table, self.p = net, e, table, p
+        #: the characteristic's torque T(x_to, theta_cs, theta_cm) (native or Python clutch model)
+        self.clutch = TcuClutchModel(table, p, native)
         self.calibration = calibration if calibration is not None else (lambda w: 1.0)
         #: the calibration's friction at the measured slip (:meth:`set_slip`) and at SLIP_REF_RAD_S, 1
         self.cal = self.cal_ref = float(self.calibration(SLIP_REF_RAD_S))
         self.model = ThermalNetwork(net, theta_a, theta0)
+        self._caps = np.array(self.model.caps)   # the nodes' heat capacities, J/K
+        self._eye = np.eye(N_STATE)
         self.theta_a = theta_a
         self.s = np.array([theta0] * N_T + [0.0, 1.0, 1.0, 1.0])
         self.P = np.diag([e.theta0_sd_K ** 2] * N_T + [e.kiss_sd_m ** 2, e.mu_sd ** 2, e.loss_scale_sd ** 2,
@@ -388,17 +398,27 @@ class ClutchEkf:
         self._ecu_cache: dict = {}
         #: the friction scale's sd when the gain was last referenced, 1
         self.gain_ref_sd = e.mu_deadband
+        #: counts the changes of the estimate (state, covariance, evidence, references) made by
+        #: :meth:`predict`, :meth:`correct`, :meth:`update_evidence` and :meth:`set_prior`: what is derived
+        #: from the estimate alone is kept per revision (:attr:`mu_applied`'s parts, the production TCU's kiss
+        #: point); code that writes :attr:`s` or :attr:`P` directly calls :meth:`changed`
+        self.revision = 0
+        self._mu_parts = (-1, 0.0, 0.0)
+
+    def changed(self) -> None:
+        """Mark the estimate changed (after writing :attr:`s` or :attr:`P` directly)."""
+        self.revision += 1
 
     # --- estimates -----------------------------------------------------------------------------
     @property
     def theta_cs(self) -> float:
         """Estimated cushion-spring temperature, K."""
-        return float(self.s[IX_CS])
+        return self.s.item(IX_CS)
 
     @property
     def theta_cm(self) -> float:
         """Estimated facing temperature (mean of both facings), K."""
-        return float(0.5 * (self.s[F1] + self.s[F2]))
+        return 0.5 * (self.s.item(F1) + self.s.item(F2))
 
     @property
     def theta_cm_model(self) -> float:
@@ -410,27 +430,27 @@ class ClutchEkf:
     @property
     def dx_kiss(self) -> float:
         """Learned touch-point offset at the bearing, m."""
-        return float(self.s[IX_DX])
+        return self.s.item(IX_DX)
 
     @property
     def mu_scale(self) -> float:
         """Learned friction relative to the nominal mu, 1."""
-        return float(self.s[IX_MU])
+        return self.s.item(IX_MU)
 
     @property
     def torque_offset(self) -> float:
         """Learned offset of the engine control unit's torque estimate, N.m (not the clutch's: never applied)."""
-        return float(self.s[IX_OFF])
+        return self.s.item(IX_OFF)
 
     @property
     def loss_scale(self) -> float:
         """Learned scale of the network's heat-loss conductances (convection, engine block), 1."""
-        return float(self.s[IX_LOSS])
+        return self.s.item(IX_LOSS)
 
     @property
     def heat_scale(self) -> float:
         """Learned scale of the slip heat that reaches the network, 1."""
-        return float(self.s[IX_HEAT])
+        return self.s.item(IX_HEAT)
 
     def set_prior(self, dx_m: float, dx_sd_m: float, mu_scale: float = 1.0, loss_scale: float = 1.0,
                   heat_scale: float = 1.0) -> None:
@@ -448,12 +468,13 @@ class ClutchEkf:
         self.dx_prior, self.mu_prior, self.x_accuracy = dx_m, mu_scale, dx_sd_m
         self.evidence, self.evidence_ratio, self._over = False, 0.0, 0
         self.mu_evidence, self.mu_evidence_ratio, self._mu_over = False, 0.0, 0
+        self.revision += 1
 
     @property
     def dx_used(self) -> float:
         """The touch-point offset the TCU applies: ``dx_kiss`` on evidence (module docstring), else the
         prior's, m."""
-        return float(self.s[IX_DX]) if self.evidence else self.dx_prior
+        return self.s.item(IX_DX) if self.evidence else self.dx_prior
 
     @property
     def mu_used(self) -> float:
@@ -467,7 +488,7 @@ class ClutchEkf:
         """
         band = self.e.mu_deadband
         if self.evidence and self.gain_ref is not None:
-            return float(self.s[IX_MU]) / self.gain_ref
+            return self.s.item(IX_MU) / self.gain_ref
         if self.mu_evidence:                    # with the prior's touch point: the engine control unit's torque
             return self.mu_prior * self.friction_ratio()    # the filter expects, over its cool reference
         d = (self.s[IX_MU] if self.evidence else self.mu_prior) - 1.0
@@ -482,15 +503,15 @@ class ClutchEkf:
         nearly collinear touch point, friction scale and offset carry; NaN beyond the closed capacity.
         """
         s = self.s if s is None else s
-        th = min(max(float(s[IX_CS]), self.table.theta_min_K), self.table.theta_max_K)
-        theta_cm = min(max(float(0.5 * (s[F1] + s[F2])), THETA_MIN_K), THETA_MAX_K)   # within the model's range
-        key = (round(th, 0), round(theta_cm, 0), round(float(s[IX_DX]) - self.dx_prior, 7))
+        th = min(max(s.item(IX_CS), self.table.theta_min_K), self.table.theta_max_K)
+        theta_cm = min(max(0.5 * (s.item(F1) + s.item(F2)), THETA_MIN_K), THETA_MAX_K)   # within the model's range
+        key = (round(th, 0), round(theta_cm, 0), round(s.item(IX_DX) - self.dx_prior, 7))
         hit = self._ecu_cache.get(key)
         if hit is None:
             try:
                 x = x_to_for_torque(FRICTION_TORQUE_NM, th, self.table, self.p, theta_cm=theta_cm)
-                t0 = outputs(x, th, self.table, self.p, theta_cm).torque
-                t1 = outputs(x + self.dx_prior - float(s[IX_DX]), th, self.table, self.p, theta_cm).torque
+                t0 = self.clutch.torque(x, th, theta_cm)
+                t1 = self.clutch.torque(x + self.dx_prior - s.item(IX_DX), th, theta_cm)
                 hit = (t0, t1) if t0 >= 0.9 * FRICTION_TORQUE_NM else (math.nan, math.nan)
             except ValueError:
                 hit = (math.nan, math.nan)
@@ -499,7 +520,7 @@ class ClutchEkf:
             self._ecu_cache[key] = hit
         t0, t1 = hit
         c = self.cal_ref
-        return (c * float(s[IX_MU]) * t1 + float(s[IX_OFF])) / (c * t0)
+        return (c * s.item(IX_MU) * t1 + s.item(IX_OFF)) / (c * t0)
 
     def friction_ratio(self) -> float:
         """The friction relative to the one on cool facings: :meth:`ecu_ratio` over its cool reference
@@ -516,15 +537,19 @@ class ClutchEkf:
     def mu_applied(self) -> float:
         """The friction relative to the nominal mu the TCU applies at the measured slip: the calibration's
         (:attr:`cal`) times :attr:`mu_used` plus the slip-speed slope's term (:meth:`mu_factor`), 1."""
-        return self.cal * (self.mu_used + self.slope_used * (abs(self.slip) - SLIP_REF_RAD_S) / SLIP_UNIT_RAD_S)
+        rev, mu, slope = self._mu_parts             # mu_used and slope_used depend on the estimate alone
+        if rev != self.revision:
+            mu, slope = self.mu_used, self.slope_used
+            self._mu_parts = (self.revision, mu, slope)
+        return self.cal * (mu + slope * (abs(self.slip) - SLIP_REF_RAD_S) / SLIP_UNIT_RAD_S)
 
     @property
     def slope_used(self) -> float:
         """The slip-speed slope of the friction the TCU applies (per ``SLIP_UNIT_RAD_S``): the learned slope
         beyond ``mu_slope_evidence_sd`` of its standard deviation (0 while the filter cannot tell it from
         none: the nominal mu is constant), 1."""
-        d, band = float(self.s[IX_SLOPE]), self.e.mu_slope_evidence_sd * math.sqrt(max(float(self.P[IX_SLOPE,
-                                                                                                   IX_SLOPE]), 0.0))
+        d = self.s.item(IX_SLOPE)
+        band = self.e.mu_slope_evidence_sd * math.sqrt(max(self.P.item(IX_SLOPE, IX_SLOPE), 0.0))
         return d - band if d > band else (d + band if d < -band else 0.0)
 
     def model_torque(self, x_m: float, s: np.ndarray | None = None, mu: float | None = None,
@@ -535,18 +560,18 @@ class ClutchEkf:
         relative to the nominal mu (:meth:`mu_factor`).
         """
         s = self.s if s is None else s
-        th = min(max(float(s[IX_CS]), self.table.theta_min_K), self.table.theta_max_K)
-        theta_cm = min(max(float(0.5 * (s[F1] + s[F2])), THETA_MIN_K), THETA_MAX_K)   # the stack's growth there
+        th = min(max(s.item(IX_CS), self.table.theta_min_K), self.table.theta_max_K)
+        theta_cm = min(max(0.5 * (s.item(F1) + s.item(F2)), THETA_MIN_K), THETA_MAX_K)   # the stack's growth there
         f = self.mu_factor(s, mu) if factor is None else factor
-        return f * outputs(x_m - float(s[IX_DX]), th, self.table, self.p, theta_cm).torque
+        return f * self.clutch.torque(x_m - s.item(IX_DX), th, theta_cm)
 
     def mu_factor(self, s: np.ndarray | None = None, mu: float | None = None) -> float:
         """Friction relative to the nominal mu at the measured slip :attr:`slip`: the calibration's there
         (:attr:`cal`) times the scale (``mu`` if given) plus the slip-speed slope times
         ``(|slip| - SLIP_REF_RAD_S) / SLIP_UNIT_RAD_S``, 1."""
         s = self.s if s is None else s
-        return self.cal * ((float(s[IX_MU]) if mu is None else mu)
-                           + float(s[IX_SLOPE]) * (abs(self.slip) - SLIP_REF_RAD_S) / SLIP_UNIT_RAD_S)
+        return self.cal * ((s.item(IX_MU) if mu is None else mu)
+                           + s.item(IX_SLOPE) * (abs(self.slip) - SLIP_REF_RAD_S) / SLIP_UNIT_RAD_S)
 
     def set_slip(self, w_slip_rad_s: float) -> None:
         """The measured slip speed (rad/s) at which the characteristic is evaluated from now on."""
@@ -556,9 +581,12 @@ class ClutchEkf:
     def used_torque(self, x_m: float, mu: float | None = None) -> float:
         """The torque the TCU applies at the measured bearing position ``x_m`` (m): :attr:`dx_used` and
         :attr:`mu_applied` (``mu`` replaces the latter: the whole friction relative to the nominal mu), N.m."""
-        s = self.s.copy()
-        s[IX_DX] = self.dx_used
-        return self.model_torque(x_m, s, factor=self.mu_applied if mu is None else mu)
+        # model_torque on the estimate with dx_used for dx_kiss, without the copy of the state: the same operations
+        s = self.s
+        th = min(max(s.item(IX_CS), self.table.theta_min_K), self.table.theta_max_K)
+        theta_cm = min(max(0.5 * (s.item(F1) + s.item(F2)), THETA_MIN_K), THETA_MAX_K)
+        f = self.mu_applied if mu is None else mu
+        return f * self.clutch.torque(x_m - self.dx_used, th, theta_cm)
 
     def update_evidence(self) -> bool:
         """Compare the learned characteristic with the nominal one; set and return :attr:`evidence`.
@@ -572,7 +600,7 @@ class ClutchEkf:
         ``evidence_confirm`` consecutive calls, kept until it falls below ``evidence_release``.
         """
         e, s = self.e, self.s
-        th = min(max(float(s[IX_CS]), self.table.theta_min_K), self.table.theta_max_K)
+        th = min(max(s.item(IX_CS), self.table.theta_min_K), self.table.theta_max_K)
         theta_cm = self.theta_cm_model
         key = (round(th, 0), round(theta_cm, 0))
         pts = self._ev_cache.get(key)
@@ -583,10 +611,10 @@ class ClutchEkf:
                     x = x_to_for_torque(t, th, self.table, self.p, theta_cm=theta_cm)
                 except ValueError:
                     continue
-                t0 = outputs(x, th, self.table, self.p, theta_cm).torque
+                t0 = self.clutch.torque(x, th, theta_cm)
                 if t0 < 0.9 * t:                    # beyond the closed capacity
                     continue
-                slope = (outputs(x + 10e-6, th, self.table, self.p, theta_cm).torque - t0) / 10e-6
+                slope = (self.clutch.torque(x + 10e-6, th, theta_cm) - t0) / 10e-6
                 pts.append((x, t0, e.mu_deadband * t0 + e.torque_offset_accuracy_Nm, slope))
             if len(self._ev_cache) > 4096:
                 self._ev_cache.clear()
@@ -594,11 +622,11 @@ class ClutchEkf:
         dx0, mu0 = self.dx_prior, self.mu_prior
         # before the gain is referenced the touch point and the friction are judged together (nearly collinear,
         # module docstring); after, the friction has its own evidence (below) and this is the touch point's
-        mu, dx = (float(s[IX_MU]) if self.gain_ref is None else mu0), float(s[IX_DX])
+        mu, dx = (s.item(IX_MU) if self.gain_ref is None else mu0), s.item(IX_DX)
         ratio = 0.0
         for x, t0, env0, slope in pts:                  # the prior's position for each nominal torque
             env = mu0 * (env0 + slope * self.x_accuracy)
-            d = abs(mu * outputs(x + dx0 - dx, th, self.table, self.p, theta_cm).torque - mu0 * t0)
+            d = abs(mu * self.clutch.torque(x + dx0 - dx, th, theta_cm) - mu0 * t0)
             ratio = max(ratio, d / env if env > 0.0 else math.inf)
         self.evidence_ratio = ratio
         self._over = self._over + 1 if ratio > e.evidence_threshold else 0
@@ -610,6 +638,7 @@ class ClutchEkf:
             self.mu_evidence_ratio = r
             self._mu_over = self._mu_over + 1 if r > e.evidence_threshold else 0
             self.mu_evidence = self._mu_over >= e.evidence_confirm or (self.mu_evidence and r > e.evidence_release)
+        self.revision += 1
         return self.evidence
 
     # --- prediction ----------------------------------------------------------------------------
@@ -693,28 +722,32 @@ class ClutchEkf:
             return
         p_mean = self.energy_J / dt
         s = self.s
-        k_loss, k_heat = float(s[IX_LOSS]), float(s[IX_HEAT])
+        k_loss, k_heat = s.item(IX_LOSS), s.item(IX_HEAT)
         phi, psi, (a_link, a_sink, b_sink, b_cs) = self._discrete(w_engine, w_disc, clamped, dt, k_loss, k_heat)
         th = s[:N_T]
-        q = np.zeros(N_T)
-        if p_mean != 0.0:
-            q[:N_NODES] = np.array(self.model.heat_inputs(p_mean)) / self.model.caps
         loss = a_sink * th + b_sink                 # the losses per J/K at k_loss = 1 (0 in the spring's row)
-        rate = a_link @ th + k_loss * loss + q      # the network's heat flow per J/K at k_heat = 1
+        if p_mean != 0.0:                           # the slip heat per J/K (without it, no zeros are added)
+            q = np.zeros(N_T)
+            q[:N_NODES] = np.array(self.model.heat_inputs(p_mean)) / self._caps
+            rate = a_link @ th + k_loss * loss + q  # the network's heat flow per J/K at k_heat = 1
+            b = k_heat * (k_loss * b_sink + q)
+        else:
+            q = None
+            rate = a_link @ th + k_loss * loss
+            b = k_heat * (k_loss * b_sink)
         rate[IX_CS] = 0.0                           # the spring's ODE is the clutch model's: not scaled
-        b = k_heat * (k_loss * b_sink + q)
         b[IX_CS] += b_cs
         s_new = s.copy()
         s_new[:N_T] = phi @ th + psi @ b
-        f = np.eye(N_STATE)
+        f = self._eye.copy()
         f[:N_T, :N_T] = phi
         f[:N_T, IX_LOSS] = psi @ (k_heat * loss)
         f[:N_T, IX_HEAT] = psi @ rate
         ref = self.e.mu_reference_max_degC + 273.15      # the friction may change as the facings heat above it
-        cm_old, cm_new = 0.5 * float(s[F1] + s[F2]), 0.5 * float(s_new[F1] + s_new[F2])
+        cm_old, cm_new = 0.5 * (s.item(F1) + s.item(F2)), 0.5 * (s_new.item(F1) + s_new.item(F2))
         d_cm = max(cm_new, ref) - max(cm_old, ref)
         if self.e.mu_fade_sd > 0.0 and d_cm != 0.0:      # the friction follows the facings: mu += k d(theta_cm)
-            k_fade = float(s[IX_FADE])
+            k_fade = s.item(IX_FADE)
             s_new[IX_MU] += k_fade * d_cm / FADE_UNIT_K
             f[IX_MU, IX_FADE] = d_cm / FADE_UNIT_K
             dnew = 0.5 * (phi[F1] + phi[F2]) if cm_new > ref else np.zeros(N_T)
@@ -724,12 +757,16 @@ class ClutchEkf:
             f[IX_MU, :N_T] = k_fade * (dnew - dold) / FADE_UNIT_K
         self.s = s_new
         qn = self.q_rw * dt
-        qn[:N_T] += (self.e.heat_share_sd * k_heat * q * dt) ** 2
+        if q is not None:
+            qn[:N_T] += (self.e.heat_share_sd * k_heat * q * dt) ** 2
         qn[IX_MU] += self.e.mu_walk_per_K * max(d_cm, 0.0)
         if self.e.mu_fade_sd > 0.0:
             qn[IX_FADE] += self.e.mu_fade_walk_per_K * max(d_cm, 0.0)
-        self.P = f @ self.P @ f.T + np.diag(qn)
+        p_new = f @ self.P @ f.T
+        p_new[_DIAG] += qn                       # + diag(qn)
+        self.P = p_new
         self.energy_J = self.t_acc = 0.0
+        self.revision += 1
 
     # --- measurement ---------------------------------------------------------------------------
     def correct(self, torque_meas_Nm: float, x_meas_m: float, w_slip_rad_s: float, launching: bool,
@@ -744,7 +781,7 @@ class ClutchEkf:
             return False
         self.set_slip(w_slip_rad_s)
         h0 = self.model_torque(x_meas_m)
-        off = float(self.s[IX_OFF])
+        off = self.s.item(IX_OFF)
         mask = np.zeros(N_STATE, dtype=bool)
         if e.touch_torque_min_Nm <= h0 <= e.touch_torque_max_Nm:
             mask[IX_DX] = True
@@ -785,10 +822,11 @@ class ClutchEkf:
         if mask[IX_MU] and self.theta_cm < e.mu_reference_max_degC + 273.15:
             band = e.mu_deadband
             self.gain_ref = min(max(self.mu_scale, 1.0 - band), 1.0 + band)
-            self.gain_ref_sd = math.sqrt(max(float(self.P[IX_MU, IX_MU]), 0.0))
+            self.gain_ref_sd = math.sqrt(max(self.P.item(IX_MU, IX_MU), 0.0))
             r_ref = self.ecu_ratio()
             if math.isfinite(r_ref):
                 self.ecu_ratio_ref = r_ref
         if mask[IX_DX] or mask[IX_MU]:
             self.update_evidence()
+        self.revision += 1
         return True

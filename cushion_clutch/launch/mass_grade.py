@@ -74,7 +74,7 @@ class MassGradeEstimator:
     """
 
     __slots__ = ("mg", "i_tot", "r", "eta", "m_rot", "c_r", "air", "theta", "P", "lam", "r_noise", "p0",
-                 "updates")
+                 "updates", "_cap")
 
     def __init__(self, mg: MassGrade, i_tot: float, r_m: float, eta: float, j_disc_kg_m2: float,
                  rolling: float, air_N_s2_per_m2: float, slope0_percent: float = 0.0):
@@ -86,6 +86,7 @@ class MassGradeEstimator:
         self.theta = np.array([m_eq, mg.mass_prior_kg * G * (math.sin(alpha) + rolling * math.cos(alpha))])
         self.p0 = np.array([mg.mass_prior_sd_kg, mg.load_prior_sd_N]) ** 2
         self.P = np.diag(self.p0)
+        self._cap = float(self.p0.sum())       # the covariance's bound on its trace
         self.lam, self.r_noise = mg.forgetting, mg.noise_sd_N ** 2
         self.updates = 0
 
@@ -94,14 +95,25 @@ class MassGradeEstimator:
         if clutch_torque_Nm < self.mg.torque_min_Nm or v_m_s < self.mg.speed_min_m_s:
             return False
         y = self.eta * self.i_tot * clutch_torque_Nm / self.r - self.air * v_m_s * v_m_s
+        # numpy for the products (its matrix-vector product's rounding is the reference's), plain floats for
+        # the elementwise rest (the same IEEE operations without numpy's per-call cost)
         phi = np.array([a_m_s2, 1.0])
         pphi = self.P @ phi
-        k = pphi / (self.lam * self.r_noise + phi @ pphi)
-        self.theta = self.theta + k * (y - phi @ self.theta)
-        self.P = (self.P - np.outer(k, pphi)) / self.lam
-        tr, cap = float(np.trace(self.P)), float(self.p0.sum())
+        den = self.lam * self.r_noise + (phi @ pphi).item()
+        pp0, pp1 = pphi.tolist()
+        k0, k1 = pp0 / den, pp1 / den
+        e = y - (phi @ self.theta).item()
+        t0, t1 = self.theta.tolist()
+        self.theta = np.array([t0 + k0 * e, t1 + k1 * e])
+        (p00, p01), (p10, p11) = self.P.tolist()
+        lam = self.lam
+        p00, p01 = (p00 - k0 * pp0) / lam, (p01 - k0 * pp1) / lam
+        p10, p11 = (p10 - k1 * pp0) / lam, (p11 - k1 * pp1) / lam
+        tr, cap = p00 + p11, self._cap
         if tr > cap:                      # bounded covariance: no wind-up while the data do not excite
-            self.P *= cap / tr
+            f = cap / tr
+            p00, p01, p10, p11 = p00 * f, p01 * f, p10 * f, p11 * f
+        self.P = np.array([[p00, p01], [p10, p11]])
         self.updates += 1
         return True
 

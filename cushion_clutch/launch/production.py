@@ -87,8 +87,10 @@ class ProductionTcu(TcuController):
         self.w_prev = (0.0, 0.0)
         self.hist: deque = deque(maxlen=WINDOW + 1)     # (w_e, w_v, T_est, x_meas)
         self.x_offset = sensors.position_offset_m
-        self._closed_key: tuple = ()
+        self._closed_key = -1                   # the EKF revision of the closed-position torque below
         self._closed_value = 0.0
+        self._kiss_rev, self._kiss_belief = -1, 0.0     # the EKF revision of the kiss point below
+        self._rls_n, self._rls_load = -1, (0.0, 0.0)     # the RLS's update count and its inertia and load then
         super().__init__(variant, sc, table, p, theta0, self.rls.inertia_at_disc_kg_m2(),
                          self.rls.holding_torque_Nm(), j_e_kg_m2, w_idle_rad_s)
 
@@ -104,8 +106,12 @@ class ProductionTcu(TcuController):
         return self.ekf.theta_cm_model
 
     def kiss(self) -> float:
-        """The kiss point the TCU believes, in the true bearing frame, m."""
-        return self.model_kiss(self.ekf.theta_cs) + self.ekf.dx_used - self.x_offset
+        """The kiss point the TCU believes, in the true bearing frame, m (kept until the EKF's estimate changes,
+        :attr:`~.ekf.ClutchEkf.revision`)."""
+        e = self.ekf
+        if e.revision != self._kiss_rev:
+            self._kiss_rev, self._kiss_belief = e.revision, self.model_kiss(e.theta_cs) + e.dx_used - self.x_offset
+        return self._kiss_belief
 
     def command(self, torque_Nm: float) -> float:
         """Bearing position for ``torque_Nm`` (N.m) as the position sensor reads it, m."""
@@ -117,14 +123,13 @@ class ProductionTcu(TcuController):
         """Torque the TCU believes at the true bearing position ``x_m`` (it sees it through its sensor), N.m.
 
         The value at the closed position (asked every launch cycle for the capacity limit) is kept
-        until the EKF's estimate changes (every ``ekf.period_s`` at most), and scaled by the friction the TCU
-        applies at the measured slip.
+        until the EKF's estimate changes (every ``ekf.period_s`` at most, :attr:`~.ekf.ClutchEkf.revision`), and
+        scaled by the friction the TCU applies at the measured slip.
         """
         e = self.ekf
         if x_m == self.sc.tcu.x_to_closed_m:
-            key = (e.theta_cs, e.theta_cm, e.dx_used)
-            if key != self._closed_key:                 # the nominal-friction torque; the friction scales it
-                self._closed_key, self._closed_value = key, e.used_torque(x_m + self.x_offset, mu=1.0)
+            if e.revision != self._closed_key:          # the nominal-friction torque; the friction scales it
+                self._closed_key, self._closed_value = e.revision, e.used_torque(x_m + self.x_offset, mu=1.0)
             return self._closed_value * e.mu_applied
         return e.used_torque(x_m + self.x_offset)
 
@@ -162,9 +167,9 @@ class ProductionTcu(TcuController):
             return readings
         span = WINDOW * self.period
         h0, h1 = self.hist[0], self.hist[-1]
-        items = list(self.hist)[1:]
-        t_est = sum(i[2] for i in items) / WINDOW
-        x_mean = sum(i[3] for i in items) / WINDOW
+        _, _, ts, xs = zip(*self.hist)
+        t_est = sum(ts[1:]) / WINDOW
+        x_mean = sum(xs[1:]) / WINDOW
         t_c = t_est - self.j_e * (h1[0] - h0[0]) / span
         v = h1[1] * self.r / self.i_tot               # wheel speed at the disc (ABS sensors)
         a = (h1[1] - h0[1]) / span * self.r / self.i_tot
@@ -191,7 +196,10 @@ class ProductionTcu(TcuController):
         the sensor's offset (the servo drives the measured position).
         """
         w_e_m, w_d_m, x_m, t_est = self._estimate(x_meas, w_d if w_v is None else w_v)
-        self.j_d, self.t_load = self.rls.inertia_at_disc_kg_m2(), self.rls.holding_torque_Nm()
+        rls = self.rls
+        if rls.updates != self._rls_n:                  # the estimates change only with an update
+            self._rls_n, self._rls_load = rls.updates, (rls.inertia_at_disc_kg_m2(), rls.holding_torque_Nm())
+        self.j_d, self.t_load = self._rls_load
         super().cycle(launch, tl, locked_once, w_e_m, w_d_m, x_m, theta_cm_true, t_est, level, w_d_m)
         if self.x_cmd != 0.0:
             self.x_cmd -= self.x_offset

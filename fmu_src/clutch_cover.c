@@ -70,6 +70,24 @@ void cc_cover_prepare(CcCover *cv, const double *par, double lever_ratio, double
     cv->p1h = 1.0 + par[CV_H] * par[CV_H] / cv->tt;
     cv->f_theta_cs = NAN; /* no frame yet */
     cv->hint = cv->hint_k = cv->hint_t = 0;
+    /* the open solve's shortcut (cc_cover_solve) needs every CurvePair's cell 0 to be the clamped constant:
+       coefficients 1..3 +0 in both curves, and a first knot (clutch_tables.c builds them so; else it stays off;
+       -DCC_NO_OPEN_SHORTCUT turns it off, for tests/test_native_speed.py's comparison) */
+    cv->open_ok = 1;
+    {
+        int j, r;
+        for (j = 0; j < 2 * tb->nt - 1; ++j) {
+            const CurvePair *pr = &tb->pairs[j];
+            if (pr->m < 1) cv->open_ok = 0;
+            for (r = 1; r < 4 && pr->m >= 1; ++r)
+                if (!(pr->cell[0].a[r] == 0.0 && !signbit(pr->cell[0].a[r]) && pr->cell[0].d[r] == 0.0 &&
+                      !signbit(pr->cell[0].d[r])))
+                    cv->open_ok = 0;
+        }
+    }
+#ifdef CC_NO_OPEN_SHORTCUT
+    cv->open_ok = 0;
+#endif
 }
 
 /* -(dx_to/ds) at its smallest (open phase, s = h) at the largest E: > 0 means no snap-through */
@@ -140,11 +158,13 @@ static void frame(CcCover *cv, const Table *tb, double theta_cs, double theta_cm
 }
 
 
-#ifdef CC_COUNT_EVALS /* tests/test_native_speed.py counts the solver's cushion evaluations */
-long cc_count_evals;
+#ifdef CC_COUNT_EVALS /* tests/test_native_speed.py counts the solver's cushion evaluations (and the open ones) */
+long cc_count_evals, cc_count_open;
 #define COUNT_EVAL() (++cc_count_evals)
+#define COUNT_OPEN() (++cc_count_open)
 #else
 #define COUNT_EVAL() ((void)0)
+#define COUNT_OPEN() ((void)0)
 #endif
 
 int cc_cover_solve(CcCover *cv, const Table *tb, double x_to, double theta_cs, double theta_cm, double wear,
@@ -195,10 +215,46 @@ int cc_cover_solve(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
             else s = (xc - x_to - comp * cv->fto_kiss) / kb;
             if (!(s > lo && s < hi)) s = hi;
         }
+        k = 0;
+        if (x_to < cv->x_kiss && cv->open_ok) {
+            /* open: the answer lies past the kiss point. Where phi = ((s_kiss - s) kp - first) inv_span, as
+               cc_bracket_force computes it, lies below the CurvePair's first knot, phi is in cell 0, where
+               cc_bracket_force returns (a0 + w d0) + tau (c1 + tau (c2 + tau c3)) with c1..c3 = +0 and tau < 0, i.e.
+               a0 + w d0 bit for bit, and dF_c/du, d2F_c/du2 are +0, which leave the slope and the curvature as they
+               are without them (x - (+0) = x; the curvature only enters as r times it against 2 slope^2). There
+               r(s) is the cubic P(s) + ckl F_c: the steps of the loop below without the table, the same bits
+               (tests/test_native_speed.py), until an iterate leaves cell 0 (then that loop goes on) */
+            const PairCell *c = b->pr->cell;
+            const double first = b->first, isp = b->inv_span, lo1 = c[1].lo;
+            if (((s_kiss - s) * kp - first) * isp < lo1) {
+                double r0;
+                fc = c[0].a[0] + b->w * c[0].d[0];
+                r0 = ckl * fc;
+                r = p0 + s * (p1 + s * (p2 + s * p3)) + r0;
+                COUNT_EVAL(); COUNT_OPEN();
+                for (; k < 100; ++k) {
+                    double s_new;
+                    if (fabs(r) <= tol_r || hi - lo <= 1e-15 * (1.0 + hi)) goto done;
+                    if (r > 0.0) lo = s; else hi = s;
+                    slope = p1 + s * (2.0 * p2 + 3.0 * p3 * s);
+                    if (slope < 0.0) {
+                        double curv = 2.0 * p2 + 6.0 * p3 * s, s2 = slope * slope;
+                        double den = 2.0 * s2 - r * curv;
+                        s_new = den > s2 && den < 4.0 * s2 ? s - 2.0 * r * slope / den : s - r / slope;
+                    } else s_new = 0.5 * (lo + hi);
+                    s = (s_new > lo && s_new < hi) ? s_new : 0.5 * (lo + hi);
+                    if (!(((s_kiss - s) * kp - first) * isp < lo1)) { ++k; goto table; }
+                    r = p0 + s * (p1 + s * (p2 + s * p3)) + r0;
+                    COUNT_EVAL(); COUNT_OPEN();
+                }
+                goto done;
+            }
+        }
+    table:
         fc = cushion(b, (s_kiss - s) * kp, &hint, &pt);
         r = p0 + s * (p1 + s * (p2 + s * p3)) + ckl * fc;
         COUNT_EVAL();
-        for (k = 0; k < 100; ++k) {
+        for (; k < 100; ++k) {
             double s_new;
             if (fabs(r) <= tol_r || hi - lo <= 1e-15 * (1.0 + hi)) break;
             if (r > 0.0) lo = s; else hi = s;
@@ -216,6 +272,7 @@ int cc_cover_solve(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
             r = p0 + s * (p1 + s * (p2 + s * p3)) + ckl * fc;
             COUNT_EVAL();
         }
+    done:
         /* the bearing force at the answer as cover.py writes it */
         fto = (moment(cv, s, cv->f_e) - fc * cv->L_pp) / cv->L_b;
         cv->hint = hint;

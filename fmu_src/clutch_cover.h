@@ -29,6 +29,7 @@ typedef struct {
     TBracket f_br;
     double s_kiss, s_solid, fc_solid, m_solid, fto_solid, fto_kiss, x_solid, x_kiss;
     double p1, p2, p3;                /* the solver's P(s) = X_c - x_to + p1 s + p2 s^2 + p3 s^3, m */
+    int open_ok; /* every CurvePair's cell 0 is the clamped constant: the open solve's shortcut (cc_cover_prepare) */
 } CcCover;
 
 typedef struct {

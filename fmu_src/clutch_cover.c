@@ -229,15 +229,20 @@ int cc_cover_solve(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
                (tests/test_native_speed.py), until an iterate leaves cell 0 (then that loop goes on) */
             const PairCell *c = b->pr->cell;
             const double first = b->first, isp = b->inv_span, lo1 = c[1].lo;
-            double sq;
-            /* the open start: with a history of three answers (CcWarm s2, s1, s0, each refined by a Newton step),
-               their parabola in the order of the solves, s2 + 3 (s0 - s1), if the bearing moved by at most
-               CC_WARM_DX and it lies in the bracket and in cell 0 (where the cushion carries its constant, so the
-               torque does not depend on the start). The open clutch's answer drifts smoothly with theta_cs and a
-               decaying bearing: in the 1 ms steps of a launch's braked standstill the first evaluation passes the
-               test in 9 of 10 steps, the tangent's in none */
-            if (fabs(d) <= CC_WARM_DX && w->s2 == w->s2 &&
-                (sq = w->s2 + 3.0 * (w->s0 - w->s1), sq > lo && sq < hi && ((s_kiss - sq) * kp - first) * isp < lo1)) {
+            double sq = NAN;
+            /* the open start: with a history of three answers (the last one, w->s, and CcWarm s1, s2 of the two
+               open solves before, each refined by a Newton step), their parabola in the order of the solves,
+               s2 + 3 (s0 - s1), if the bearing moved by at most CC_WARM_DX and it lies in the bracket and in cell 0
+               (where the cushion carries its constant, so the torque does not depend on the start). The open
+               clutch's answer drifts smoothly with theta_cs and a decaying bearing: in the 1 ms steps of a launch's
+               braked standstill the first evaluation passes the test in 9 of 10 steps, the tangent's in none */
+            if (w->x == w->x) { /* the history goes on with the last answer refined (finite) */
+                const double s0 = w->slope < -1e-200 ? w->s - w->r / w->slope : w->s;
+                sq = w->s2 + 3.0 * (s0 - w->s1);
+                w->s2 = w->s1;
+                w->s1 = s0;
+            } else w->s1 = w->s2 = NAN;
+            if (fabs(d) <= CC_WARM_DX && sq > lo && sq < hi && ((s_kiss - sq) * kp - first) * isp < lo1) {
                 s = sq;
                 slope = w->slope;
             }
@@ -264,7 +269,7 @@ int cc_cover_solve(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
                 }
                 goto done;
             }
-        }
+        } else w->s1 = NAN; /* the open history starts again after a solve in the cushion phase */
     table:
         fc = cushion(b, (s_kiss - s) * kp, &hint, &pt);
         r = p0 + s * (p1 + s * (p2 + s * p3)) + ckl * fc;
@@ -296,11 +301,7 @@ int cc_cover_solve(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
         out->cushion = fc;
         out->u = (s_kiss - s) * kp;
         out->s = s;
-        if (w->x == w->x) { /* the history of answers goes on (else it starts again with this one) */
-            w->s2 = w->s1;
-            w->s1 = w->s0;
-        } else w->s1 = w->s2 = NAN;
-        w->s0 = slope < -1e-200 ? s - r / slope : s; /* refined by a Newton step (finite): the extrapolation's point */
+        w->r = r;
         w->x = x_to;
         w->s = s;
         w->slope = slope;

@@ -610,7 +610,9 @@ int cc_state_check(CcModel *m, const void *bytes, size_t size, const char *fn) {
         }
     if (!isfinite(s.time) || !(s.r[VR_THETA_CS] >= THETA_MIN_K && s.r[VR_THETA_CS] <= THETA_MAX_K) ||
         !(s.range_warned >= 0 && s.range_warned <= 2) || !(s.terminated == 0 || s.terminated == 1) ||
-        !(isnan(s.warm.x) || isfinite(s.warm.x)) || !isfinite(s.warm.s) || !isfinite(s.warm.slope)) {
+        !(isnan(s.warm.x) || isfinite(s.warm.x)) || !isfinite(s.warm.s) || !isfinite(s.warm.slope) ||
+        !(isnan(s.warm.r) || isfinite(s.warm.r)) || !(isnan(s.warm.s1) || isfinite(s.warm.s1)) ||
+        !(isnan(s.warm.s2) || isfinite(s.warm.s2))) {
         cc_log(m, CC_ERROR, "%s: the state's time, theta_cs, flags or warm start are out of range", fn);
         return 0;
     }

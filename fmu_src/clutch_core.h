@@ -82,7 +82,8 @@ typedef struct {
 
 /* the serialized (and saved) FMU state: versioned, checksummed, validated before use */
 #define CC_STATE_MAGIC 0x43434653u /* "CCFS" */
-#define CC_STATE_VERSION 5u /* 3: the cover variables; 4: validity (range_warned = last validity 0..2); 5: warm start */
+#define CC_STATE_VERSION 6u /* 3: the cover variables; 4: validity (range_warned = last validity 0..2); 5: warm start;
+                               6: the warm start's residual and history (CcWarm r, s1, s2) */
 typedef struct {
     uint32_t magic, version, size;
     int32_t phase, me, range_warned, terminated, reserved;

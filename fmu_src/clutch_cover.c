@@ -12,9 +12,12 @@
  * The forward map is a safeguarded Halley iteration on s in [s_solid, s_rigid]. cc_cover_state starts it from a
  * chord (3.1 evaluations per call on average): the start depends on the inputs only, so its results are the same
  * bits whatever the call history. cc_cover_solve starts from the last answer moved along its tangent when the
- * bearing moved by at most CC_WARM_DX (2.0 evaluations per call in a launch's 1 ms steps); its answer passes the
- * same residual test, so it agrees with cc_cover_state's to that residual, and depends on the CcWarm passed in
- * (the FMU keeps it in its saved state).
+ * bearing moved by at most CC_WARM_DX (2.0 evaluations per call in a launch's 1 ms steps), or, with the clutch
+ * open and the cushion in its force-free cell, from the parabola through its last three answers (1.1 evaluations
+ * per call in a braked standstill's 1 ms steps); its answer passes the same residual test, so it agrees with
+ * cc_cover_state's to that residual, and depends on the CcWarm passed in (the FMU keeps it in its saved state).
+ * Where the cushion is in that cell the solve iterates on the cubic P(s) alone, with the same bits as with the
+ * table (open clutch: no table lookups).
  */
 #include "clutch_cover.h"
 
@@ -70,6 +73,24 @@ void cc_cover_prepare(CcCover *cv, const double *par, double lever_ratio, double
     cv->p1h = 1.0 + par[CV_H] * par[CV_H] / cv->tt;
     cv->f_theta_cs = NAN; /* no frame yet */
     cv->hint = cv->hint_k = cv->hint_t = 0;
+    /* the open solve's shortcut (cc_cover_solve) needs every CurvePair's cell 0 to be the clamped constant:
+       coefficients 1..3 +0 in both curves, and a first knot (clutch_tables.c builds them so; else it stays off;
+       -DCC_NO_OPEN_SHORTCUT turns it off, for tests/test_native_speed.py's comparison) */
+    cv->open_ok = 1;
+    {
+        int j, r;
+        for (j = 0; j < 2 * tb->nt - 1; ++j) {
+            const CurvePair *pr = &tb->pairs[j];
+            if (pr->m < 1) cv->open_ok = 0;
+            for (r = 1; r < 4 && pr->m >= 1; ++r)
+                if (!(pr->cell[0].a[r] == 0.0 && !signbit(pr->cell[0].a[r]) && pr->cell[0].d[r] == 0.0 &&
+                      !signbit(pr->cell[0].d[r])))
+                    cv->open_ok = 0;
+        }
+    }
+#ifdef CC_NO_OPEN_SHORTCUT
+    cv->open_ok = 0;
+#endif
 }
 
 /* -(dx_to/ds) at its smallest (open phase, s = h) at the largest E: > 0 means no snap-through */
@@ -140,11 +161,13 @@ static void frame(CcCover *cv, const Table *tb, double theta_cs, double theta_cm
 }
 
 
-#ifdef CC_COUNT_EVALS /* tests/test_native_speed.py counts the solver's cushion evaluations */
-long cc_count_evals;
+#ifdef CC_COUNT_EVALS /* tests/test_native_speed.py counts the solver's cushion evaluations (and the open ones) */
+long cc_count_evals, cc_count_open;
 #define COUNT_EVAL() (++cc_count_evals)
+#define COUNT_OPEN() (++cc_count_open)
 #else
 #define COUNT_EVAL() ((void)0)
+#define COUNT_OPEN() ((void)0)
 #endif
 
 int cc_cover_solve(CcCover *cv, const Table *tb, double x_to, double theta_cs, double theta_cm, double wear,
@@ -186,7 +209,7 @@ int cc_cover_solve(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
         /* start: the warm start's answer moved along its tangent, if the bearing moved by at most CC_WARM_DX and it
            lies in the bracket (false for a slope of 0: inf or NaN); else (from the inputs only) the chord of x(s)
            between the solid and kiss points (cushion phase) or the rigid lever shifted by the kiss-point
-           compliance (open) */
+           compliance (open). Open, the parabola through the warm start's history below replaces it */
         if (fabs(d) <= CC_WARM_DX && (s = w->s + d / w->slope, s > lo && s < hi)) {
             slope = w->slope; /* the tangent kept if this start passes the test at once */
         } else {
@@ -195,10 +218,63 @@ int cc_cover_solve(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
             else s = (xc - x_to - comp * cv->fto_kiss) / kb;
             if (!(s > lo && s < hi)) s = hi;
         }
+        k = 0;
+        if (x_to < cv->x_kiss) {
+            /* open: the answer lies past the kiss point. Where phi = ((s_kiss - s) kp - first) inv_span, as
+               cc_bracket_force computes it, lies below the CurvePair's first knot, phi is in cell 0, where
+               cc_bracket_force returns (a0 + w d0) + tau (c1 + tau (c2 + tau c3)) with c1..c3 = +0 and tau < 0, i.e.
+               a0 + w d0 bit for bit, and dF_c/du, d2F_c/du2 are +0, which leave the slope and the curvature as they
+               are without them (x - (+0) = x; the curvature only enters as r times it against 2 slope^2). There
+               r(s) is the cubic P(s) + ckl F_c: the steps of the loop below without the table, the same bits
+               (tests/test_native_speed.py), until an iterate leaves cell 0 (then that loop goes on) */
+            const PairCell *c = b->pr->cell;
+            const double first = b->first, isp = b->inv_span, lo1 = c[1].lo;
+            double sq = NAN;
+            /* the open start: with a history of three answers (the last one, w->s, and CcWarm s1, s2 of the two
+               open solves before, each refined by a Newton step), their parabola in the order of the solves,
+               s2 + 3 (s0 - s1), if the bearing moved by at most CC_WARM_DX and it lies in the bracket and in cell 0
+               (where the cushion carries its constant, so the torque does not depend on the start). The open
+               clutch's answer drifts smoothly with theta_cs and a decaying bearing: in the 1 ms steps of a launch's
+               braked standstill the first evaluation passes the test in 9 of 10 steps, the tangent's in none */
+            if (w->x == w->x) { /* the history goes on with the last answer refined (finite) */
+                const double s0 = w->slope < -1e-200 ? w->s - w->r / w->slope : w->s;
+                sq = w->s2 + 3.0 * (s0 - w->s1);
+                w->s2 = w->s1;
+                w->s1 = s0;
+            } else w->s1 = w->s2 = NAN;
+            if (fabs(d) <= CC_WARM_DX && sq > lo && sq < hi && ((s_kiss - sq) * kp - first) * isp < lo1) {
+                s = sq;
+                slope = w->slope;
+            }
+            if (cv->open_ok && ((s_kiss - s) * kp - first) * isp < lo1) {
+                double r0;
+                fc = c[0].a[0] + b->w * c[0].d[0];
+                r0 = ckl * fc;
+                r = p0 + s * (p1 + s * (p2 + s * p3)) + r0;
+                COUNT_EVAL(); COUNT_OPEN();
+                for (; k < 100; ++k) {
+                    double s_new;
+                    if (fabs(r) <= tol_r || hi - lo <= 1e-15 * (1.0 + hi)) goto done;
+                    if (r > 0.0) lo = s; else hi = s;
+                    slope = p1 + s * (2.0 * p2 + 3.0 * p3 * s);
+                    if (slope < 0.0) {
+                        double curv = 2.0 * p2 + 6.0 * p3 * s, s2 = slope * slope;
+                        double den = 2.0 * s2 - r * curv;
+                        s_new = den > s2 && den < 4.0 * s2 ? s - 2.0 * r * slope / den : s - r / slope;
+                    } else s_new = 0.5 * (lo + hi);
+                    s = (s_new > lo && s_new < hi) ? s_new : 0.5 * (lo + hi);
+                    if (!(((s_kiss - s) * kp - first) * isp < lo1)) { ++k; goto table; }
+                    r = p0 + s * (p1 + s * (p2 + s * p3)) + r0;
+                    COUNT_EVAL(); COUNT_OPEN();
+                }
+                goto done;
+            }
+        } else w->s1 = NAN; /* the open history starts again after a solve in the cushion phase */
+    table:
         fc = cushion(b, (s_kiss - s) * kp, &hint, &pt);
         r = p0 + s * (p1 + s * (p2 + s * p3)) + ckl * fc;
         COUNT_EVAL();
-        for (k = 0; k < 100; ++k) {
+        for (; k < 100; ++k) {
             double s_new;
             if (fabs(r) <= tol_r || hi - lo <= 1e-15 * (1.0 + hi)) break;
             if (r > 0.0) lo = s; else hi = s;
@@ -216,6 +292,7 @@ int cc_cover_solve(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
             r = p0 + s * (p1 + s * (p2 + s * p3)) + ckl * fc;
             COUNT_EVAL();
         }
+    done:
         /* the bearing force at the answer as cover.py writes it */
         fto = (moment(cv, s, cv->f_e) - fc * cv->L_pp) / cv->L_b;
         cv->hint = hint;
@@ -224,6 +301,7 @@ int cc_cover_solve(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
         out->cushion = fc;
         out->u = (s_kiss - s) * kp;
         out->s = s;
+        w->r = r;
         w->x = x_to;
         w->s = s;
         w->slope = slope;

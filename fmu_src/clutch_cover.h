@@ -29,6 +29,7 @@ typedef struct {
     TBracket f_br;
     double s_kiss, s_solid, fc_solid, m_solid, fto_solid, fto_kiss, x_solid, x_kiss;
     double p1, p2, p3;                /* the solver's P(s) = X_c - x_to + p1 s + p2 s^2 + p3 s^3, m */
+    int open_ok; /* every CurvePair's cell 0 is the clamped constant: the open solve's shortcut (cc_cover_prepare) */
 } CcCover;
 
 typedef struct {
@@ -38,9 +39,11 @@ typedef struct {
 } CcCoverState;
 
 /* a warm start of the cover's solve (cc_cover_solve): the last answer's bearing position x (m; NaN: none),
-   diaphragm deflection s (m) and dx_to/ds near it (the last Halley step's slope; 0: none) */
+   diaphragm deflection s (m), dx_to/ds near it (the last Halley step's slope; 0: none) and residual r (m); the
+   history of the open start: s1 and s2 the answers of the two open solves before the last, refined by a Newton
+   step (m; NaN: none; a solve after x NaN starts it again, so setting x NaN makes the whole warm start cold) */
 typedef struct {
-    double x, s, slope;
+    double x, s, slope, r, s1, s2;
 } CcWarm;
 /* the largest bearing travel (m) between two solves for which the last answer, moved along its tangent, starts the
    next; a larger jump starts from the chord, as cc_cover_state does */
@@ -48,8 +51,9 @@ typedef struct {
 
 void cc_cover_prepare(CcCover *cv, const double *par, double lever_ratio, double x_kiss_ref, const Table *tb);
 /* cc_cover_state from the warm start *w (if the bearing moved by at most CC_WARM_DX since w->x and the start lies
-   in the bracket; else from the chord), then *w = this answer (x NaN in the solid phase and on refusal): the answer
-   passes the same residual test, so it agrees with cc_cover_state's to that residual, not bit for bit */
+   in the bracket: the tangent at w->s, or open in the cushion's force-free cell the parabola through the history
+   s2, s1 and w->s; else from the chord), then *w = this answer (x NaN in the solid phase and on refusal): the answer passes the same residual
+   test, so it agrees with cc_cover_state's to that residual, not bit for bit */
 int cc_cover_solve(CcCover *cv, const Table *tb, double x_to, double theta_cs, double theta_cm, double wear,
                    CcWarm *w, CcCoverState *out);
 double cc_cover_slope_bound(const CcCover *cv);

@@ -223,8 +223,8 @@ def test_corrupted_states_are_refused_and_change_nothing(capfd):
     for k in range(100):
         s.doStep(k * 0.1, 0.1)
     blob = bytearray(s.serializeFMUstate(s.getFMUstate()))
-    # header, r[], the cover's warm start (3 doubles), checksum
-    assert len(blob) == 40 + 8 * (len(VARIABLES) + 1) + 24 + 8 and blob[:4] == b"SFCC"
+    # header, r[], the cover's warm start (6 doubles: CcWarm x, s, slope, r and the open start's s1, s2), checksum
+    assert len(blob) == 40 + 8 * (len(VARIABLES) + 1) + 48 + 8 and blob[:4] == b"SFCC"
     before = s.getReal(list(range(19)))
     c_at = 40 + 8 * vr["C"]
     nan_c = bytearray(blob)

@@ -133,7 +133,6 @@ from typing import Iterable
 import numpy as np
 
 from ..config import Checked
-from ..model import x_to_for_torque
 from ..model import ClutchParameters, SpringTable
 from ..model.clutch_model import THETA_MAX_K, THETA_MIN_K
 from ..model.thermal_network import FACINGS, N_NODES, TcuNetworkBase, ThermalNetwork
@@ -509,7 +508,7 @@ class ClutchEkf:
         hit = self._ecu_cache.get(key)
         if hit is None:
             try:
-                x = x_to_for_torque(FRICTION_TORQUE_NM, th, self.table, self.p, theta_cm=theta_cm)
+                x = self.clutch.x_for_torque(FRICTION_TORQUE_NM, th, theta_cm)
                 t0 = self.clutch.torque(x, th, theta_cm)
                 t1 = self.clutch.torque(x + self.dx_prior - s.item(IX_DX), th, theta_cm)
                 hit = (t0, t1) if t0 >= 0.9 * FRICTION_TORQUE_NM else (math.nan, math.nan)
@@ -608,7 +607,7 @@ class ClutchEkf:
             pts = []
             for t in EVIDENCE_TORQUES_NM:
                 try:
-                    x = x_to_for_torque(t, th, self.table, self.p, theta_cm=theta_cm)
+                    x = self.clutch.x_for_torque(t, th, theta_cm)
                 except ValueError:
                     continue
                 t0 = self.clutch.torque(x, th, theta_cm)

@@ -155,8 +155,6 @@ IX_SLOPE = IX_OFF + 1
 #: ``mu_reference_max_degC``): the last state
 IX_FADE = IX_SLOPE + 1
 N_STATE = IX_FADE + 1
-#: the diagonal of a state covariance (index arrays)
-_DIAG = (np.arange(N_STATE), np.arange(N_STATE))
 #: slip speed about which the friction scale is stated, and the unit of the slope, rad/s
 SLIP_REF_RAD_S = 150.0
 SLIP_UNIT_RAD_S = 100.0
@@ -762,7 +760,7 @@ class ClutchEkf:
         if self.e.mu_fade_sd > 0.0:
             qn[IX_FADE] += self.e.mu_fade_walk_per_K * max(d_cm, 0.0)
         p_new = f @ self.P @ f.T
-        p_new[_DIAG] += qn                       # + diag(qn)
+        p_new.ravel()[::N_STATE + 1] += qn       # + diag(qn) (the diagonal as a strided view: the same sums)
         self.P = p_new
         self.energy_J = self.t_acc = 0.0
         self.revision += 1

@@ -16,3 +16,8 @@ void tm_close(TcuModel *m);
 /* torque (N.m) at bearing position x_to (m), theta_cs and theta_cm (K): gain times the cover's clamp force;
    NaN if the diaphragm cannot hold the cushion there (the caller asks the Python model) */
 double tm_torque(TcuModel *m, double x_to, double theta_cs, double theta_cm);
+/* the inverse (clutch_model.x_to_for_torque, cover.py _Frame.x_for_clamp): the smallest bearing position (m) whose
+   torque reaches torque (N.m) at theta_cs and theta_cm (K), the cushion's compression found to tol_m / lever ratio
+   (tol_m in m); at or below the cushion's first force its first-contact position, above the closed capacity the
+   lift-off position; NaN if the diaphragm cannot hold the cushion (the caller asks the Python model) */
+double tm_x_for_torque(TcuModel *m, double torque, double theta_cs, double theta_cm, double tol_m);

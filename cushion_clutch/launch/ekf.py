@@ -133,7 +133,6 @@ from typing import Iterable
 import numpy as np
 
 from ..config import Checked
-from ..model import x_to_for_torque
 from ..model import ClutchParameters, SpringTable
 from ..model.clutch_model import THETA_MAX_K, THETA_MIN_K
 from ..model.thermal_network import FACINGS, N_NODES, TcuNetworkBase, ThermalNetwork
@@ -156,8 +155,6 @@ IX_SLOPE = IX_OFF + 1
 #: ``mu_reference_max_degC``): the last state
 IX_FADE = IX_SLOPE + 1
 N_STATE = IX_FADE + 1
-#: the diagonal of a state covariance (index arrays)
-_DIAG = (np.arange(N_STATE), np.arange(N_STATE))
 #: slip speed about which the friction scale is stated, and the unit of the slope, rad/s
 SLIP_REF_RAD_S = 150.0
 SLIP_UNIT_RAD_S = 100.0
@@ -509,7 +506,7 @@ class ClutchEkf:
         hit = self._ecu_cache.get(key)
         if hit is None:
             try:
-                x = x_to_for_torque(FRICTION_TORQUE_NM, th, self.table, self.p, theta_cm=theta_cm)
+                x = self.clutch.x_for_torque(FRICTION_TORQUE_NM, th, theta_cm)
                 t0 = self.clutch.torque(x, th, theta_cm)
                 t1 = self.clutch.torque(x + self.dx_prior - s.item(IX_DX), th, theta_cm)
                 hit = (t0, t1) if t0 >= 0.9 * FRICTION_TORQUE_NM else (math.nan, math.nan)
@@ -608,7 +605,7 @@ class ClutchEkf:
             pts = []
             for t in EVIDENCE_TORQUES_NM:
                 try:
-                    x = x_to_for_torque(t, th, self.table, self.p, theta_cm=theta_cm)
+                    x = self.clutch.x_for_torque(t, th, theta_cm)
                 except ValueError:
                     continue
                 t0 = self.clutch.torque(x, th, theta_cm)
@@ -763,7 +760,7 @@ class ClutchEkf:
         if self.e.mu_fade_sd > 0.0:
             qn[IX_FADE] += self.e.mu_fade_walk_per_K * max(d_cm, 0.0)
         p_new = f @ self.P @ f.T
-        p_new[_DIAG] += qn                       # + diag(qn)
+        p_new.ravel()[::N_STATE + 1] += qn       # + diag(qn) (the diagonal as a strided view: the same sums)
         self.P = p_new
         self.energy_J = self.t_acc = 0.0
         self.revision += 1

@@ -47,7 +47,7 @@ from .ekf import IX_DX, ClutchEkf, EkfParams, TcuNetworkParams
 from .mass_grade import MassGrade, MassGradeEstimator
 from .sensors import ProductionSensors, TcuSensors
 from .store import AdaptedState, load_state, save_state
-from .tcu import LAUNCH, OPEN, TcuController, Variant
+from .tcu import LAUNCH, OPEN, TcuController, Variant, _memo
 from .touchpoint import StandstillResult, learn_touch_point
 
 #: TCU periods over which speeds are differentiated
@@ -112,6 +112,14 @@ class ProductionTcu(TcuController):
         if e.revision != self._kiss_rev:
             self._kiss_rev, self._kiss_belief = e.revision, self.model_kiss(e.theta_cs) + e.dx_used - self.x_offset
         return self._kiss_belief
+
+    def x_for_torque(self, torque_Nm: float, theta: float, theta_cm: float) -> float:
+        """The model's bearing position for ``torque_Nm`` (N.m) at ``theta`` and ``theta_cm`` (K), m: the EKF's
+        clutch model's inverse (:meth:`~.tcu_model.TcuClutchModel.x_for_torque`: native, or with
+        ``tcu_model.NATIVE = False`` the Python :func:`~cushion_clutch.model.x_to_for_torque`, the reference),
+        remembered per exact inputs as :meth:`.tcu.TcuController.x_for_torque` does."""
+        return _memo(self._command_memo, (torque_Nm, theta, theta_cm),
+                     lambda: self.ekf.clutch.x_for_torque(torque_Nm, theta, theta_cm))
 
     def command(self, torque_Nm: float) -> float:
         """Bearing position for ``torque_Nm`` (N.m) as the position sensor reads it, m."""

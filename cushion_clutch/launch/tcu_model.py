@@ -26,7 +26,7 @@ from pathlib import Path
 
 from ..data import fmu_sources
 from ..fmu.hostlib import host_library
-from ..model import ClutchParameters, SpringTable, outputs
+from ..model import ClutchParameters, SpringTable, outputs, x_to_for_torque
 from ..model.clutch_model import THETA_MAX_K, THETA_MIN_K, X_TO_MAX, X_TO_MIN
 
 log = logging.getLogger(__name__)
@@ -121,6 +121,7 @@ class TcuClutchModel:
             raise RuntimeError(ffi.string(err).decode(errors="replace"))
         self._m = ffi.gc(m, lib.tm_close)
         self._torque = lib.tm_torque
+        self._inverse = lib.tm_x_for_torque
 
     @property
     def native(self) -> bool:
@@ -141,3 +142,24 @@ class TcuClutchModel:
             if t == t:
                 return t
         return outputs(x_to, theta_cs, self.table, self.p, theta_cm).torque
+
+    def x_for_torque(self, torque: float, theta_cs: float, theta_cm: float, tol_m: float = 1e-12) -> float:
+        """Smallest bearing position (m) whose torque reaches ``torque`` (N.m) at ``theta_cs`` and ``theta_cm``
+        (K): ``x_to_for_torque(torque, theta_cs, table, p, tol_m, theta_cm)`` (at or below the cushion's first
+        force its first-contact position, above the closed capacity the lift-off position).
+
+        The native inverse finds the cushion's compression as the Python one does (the same bracket, to
+        ``tol_m`` over the lever ratio) and its position through the forward map (the secant method), so the
+        two agree within about ``tol_m`` (``tests/test_tcu_model.py``).
+
+        Raises
+        ------
+        ValueError
+            As :func:`~..model.x_to_for_torque`, naming the argument outside its range.
+        """
+        if self._m is not None and -1e9 <= torque <= 1e9 and THETA_MIN_K <= theta_cs <= THETA_MAX_K \
+                and THETA_MIN_K <= theta_cm <= THETA_MAX_K and 0.0 < tol_m <= 1.0:
+            x = self._inverse(self._m, torque, theta_cs, theta_cm, tol_m)
+            if x == x:
+                return x
+        return x_to_for_torque(torque, theta_cs, self.table, self.p, tol_m, theta_cm=theta_cm)

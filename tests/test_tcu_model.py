@@ -139,8 +139,8 @@ def test_python_path_is_the_reference_and_the_fallback(monkeypatch, caplog):
     def broken():
         raise RuntimeError("no compiler (test)")
 
-    monkeypatch.setattr(tcu_model, "_LIB", None)
-    monkeypatch.setattr(tcu_model, "library", broken)
+    monkeypatch.setattr(tcu_model.LIBRARY, "_loaded", None)
+    monkeypatch.setattr(tcu_model.LIBRARY, "path", broken)
     with caplog.at_level(logging.WARNING, logger="cushion_clutch.launch.tcu_model"):
         m = TcuClutchModel(table, p)
     assert not m.native and "no compiler (test)" in caplog.text
@@ -234,20 +234,22 @@ def test_a_production_run_gives_the_same_figures_on_both_paths(tmp_path, monkeyp
     amplifies the torque's round-off; measured on this machine: at most 1.1e-10, in the worst characteristic error
     of launch 2; 1.6e-8 in the hot protection runs of test_launch_golden). With the native inverse too (it differs
     from the Python one within its 1e-12 m tolerance, at the last probe of the bracket, not to round-off) the
-    quantiser takes other steps, as with another sensor-noise realisation: the thermal estimate, the characteristic
-    error and the slip energy stay within 1e-4 relative (measured: at most 1.5e-5), the engagement within 0.05 s;
-    the shuffle and tracking figures move more (measured: up to 5e-3 relative)."""
+    quantiser takes other steps, as with another sensor-noise realisation; judged on the bar's scale (7.2 N.m) the
+    figures stay put: the characteristic errors within 1e-3 N.m (measured on main 8cbfd68: 1.7e-4 in launch 2; 1.5e-5
+    relative on the code before the cover's warm starts, which move the plant's trajectory), the thermal estimate
+    within 1e-4 K (4e-7), the kiss point within 1e-6 mm, the slip energy within 1e-3 relative (3.3e-5), the
+    engagement within 0.1 s (0.038); the shuffle and tracking figures move more (measured: up to 5e-3 relative)."""
     runs = _creep_runs(tmp_path, monkeypatch, ((True, False), (False, False), (True, True)))
     ref = runs[False, False]
     assert _compare(runs[True, False], ref,
                     lambda k, v, w: abs(v - w) <= 1e-8 * max(abs(v), abs(w), 1e-9)) > 10
-    close = ("theta_cs_start_degC", "theta_cs_error_K", "characteristic_error_max_Nm", "characteristic_error_rms_Nm",
-             "slip_energy_kJ", "kiss_point_error_mm")
+    absolute = {"theta_cs_start_degC": 1e-4, "theta_cs_error_K": 1e-4, "characteristic_error_max_Nm": 1e-3,
+                "characteristic_error_rms_Nm": 1e-3, "kiss_point_error_mm": 1e-6, "engagement_time_s": 0.1}
 
     def near(k, v, w):
-        if k in close:
-            return abs(v - w) <= 1e-4 * max(abs(v), abs(w), 1e-9)
-        if k == "engagement_time_s":
-            return abs(v - w) <= 0.05
+        if k in absolute:
+            return abs(v - w) <= absolute[k]
+        if k == "slip_energy_kJ":
+            return abs(v - w) <= 1e-3 * max(abs(v), abs(w))
         return True
     assert _compare(runs[True, True], ref, near) > 10

@@ -67,3 +67,33 @@ def host_library(name: str, files: tuple[str, ...], headers: tuple[str, ...],
         os.replace(tmp, out)                        # atomic: a parallel build leaves one whole library
         return out
     raise RuntimeError(f"no writable cache folder for the native {name} library")
+
+
+class HostLibrary:
+    """One ``fmu_src`` library for this machine, compiled on first use and loaded once with cffi.
+
+    Parameters
+    ----------
+    name : str
+        The library's file name stem (see :func:`host_library`).
+    files, headers : tuple of str
+        Sources compiled and headers they include, names in ``fmu_src``; ``headers[0]`` declares the API
+        (``cffi.FFI.cdef``).
+    """
+
+    def __init__(self, name: str, files: tuple[str, ...], headers: tuple[str, ...]):
+        self.name, self.files, self.headers = name, files, headers
+        self._loaded = None
+
+    def path(self) -> Path:
+        """The compiled library (:func:`host_library`; raises ``RuntimeError`` as it does)."""
+        return host_library(self.name, self.files, self.headers)
+
+    def load(self):
+        """``(ffi, lib)``: the API of ``headers[0]`` and the opened library (opened once per process)."""
+        if self._loaded is None:
+            import cffi
+            ffi = cffi.FFI()
+            ffi.cdef((fmu_sources() / self.headers[0]).read_text())
+            self._loaded = (ffi, ffi.dlopen(str(self.path())))
+        return self._loaded

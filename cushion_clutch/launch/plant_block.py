@@ -18,13 +18,8 @@ C compiler, and cached under ``$XDG_CACHE_HOME/cushion_clutch`` (default ``~/.ca
 """
 from __future__ import annotations
 
-from pathlib import Path
-
-import cffi
-
-from ..data import fmu_sources
 from ..errors import FmuCallError
-from ..fmu.hostlib import host_library
+from ..fmu.hostlib import HostLibrary
 
 SOURCE, HEADER = "launch_plant.c", "launch_plant.h"
 #: the most points of an engine torque curve the C step takes (lp_consts.curve_w)
@@ -40,28 +35,8 @@ HEAD = ("steps", "n_events", "w_e", "w_d", "v", "phi", "locked", "t_e", "x_act",
 MAX_NODES = 16
 
 
-def library() -> Path:
-    """The compiled plant step (built on first use, cached by the sources' hash; :func:`.hostlib.host_library`).
-
-    Raises
-    ------
-    RuntimeError
-        If no compiler is found or the build fails (with the compiler's message).
-    """
-    return host_library("launch_plant", (SOURCE,), (HEADER,))
-
-
-_FFI = None
-_LIB = None
-
-
-def _lib():
-    global _FFI, _LIB
-    if _LIB is None:
-        ffi = cffi.FFI()
-        ffi.cdef((fmu_sources() / HEADER).read_text())
-        _LIB, _FFI = ffi.dlopen(str(library())), ffi
-    return _FFI, _LIB
+#: the compiled plant step (built on first use, cached by the sources' hash)
+LIBRARY = HostLibrary("launch_plant", (SOURCE,), (HEADER,))
 
 
 class NativePlant:
@@ -91,7 +66,7 @@ class NativePlant:
             raise ValueError(f"engine torque curve: {len(engine.w)} points, the native plant takes {MAX_CURVE}")
         if len(net.theta) > MAX_NODES:
             raise ValueError(f"thermal network: {len(net.theta)} nodes, the native plant takes {MAX_NODES}")
-        ffi, lib = _lib()
+        ffi, lib = LIBRARY.load()
         self.ffi, self.run_block, self.run_quiet = ffi, lib.lp_run_block, lib.lp_run_quiet
         self.clutch, self.engine, self.dl, self.net = clutch, engine, dl, net
         c = self.c = ffi.new("lp_consts *")

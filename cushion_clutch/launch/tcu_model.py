@@ -14,7 +14,7 @@ within about 1e-11 relative (``tests/test_native_speed.py``), so the two paths d
 diaphragm cannot hold the cushion, are always answered (or refused, with its ``ValueError``) by the Python
 model, so both paths raise the same errors.
 
-The library is compiled once per source version and cached (:func:`..fmu.hostlib.host_library`).
+The library is compiled once per source version and cached (:class:`..fmu.hostlib.HostLibrary`).
 """
 from __future__ import annotations
 
@@ -24,8 +24,7 @@ import shutil
 import tempfile
 from pathlib import Path
 
-from ..data import fmu_sources
-from ..fmu.hostlib import host_library
+from ..fmu.hostlib import HostLibrary
 from ..model import ClutchParameters, SpringTable, outputs, x_to_for_torque
 from ..model.clutch_model import THETA_MAX_K, THETA_MIN_K, X_TO_MAX, X_TO_MIN
 
@@ -39,29 +38,8 @@ SOURCES = ("tcu_model.c", "clutch_tables.c", "clutch_cover.c", "resource_uri.c")
 HEADERS = ("tcu_model.h", "clutch_tables.h", "clutch_cover.h", "resource_uri.h")
 
 
-def library() -> Path:
-    """The compiled TCU clutch model (built on first use, cached by the sources' hash).
-
-    Raises
-    ------
-    RuntimeError
-        If no compiler is found or the build fails (with the compiler's message).
-    """
-    return host_library("tcu_model", SOURCES, HEADERS)
-
-
-_FFI = None
-_LIB = None
-
-
-def _lib():
-    global _FFI, _LIB
-    if _LIB is None:
-        import cffi
-        ffi = cffi.FFI()
-        ffi.cdef((fmu_sources() / "tcu_model.h").read_text())
-        _LIB, _FFI = ffi.dlopen(str(library())), ffi
-    return _FFI, _LIB
+#: the compiled TCU clutch model (built on first use, cached by the sources' hash)
+LIBRARY = HostLibrary("tcu_model", SOURCES, HEADERS)
 
 
 def write_table(table: SpringTable, folder: Path) -> None:
@@ -106,7 +84,7 @@ class TcuClutchModel:
                 self._m = None
 
     def _open(self) -> None:
-        ffi, lib = _lib()
+        ffi, lib = LIBRARY.load()
         p = self.p
         folder = Path(tempfile.mkdtemp(prefix="tcu_model_"))
         try:

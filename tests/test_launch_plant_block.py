@@ -113,13 +113,12 @@ def test_unknown_plant_named(fmu):
         simulate_launches(fmu, _scenario("creep", 1, 14.0), load_table(), "naive", plant="c")
 
 
-def test_fmu_refusal_raises_naming_the_function(fmu):
-    """An input the FMU refuses (a NaN bearing position): FmuCallError naming fmi2DoStep, as the Python path."""
-    from cushion_clutch.errors import FmuCallError
+def _creep_plant(fmu, theta0_K):
+    """A native plant of one ``creep`` launch with the network at ``theta0_K``, its clutch FMU (the caller closes
+    it) and the step, s."""
     from cushion_clutch.launch.driveline import Driveline
     from cushion_clutch.launch.engine import EngineGovernor
     from cushion_clutch.launch.fmu_client import ClutchFmu
-    from cushion_clutch.launch.metrics import LaunchRecord
     from cushion_clutch.launch.plant_block import NativePlant
     from cushion_clutch.model.thermal_network import ThermalNetwork
 
@@ -129,8 +128,21 @@ def test_fmu_refusal_raises_naming_the_function(fmu):
     dl = Driveline(sc, engine.w_idle)
     clutch = ClutchFmu(fmu, {})
     try:
-        native = NativePlant(clutch, engine, dl, ThermalNetwork(sc.plant_thermal, 293.15, 400.0), h, 0.9, 300.0,
+        native = NativePlant(clutch, engine, dl, ThermalNetwork(sc.plant_thermal, 293.15, theta0_K), h, 0.9, 300.0,
                              0.3, 10, 10, 0.05, 30.0)
+    except BaseException:
+        clutch.close()
+        raise
+    return native, clutch, h
+
+
+def test_fmu_refusal_raises_naming_the_function(fmu):
+    """An input the FMU refuses (a NaN bearing position): FmuCallError naming fmi2DoStep, as the Python path."""
+    from cushion_clutch.errors import FmuCallError
+    from cushion_clutch.launch.metrics import LaunchRecord
+
+    native, clutch, h = _creep_plant(fmu, 400.0)
+    try:
         native.start(LaunchRecord(1, False, h), 0.0, 400.0, 0.0, 0.0, 400.0, 0.0)
         args = dict(k0=0, n_steps=100, next_switch=1.0, slot_start=0.0, slot_end=1.0, countdown=10, x_cmd=1e-3,
                     pedal_level=0.5, t_dem=0.0, t_rate=0.0, engaged=True, braking=False, launching=True)
@@ -145,21 +157,11 @@ def test_quiet_period_refusals(fmu):
     """lp_run_quiet: a torque with the bearing not retracted is reported (None: the loop raises), an input the
     FMU refuses raises FmuCallError naming the function."""
     from cushion_clutch.errors import FmuCallError
-    from cushion_clutch.launch.driveline import Driveline
-    from cushion_clutch.launch.engine import EngineGovernor
-    from cushion_clutch.launch.fmu_client import ClutchFmu
     from cushion_clutch.launch.metrics import LaunchRecord
-    from cushion_clutch.launch.plant_block import HEAD, NativePlant
-    from cushion_clutch.model.thermal_network import ThermalNetwork
+    from cushion_clutch.launch.plant_block import HEAD
 
-    sc = _scenario("creep", 1)
-    h = sc.run.step_s
-    engine = EngineGovernor(sc.engine, h)
-    dl = Driveline(sc, engine.w_idle)
-    clutch = ClutchFmu(fmu, {})
+    native, clutch, h = _creep_plant(fmu, 300.0)
     try:
-        native = NativePlant(clutch, engine, dl, ThermalNetwork(sc.plant_thermal, 293.15, 300.0), h, 0.9, 300.0,
-                             0.3, 10, 10, 0.05, 30.0)
         rec = LaunchRecord(1, False, h)
         native.start(rec, 0.0, 300.0, 0.0, 0.0, 300.0, 0.0)
         head = dict(zip(HEAD, native.quiet(0.0, 10 * h, 1.0)))       # retracted: no torque, the network stepped

@@ -31,6 +31,14 @@
 #include "fmi2Functions.h"
 #include "host_fmi2.h"          /* logger, LOAD_FMI2_CS, host_fmi2_start() */
 
+/* FNV-1a 64 of n doubles' bytes, continuing from hash */
+static unsigned long long fnv1a(unsigned long long hash, const double *v, size_t n) {
+    const unsigned char *b = (const unsigned char *)v;
+    size_t i;
+    for (i = 0; i < n * sizeof(double); ++i) hash = (hash ^ b[i]) * 1099511628211ULL;
+    return hash;
+}
+
 /* the replay file's steps (3 doubles each) in a malloc'd array, their number in *n; NULL (reason on stderr) */
 static double *read_replay(const char *path, long *n) {
     FILE *f = fopen(path, "rb");
@@ -114,11 +122,7 @@ int main(int argc, char **argv) {
                     return 1;
                 }
                 t += h;
-                if (checksum) {
-                    const unsigned char *b = (const unsigned char *)out;
-                    size_t i;
-                    for (i = 0; i < 3 * sizeof(double); ++i) hash = (hash ^ b[i]) * 1099511628211ULL;
-                }
+                if (checksum) hash = fnv1a(hash, out, 3);
                 if (++j == nrec) { j = 0; r = rec; } else r += 3;
             }
             t1 = now_s();
@@ -135,11 +139,7 @@ int main(int argc, char **argv) {
                     return 1;
                 }
                 t += h;
-                if (checksum) {
-                    const unsigned char *b = (const unsigned char *)out;
-                    size_t j;
-                    for (j = 0; j < sizeof out; ++j) hash = (hash ^ b[j]) * 1099511628211ULL;
-                }
+                if (checksum) hash = fnv1a(hash, out, 5);
             }
             t1 = now_s();
             printf("outputs %.17g %.17g %.17g %.17g %.17g\n", out[0], out[1], out[2], out[3], out[4]);

@@ -429,6 +429,12 @@ class ClutchEkf:
         stop the TCU), K."""
         return min(max(self.theta_cm, THETA_MIN_K), THETA_MAX_K)
 
+    def _model_temperatures(self, s: np.ndarray) -> tuple[float, float]:
+        """The temperatures the characteristic is evaluated at for state ``s``: ``theta_cs`` within the
+        table's range and the facings' mean within the model's (the stack's growth there), K."""
+        return (min(max(s.item(IX_CS), self.table.theta_min_K), self.table.theta_max_K),
+                min(max(0.5 * (s.item(F1) + s.item(F2)), THETA_MIN_K), THETA_MAX_K))
+
     @property
     def dx_kiss(self) -> float:
         """Learned touch-point offset at the bearing, m."""
@@ -505,8 +511,7 @@ class ClutchEkf:
         nearly collinear touch point, friction scale and offset carry; NaN beyond the closed capacity.
         """
         s = self.s if s is None else s
-        th = min(max(s.item(IX_CS), self.table.theta_min_K), self.table.theta_max_K)
-        theta_cm = min(max(0.5 * (s.item(F1) + s.item(F2)), THETA_MIN_K), THETA_MAX_K)   # within the model's range
+        th, theta_cm = self._model_temperatures(s)
         key = (round(th, 0), round(theta_cm, 0), round(s.item(IX_DX) - self.dx_prior, 7))
         hit = self._ecu_cache.get(key)
         if hit is None:
@@ -562,8 +567,7 @@ class ClutchEkf:
         relative to the nominal mu (:meth:`mu_factor`).
         """
         s = self.s if s is None else s
-        th = min(max(s.item(IX_CS), self.table.theta_min_K), self.table.theta_max_K)
-        theta_cm = min(max(0.5 * (s.item(F1) + s.item(F2)), THETA_MIN_K), THETA_MAX_K)   # the stack's growth there
+        th, theta_cm = self._model_temperatures(s)
         f = self.mu_factor(s, mu) if factor is None else factor
         return f * self.clutch.torque(x_m - s.item(IX_DX), th, theta_cm)
 
@@ -583,10 +587,8 @@ class ClutchEkf:
     def used_torque(self, x_m: float, mu: float | None = None) -> float:
         """The torque the TCU applies at the measured bearing position ``x_m`` (m): :attr:`dx_used` and
         :attr:`mu_applied` (``mu`` replaces the latter: the whole friction relative to the nominal mu), N.m."""
-        # model_torque on the estimate with dx_used for dx_kiss, without the copy of the state: the same operations
-        s = self.s
-        th = min(max(s.item(IX_CS), self.table.theta_min_K), self.table.theta_max_K)
-        theta_cm = min(max(0.5 * (s.item(F1) + s.item(F2)), THETA_MIN_K), THETA_MAX_K)
+        # model_torque on the estimate with dx_used for dx_kiss (without a copy of the state)
+        th, theta_cm = self._model_temperatures(self.s)
         f = self.mu_applied if mu is None else mu
         return f * self.clutch.torque(x_m - self.dx_used, th, theta_cm)
 
@@ -602,8 +604,7 @@ class ClutchEkf:
         ``evidence_confirm`` consecutive calls, kept until it falls below ``evidence_release``.
         """
         e, s = self.e, self.s
-        th = min(max(s.item(IX_CS), self.table.theta_min_K), self.table.theta_max_K)
-        theta_cm = self.theta_cm_model
+        th, theta_cm = self._model_temperatures(s)
         key = (round(th, 0), round(theta_cm, 0))
         pts = self._ev_cache.get(key)
         if pts is None:

@@ -27,6 +27,7 @@ from pathlib import Path
 from ..fmu.hostlib import HostLibrary
 from ..model import ClutchParameters, SpringTable, outputs, x_to_for_torque
 from ..model.clutch_model import THETA_MAX_K, THETA_MIN_K, X_TO_MAX, X_TO_MIN
+from ..model.table_format import COLUMNS, FORCE_DEFLECTION, KISS_POINT
 
 log = logging.getLogger(__name__)
 
@@ -35,7 +36,7 @@ log = logging.getLogger(__name__)
 NATIVE = True
 
 SOURCES = ("tcu_model.c", "clutch_tables.c", "clutch_cover.c", "resource_uri.c")
-HEADERS = ("tcu_model.h", "clutch_tables.h", "clutch_cover.h", "resource_uri.h")
+HEADERS = ("tcu_model.h", "clutch_tables.h", "clutch_cover.h", "resource_uri.h", "host_export.h")
 
 
 #: the compiled TCU clutch model (built on first use, cached by the sources' hash)
@@ -48,12 +49,12 @@ def write_table(table: SpringTable, folder: Path) -> None:
     constant)."""
     out = folder / "tables"
     out.mkdir(parents=True, exist_ok=True)
-    rows = ["theta_degC,u_m,force_N"]
+    rows = [",".join(COLUMNS[FORCE_DEFLECTION])]
     for t, c in zip(table.theta_degC, table.curves):
         rows += [f"{t!r},{u!r},{f!r}" for u, f in zip(c.x, c.y)]
-    (out / "force_deflection.csv").write_text("\n".join(rows) + "\n")
-    rows = ["theta_degC,delta_kiss_m"] + [f"{t!r},{d!r}" for t, d in zip(table.theta_degC, table.delta_kiss_m)]
-    (out / "kiss_point.csv").write_text("\n".join(rows) + "\n")
+    (out / FORCE_DEFLECTION).write_text("\n".join(rows) + "\n")
+    rows = [",".join(COLUMNS[KISS_POINT])] + [f"{t!r},{d!r}" for t, d in zip(table.theta_degC, table.delta_kiss_m)]
+    (out / KISS_POINT).write_text("\n".join(rows) + "\n")
 
 
 class TcuClutchModel:

@@ -15,11 +15,7 @@
 #include <stddef.h>
 #include "launch_plant.h"
 
-#if defined(_WIN32)
-#define LP_EXPORT __declspec(dllexport)
-#else
-#define LP_EXPORT __attribute__((visibility("default")))
-#endif
+#include "host_export.h"
 
 /* engine.EngineGovernor.torque */
 static double engine_torque(const lp_consts *c, lp_state *s, double w_e, double pedal, int stalled, double h)
@@ -266,7 +262,7 @@ static int clutch_step(const lp_consts *c, lp_state *s, double t, double h, doub
     return 0;
 }
 
-LP_EXPORT int lp_run_block(lp_consts *c, lp_state *s, const lp_block *blk, lp_step_out *out, double *accel_out,
+HOST_EXPORT int lp_run_block(lp_consts *c, lp_state *s, const lp_block *blk, lp_step_out *out, double *accel_out,
                            int max_steps, int *fmi_status)
 {
     double h = c->h;
@@ -344,7 +340,7 @@ LP_EXPORT int lp_run_block(lp_consts *c, lp_state *s, const lp_block *blk, lp_st
     return j;
 }
 
-LP_EXPORT int lp_run_quiet(lp_consts *c, lp_state *s, double t, double h_quiet, double act_quiet, int *fmi_status)
+HOST_EXPORT int lp_run_quiet(lp_consts *c, lp_state *s, double t, double h_quiet, double act_quiet, int *fmi_status)
 {
     s->x_act *= act_quiet;
     int st = clutch_step(c, s, t, h_quiet, s->w_e, fmi_status);

@@ -7,11 +7,7 @@
 #include "clutch_tables.h"
 #include "tcu_model.h"
 
-#if defined(_WIN32)
-#define TM_EXPORT __declspec(dllexport)
-#else
-#define TM_EXPORT __attribute__((visibility("default")))
-#endif
+#include "host_export.h"
 
 struct TcuModel {
     Table table;
@@ -26,7 +22,7 @@ struct TcuModel {
    the last: the step after it would be far smaller still) */
 #define TM_X_TOL 1e-3
 
-TM_EXPORT TcuModel *tm_open(const char *dir, const double *cover, int n_cover, double lever_ratio, double x_kiss_ref,
+HOST_EXPORT TcuModel *tm_open(const char *dir, const double *cover, int n_cover, double lever_ratio, double x_kiss_ref,
                   double wear, double gain, char *err, size_t errlen) {
     TcuModel *m;
     if (n_cover != CV_NPAR) {
@@ -43,13 +39,13 @@ TM_EXPORT TcuModel *tm_open(const char *dir, const double *cover, int n_cover, d
     return m;
 }
 
-TM_EXPORT void tm_close(TcuModel *m) {
+HOST_EXPORT void tm_close(TcuModel *m) {
     if (!m) return;
     cc_table_free(&m->table);
     free(m);
 }
 
-TM_EXPORT double tm_torque(TcuModel *m, double x_to, double theta_cs, double theta_cm) {
+HOST_EXPORT double tm_torque(TcuModel *m, double x_to, double theta_cs, double theta_cm) {
     CcCoverState st;
     if (cc_cover_state(&m->cover, &m->table, x_to, theta_cs, theta_cm, m->wear, &st) != 0) return NAN;
     return m->gain * st.clamp;
@@ -131,7 +127,7 @@ static double bracket_u_start(const TBracket *b, double force) {
                        b->w * (curve_u_at(c1, force) - c1->x_first) / r1);
 }
 
-TM_EXPORT double tm_x_for_torque(TcuModel *m, double torque, double theta_cs, double theta_cm, double tol_m) {
+HOST_EXPORT double tm_x_for_torque(TcuModel *m, double torque, double theta_cs, double theta_cm, double tol_m) {
     CcCoverState st;
     TBracket br;
     CellPt pt;

@@ -36,7 +36,7 @@ MAX_NODES = 16
 
 
 #: the compiled plant step (built on first use, cached by the sources' hash)
-LIBRARY = HostLibrary("launch_plant", (SOURCE,), (HEADER,))
+LIBRARY = HostLibrary("launch_plant", (SOURCE,), (HEADER, "host_export.h"))
 
 
 class NativePlant:

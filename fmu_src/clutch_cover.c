@@ -161,6 +161,18 @@ static void frame(CcCover *cv, const Table *tb, double theta_cs, double theta_cm
 }
 
 
+/* the safeguarded Halley step of the cover's solve from s with residual r, slope r' and curvature r'' in the bracket
+   (lo, hi): Halley's 2 r r' / (2 r'^2 - r r'') (third order where x(s) is smooth; one division), or Newton's where
+   it would change the Newton step by more than a factor 2; bisection where r' >= 0 or the step leaves the bracket */
+static inline double halley_next(double s, double r, double slope, double curv, double lo, double hi) {
+    double s_new;
+    if (slope < 0.0) {
+        double s2 = slope * slope, den = 2.0 * s2 - r * curv;
+        s_new = den > s2 && den < 4.0 * s2 ? s - 2.0 * r * slope / den : s - r / slope;
+    } else s_new = 0.5 * (lo + hi);
+    return (s_new > lo && s_new < hi) ? s_new : 0.5 * (lo + hi);
+}
+
 #ifdef CC_COUNT_EVALS /* tests/test_native_speed.py counts the solver's cushion evaluations (and the open ones) */
 long cc_count_evals, cc_count_open;
 #define COUNT_EVAL() (++cc_count_evals)
@@ -253,16 +265,10 @@ int cc_cover_solve(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
                 r = p0 + s * (p1 + s * (p2 + s * p3)) + r0;
                 COUNT_EVAL(); COUNT_OPEN();
                 for (; k < 100; ++k) {
-                    double s_new;
                     if (fabs(r) <= tol_r || hi - lo <= 1e-15 * (1.0 + hi)) goto done;
                     if (r > 0.0) lo = s; else hi = s;
                     slope = p1 + s * (2.0 * p2 + 3.0 * p3 * s);
-                    if (slope < 0.0) {
-                        double curv = 2.0 * p2 + 6.0 * p3 * s, s2 = slope * slope;
-                        double den = 2.0 * s2 - r * curv;
-                        s_new = den > s2 && den < 4.0 * s2 ? s - 2.0 * r * slope / den : s - r / slope;
-                    } else s_new = 0.5 * (lo + hi);
-                    s = (s_new > lo && s_new < hi) ? s_new : 0.5 * (lo + hi);
+                    s = halley_next(s, r, slope, 2.0 * p2 + 6.0 * p3 * s, lo, hi);
                     if (!(((s_kiss - s) * kp - first) * isp < lo1)) { ++k; goto table; }
                     r = p0 + s * (p1 + s * (p2 + s * p3)) + r0;
                     COUNT_EVAL(); COUNT_OPEN();
@@ -275,19 +281,11 @@ int cc_cover_solve(CcCover *cv, const Table *tb, double x_to, double theta_cs, d
         r = p0 + s * (p1 + s * (p2 + s * p3)) + ckl * fc;
         COUNT_EVAL();
         for (; k < 100; ++k) {
-            double s_new;
             if (fabs(r) <= tol_r || hi - lo <= 1e-15 * (1.0 + hi)) break;
             if (r > 0.0) lo = s; else hi = s;
             cushion_deriv(b, &pt, &dfc, &d2fc);
             slope = p1 + s * (2.0 * p2 + 3.0 * p3 * s) - ckp * dfc;
-            if (slope < 0.0) {
-                /* Halley's step 2 r r' / (2 r'^2 - r r'') (third order where x(s) is smooth; one division), or
-                   Newton's where it would change the Newton step by more than a factor 2 */
-                double curv = 2.0 * p2 + 6.0 * p3 * s + ckp * kp * d2fc, s2 = slope * slope;
-                double den = 2.0 * s2 - r * curv;
-                s_new = den > s2 && den < 4.0 * s2 ? s - 2.0 * r * slope / den : s - r / slope;
-            } else s_new = 0.5 * (lo + hi);
-            s = (s_new > lo && s_new < hi) ? s_new : 0.5 * (lo + hi);
+            s = halley_next(s, r, slope, 2.0 * p2 + 6.0 * p3 * s + ckp * kp * d2fc, lo, hi);
             fc = cushion(b, (s_kiss - s) * kp, &hint, &pt);
             r = p0 + s * (p1 + s * (p2 + s * p3)) + ckl * fc;
             COUNT_EVAL();

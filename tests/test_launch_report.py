@@ -42,7 +42,8 @@ def test_summary_has_a_row_per_variant(tmp_path):
     series = results["naive"].series
     assert len(thinned) == -(-len(series) // 3)
     assert [float(r["time_s"]) for r in thinned[:4]] == pytest.approx(list(series["time_s"][:12:3]), abs=1e-9)
-    assert (tmp_path / "out3" / "launch_metrics.csv").read_text() == (tmp_path / "out" / "launch_metrics.csv").read_text()
+    metrics_csv = "launch_metrics.csv"
+    assert (tmp_path / "out3" / metrics_csv).read_text() == (tmp_path / "out" / metrics_csv).read_text()
     assert {p.name for p in paths3} == {p.name for p in paths}
     assert _png_description(tmp_path / "out3" / "launch_metrics.png") == "scenario 'short' · cushion-clutch " + \
         __import__("cushion_clutch").__version__ + " · a command"
@@ -87,7 +88,8 @@ def test_lockup_counts_and_lines():
     res = SimpleNamespace(metrics=rows)
     assert lockup_counts(res) == {"n": 4, "locked": 2, "inhibited": 1, "no_lockup": 1, "stalls": 1}
     lines = lockup_lines({"production": res, "naive": SimpleNamespace(metrics=rows[:1])}).splitlines()
-    assert lines[1] == "production: 2 of 4 launches locked up; 1 inhibited, 1 launched but never locked up, 1 engine stalls"
+    assert lines[1] == ("production: 2 of 4 launches locked up; 1 inhibited, 1 launched but never locked up, "
+                        "1 engine stalls")
     assert lines[2] == "naive: 1 of 1 launches locked up"
     narrow = lockup_lines({"production": res}, width=40).splitlines()
     assert narrow[1] == "production: 2 of 4 launches locked up;" and narrow[2].startswith("  1 inhibited")

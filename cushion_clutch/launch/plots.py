@@ -222,8 +222,8 @@ def _plot_temperatures(results: dict[str, LaunchResult], out: Path, table_range:
                        label=INHIBITED_LABEL if k == 0 else None)
         for k, (a, b) in enumerate(_slot_spans(res, "no lock-up")):
             ax.axvspan(a, b, color=NO_LOCKUP_COLOR, alpha=0.10, lw=0, label=NO_LOCKUP_LABEL if k == 0 else None)
-        _shade(ax, t, (theta_cs < lo) | (theta_cs > hi), "C1", f"θ_cs outside the tables ({lo:g}–{hi:g} °C): clamped",
-               alpha=0.25, ymax=0.06)
+        _shade(ax, t, (theta_cs < lo) | (theta_cs > hi), "C1",
+               f"θ_cs outside the tables ({lo:g}–{hi:g} °C): clamped", alpha=0.25, ymax=0.06)
         if _shade(ax, t, theta_cm > FACING_DAMAGE_LIMIT_DEGC, "C3",
                   f"θ_cm above the facings' damage limit ({FACING_DAMAGE_LIMIT_DEGC:g} °C)", alpha=0.35, ymin=0.94):
             ax.axhline(FACING_DAMAGE_LIMIT_DEGC, color="C3", lw=0.8, linestyle=":")
@@ -264,7 +264,8 @@ def _plot_metrics(results: dict[str, LaunchResult], out: Path, prov: "Provenance
     fig = plt.figure(figsize=(12, 2.7 * (rows_tcu + len(METRIC_PANELS)) + 0.4))
     grid = fig.add_gridspec(rows_tcu + len(METRIC_PANELS), ncols)
     top = None
-    hot_label = f"hot launch of this TCU (θ_cs at its start ≥ {prov.hot_degC:g} °C)"
+    hot_label = ("hot launch of this TCU (θ_cs at its start ≥ "
+                 + (f"{prov.hot_degC:g} °C)" if prov.hot_degC is not None else "the scenario's hot threshold)"))
     tcu_axes = []
 
     def mark_bottom(ax, n, color, label, marker, y=0.04):
@@ -303,7 +304,8 @@ def _plot_metrics(results: dict[str, LaunchResult], out: Path, prov: "Provenance
             mark_bottom(ax, missing, f"C{i}", None, "x", 0.03 + 0.045 * i)     # one row of marks per TCU
         if any(launch_status(m) != "locked" for res in results.values() for m in res.metrics):
             ax.plot([], [], linestyle="none", marker="x", color="0.3",
-                    label="× in the band below the data: no lock-up in\nthat launch (inhibited or never locked;\none row and colour per TCU)")
+                    label="× in the band below the data: no lock-up in\nthat launch (inhibited or never locked;\n"
+                          "one row and colour per TCU)")
             vals = np.array([m[col] for res in results.values() for m in res.metrics], float)
             vals = vals[np.isfinite(vals)]
             if len(vals):                  # a band below the data for the marks (0.3 of the axis)

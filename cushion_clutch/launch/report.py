@@ -29,8 +29,9 @@ class Provenance:
     """the scenario's ``name``"""
     command: str = ""
     """the command line that ran it (empty: not from the command line)"""
-    hot_degC: float = 100.0
-    """the scenario's ``run.hot_degC``: a launch is hot when theta_cs at its start is at least this, degC"""
+    hot_degC: float | None = None
+    """the scenario's ``run.hot_degC``: a launch is hot when theta_cs at its start is at least this, degC
+    (None: not known, the plots say "the scenario's hot threshold")"""
     version: str = ""
     """cushion-clutch's version (empty: the installed package's)"""
 

@@ -53,7 +53,7 @@ VARIABLES = (
     ("force", "output", "N", "cushion-spring force F(u, theta_cs); the clamp force is clamp_force"),
     ("theta_cs", "output", "K", "cushion-spring temperature"),
     ("u_f", "output", "m", "cushion compression from the kiss point, clipped at 0"),
-    ("x_kiss", "output", "m", "kiss point at the bearing at theta_cs (u_f = 0); torque begins earlier, at first contact"),
+    ("x_kiss", "output", "m", "kiss point at the bearing at theta_cs (u_f = 0); torque starts before it"),
     ("n_surfaces", "parameter", "1", "number of friction surfaces"),
     ("mu", "parameter", "1", "dynamic friction coefficient"),
     ("R_eq", "parameter", "m", "equivalent friction radius"),

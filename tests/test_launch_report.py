@@ -119,6 +119,8 @@ def test_cli_protection_summary_counts_lock_ups_and_plots_name_the_scenario(tmp_
     prod = [r for r in metrics if r["tcu"] == "production"]
     assert sum(int(float(r["protection_level"])) >= 3 for r in prod) >= 1       # the hot start inhibits
     assert "inhibited" in next(line for line in text.splitlines() if line.startswith("production: "))
+    ours = [line for line in text.splitlines() if line.startswith((*VARIANTS, "launches locked up", "  production"))]
+    assert len(ours) >= 2 * len(VARIANTS) and all(len(line) <= 100 for line in ours), ours     # the FMU's log aside
     assert "launches with 6 TCUs simulated in" in text
     assert " MB, written to " in text or " kB, written to " in text
     assert "one recorded row in 7 (--every 7)" in text

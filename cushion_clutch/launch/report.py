@@ -128,14 +128,16 @@ def summary_rows(results: dict[str, LaunchResult]) -> list[dict]:
 
 
 def peak_lines(results: dict[str, LaunchResult]) -> str:
-    """One line per TCU: the plant's peak temperatures, the TCU's peak estimate, protection and key-on."""
+    """One line per TCU: the peak temperatures of the plant it drove, its own peak estimate (if it has a thermal
+    model), the launches its protection inhibited, and (production) how it started."""
     out = []
     for name, res in results.items():
         k = peaks(res)
         # within 100 columns: the TCU on its own line, then peaks, then (production) how it started
-        out.append(f"{name + ':':<25} peak theta_cm {k['plant_theta_cm_peak_degC']:.0f} degC (TCU's estimate "
-                   f"{_f(k['tcu_theta_cm_peak_degC'], '.0f')}), theta_cs {k['plant_theta_cs_peak_degC']:.0f} degC; "
-                   f"{k['inhibited_launches']} inhibited")
+        est = k["tcu_theta_cm_peak_degC"]
+        est = "no estimate" if math.isnan(est) else f"its estimate {est:.0f}"
+        out.append(f"{name + ':':<25} peak theta_cm {k['plant_theta_cm_peak_degC']:.0f} degC ({est}), "
+                   f"theta_cs {k['plant_theta_cs_peak_degC']:.0f} degC; {k['inhibited_launches']} inhibited")
         if k["tcu_start"]:
             out.append(f"  {name} started {k['tcu_start']}; standstill touch point "
                        f"{_f(k['standstill_kiss_error_um'], '.1f')} um off")

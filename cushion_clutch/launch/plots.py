@@ -320,6 +320,9 @@ def _plot_metrics(results: dict[str, LaunchResult], out: Path, prov: "Provenance
         _legend_outside(ax)
         if r == len(METRIC_PANELS) - 1:
             ax.set_xlabel("launch number")
-    fig.suptitle(f"Metrics per launch and TCU — scenario '{prov.scenario}' (each TCU's launches on its own "
-                 "clutch; hot shading from that TCU's clutch)", fontsize=10)
+    any_hot = any(m["hot"] for res in results.values() for m in res.metrics)
+    threshold = f"{prov.hot_degC:g} °C" if prov.hot_degC is not None else "the hot threshold"
+    fig.suptitle(f"Metrics per launch and TCU — scenario '{prov.scenario}' (each TCU's launches on its own clutch; "
+                 + ("hot shading from that TCU's clutch)" if any_hot else f"no launch started hot, θ_cs ≥ {threshold})"),
+                 fontsize=10)
     return finish_figure(fig, [], out / "launch_metrics.png", legend=False, footer=prov.line())

@@ -167,7 +167,8 @@ def _launch(args: argparse.Namespace) -> int:
     from .fmu.check import check_fmu
     from .model import load_table
     from .launch.plant import build_plant_fmu
-    from .launch.report import peak_lines, ratio_line, run_all, summary_rows, write_outputs
+    from .launch.report import (Provenance, lockup_lines, peak_lines, ratio_line, run_all, series_interval_s,
+                                summary_rows, write_outputs)
     from .launch.scenario import load_scenario, scenario_path
     from .launch.tcu import VARIANTS
     from .outputs import OutputSet
@@ -176,7 +177,9 @@ def _launch(args: argparse.Namespace) -> int:
     out = _guard_out(Path(args.out), args.force)
     _check_tables(sc.tables_path("tcu") or args.tables)
     table = load_table(sc.tables_path("tcu") or args.tables)     # a scenario may name the TCUs' table set
-    with OutputSet(out, "launch") as stage:                # checks --out before the simulation
+    prov = Provenance(sc.name, _command_line(args), sc.run.hot_degC)
+    output_set = OutputSet(out, "launch", {**prov.as_dict(), "every": args.every})
+    with output_set as stage:                              # checks --out before the simulation
         if args.fmu:
             fmu = check_fmu(args.fmu)
         else:
@@ -191,21 +194,50 @@ def _launch(args: argparse.Namespace) -> int:
             for task in tasks.values():
                 bar.update(task, completed=total)
         wall = time.perf_counter() - start
-        paths = write_outputs(results, stage)
+        paths = write_outputs(results, stage, prov, every=args.every)
+        size = sum(p.stat().st_size for p in stage.rglob("*") if p.is_file())
+        interval = series_interval_s(results, args.every)
+        output_set.info.update({"simulation_wall_s": round(wall, 1), "series_interval_s": interval,
+                                "bytes_written": size})
     paths = [out / p.relative_to(stage) for p in paths]
     print(launch_terminal_table(summary_rows(results)))
     print()
     print(ratio_line(results, "hot"))
+    print(lockup_lines(results))
     print(peak_lines(results))
     for name, res in results.items():
         e = res.energy
         print(f"{name}: energy residual {e.residual():.3g} J of {e.engine_work / 1e3:.1f} kJ; "
               f"{total / res.wall_time_s:.0f}x real time (CPU {total / res.cpu_time_s:.0f}x)")
+    every = "every recorded row" if args.every == 1 else f"one recorded row in {args.every} (--every {args.every})"
     print(f"scenario '{sc.name}': {len(results[next(iter(results))].metrics)} launches with {len(results)} TCUs "
-          f"in {wall:.1f} s; {len(paths)} files written to {out}")
+          f"simulated in {wall:.1f} s; {len(paths)} files, {_size(size)}, written to {out}")
+    print(f"time series launch_<tcu>.csv: {every}, rows at least {interval * 1e3:.0f} ms of simulated time apart")
     print(f"every metric per launch: {out / 'launch_metrics.csv'}")
     print(f"mean and worst per group: {out / 'launch_summary.csv'}")
     return 0
+
+
+def _command_line(args: argparse.Namespace) -> str:
+    """The command as it was typed (``cushion-clutch`` and its arguments), for the outputs' provenance."""
+    import shlex
+    return shlex.join(["cushion-clutch", *getattr(args, "argv", [])])
+
+
+def _size(n: int) -> str:
+    """A byte count for people: ``812 kB``, ``72.4 MB``."""
+    return f"{n / 1e6:.1f} MB" if n >= 1e6 else f"{n / 1e3:.0f} kB"
+
+
+def _positive_int(text: str) -> int:
+    """argparse type: a whole number >= 1."""
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"{text!r}: must be a whole number >= 1")
+    return value
 
 
 #: the launch summary's terminal columns: (summary key, header, format); the rest is in launch_summary.csv
@@ -217,7 +249,8 @@ TERMINAL_COLUMNS = (("characteristic_error_max_Nm_worst", "err max", ".2f"),
                     ("engagement_time_s_mean", "engage", ".2f"))
 TERMINAL_LEGEND = ("err max / err rms: characteristic error (believed - true torque) [N.m], worst max / mean RMS;\n"
                    "track rms: tracking error, worst RMS [N.m]; creep err: worst [N.m]; θ_cs err: worst [K];\n"
-                   "engage: mean [s]")
+                   "engage: mean time to lock-up [s] of the launches that locked up ('-': none did; the lines\n"
+                   "'<TCU>: k of n launches locked up' below count them)")
 
 
 def launch_terminal_table(rows: list[dict], width: int = 100) -> str:
@@ -449,6 +482,9 @@ def build_parser() -> argparse.ArgumentParser:
     la.add_argument("--tables", default=DEFAULT_TABLES, help="table folder")
     add_backend(la)
     _out(la, "output folder (default: out)", default="out")
+    la.add_argument("--every", type=_positive_int, default=1, metavar="N",
+                    help="write every N-th row of the time series launch_<tcu>.csv (default 1: every recorded "
+                         "row, one per 10 simulation steps); metrics, summary and plots use every row")
     _force(la)
 
     sm = _command(sub, "simulate", _simulate, "repeated engagements through the FMU with fmpy, with plots",
@@ -564,6 +600,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
+    args.argv = list(sys.argv[1:] if argv is None else argv)          # the command, for the outputs' provenance
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
                         format="%(levelname)s %(name)s: %(message)s")
     from . import interrupt

@@ -103,6 +103,9 @@ class OutputSet:
     name : str
         Name of the set (``launch``, ``simulate``, ``export``, ``tables``); the
         manifest is ``folder/<name>.manifest.json``.
+    info : dict, optional
+        JSON-serialisable entries for the manifest beside ``set``, ``written_utc`` and ``files`` (what
+        made the set: scenario, version, command); :attr:`info` may be updated inside the block.
 
     Examples
     --------
@@ -111,9 +114,12 @@ class OutputSet:
     >>> # now out/ holds the new files and out/launch.manifest.json
     """
 
-    def __init__(self, folder: str | Path, name: str):
+    def __init__(self, folder: str | Path, name: str, info: dict | None = None):
         self.folder = Path(folder)
         self.name = name
+        #: what made the set (scenario, version, command, ...), written into the manifest; may be updated
+        #: until the set is committed
+        self.info = dict(info or {})
         self.stage = self.folder / f".{name}.staging-{os.getpid()}"
         self.files: list[Path] = []
 
@@ -152,5 +158,6 @@ class OutputSet:
         self.files = [self.folder / rel for rel in entries]
         with atomic_path(manifest) as tmp:
             tmp.write_text(json.dumps({"set": self.name, "written_utc": time.strftime(
-                "%Y-%m-%dT%H:%M:%SZ", time.gmtime()), "files": entries}, indent=1) + "\n", encoding="utf-8")
+                "%Y-%m-%dT%H:%M:%SZ", time.gmtime()), **self.info, "files": entries}, indent=1) + "\n",
+                encoding="utf-8")
         log.info("wrote output set %s (%d files) to %s", self.name, len(entries), self.folder)

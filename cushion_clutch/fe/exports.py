@@ -57,7 +57,8 @@ THETA_DIFFERENCES_K = (25.0, 50.0, 100.0)
 
 UNITS_NOTE = ("u_m [m] cushion compression from its kiss point; theta_degC [degC]; force_N [N] whole spring; "
               "delta_kiss_m [m] the spring's free-height growth (+ = grows, contact earlier); x_kiss_m [m] kiss "
-              "point at the bearing (bearing travel from open towards engagement; smaller = earlier contact); "
+              "point at the bearing (bearing travel from open towards engagement, smaller = earlier contact, "
+              "the cushion at its kiss force at u_m = 0, torque begins earlier at the first contact); "
               "x_to_m [m] bearing position, 0 = open; clamp_force_N, bearing_force_N [N]")
 
 

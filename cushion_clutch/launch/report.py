@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import csv
 import math
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Iterable
 
@@ -18,6 +19,65 @@ from .tcu import VARIANTS
 GROUPS = (("hot", lambda r: r["hot"] and r["phase"] == "repeated"),
           ("cool-down", lambda r: r["phase"] == "cool-down"),
           ("all", lambda r: True))
+
+
+@dataclass(frozen=True)
+class Provenance:
+    """What made a launch study's outputs: written on every plot and into the output set's manifest."""
+
+    scenario: str
+    """the scenario's ``name``"""
+    command: str = ""
+    """the command line that ran it (empty: not from the command line)"""
+    hot_degC: float | None = None
+    """the scenario's ``run.hot_degC``: a launch is hot when theta_cs at its start is at least this, degC
+    (None: not known, the plots say "the scenario's hot threshold")"""
+    version: str = ""
+    """cushion-clutch's version (empty: the installed package's)"""
+
+    def line(self) -> str:
+        """One line for a plot's footer: scenario, version and command."""
+        return (f"scenario '{self.scenario}' · cushion-clutch {self.version or _version()}"
+                + (f" · {self.command}" if self.command else ""))
+
+    def as_dict(self) -> dict:
+        """The manifest's entries."""
+        return {"scenario": self.scenario, "version": self.version or _version(), "command": self.command}
+
+
+def _version() -> str:
+    from .. import __version__
+    return __version__
+
+
+def lockup_counts(res: LaunchResult) -> dict:
+    """How a TCU's launches ended: ``n`` launches, ``locked`` (locked up), ``inhibited`` (the thermal protection
+    inhibited the launch: no launch), ``no_lockup`` (launched, never locked up) and ``stalls``."""
+    locked = [not math.isnan(m["engagement_time_s"]) for m in res.metrics]
+    inhibited = [m["protection_level"] >= 3 and not ok for m, ok in zip(res.metrics, locked)]
+    return {"n": len(res.metrics), "locked": sum(locked), "inhibited": sum(inhibited),
+            "no_lockup": sum(not ok and not inh for ok, inh in zip(locked, inhibited)),
+            "stalls": sum(bool(m["engine_stall"]) for m in res.metrics)}
+
+
+def lockup_lines(results: dict[str, LaunchResult], width: int = 100) -> str:
+    """A heading, then one line per TCU: how many of its launches locked up, how many the thermal protection
+    inhibited (no launch) and how many launched but never locked up (a longer line continues indented)."""
+    out = ["launches locked up per TCU (inhibited: the TCU's thermal protection allowed no launch):"]
+    for name, res in results.items():
+        c = lockup_counts(res)
+        rest = [f"{c['inhibited']} inhibited" if c["inhibited"] else "",
+                f"{c['no_lockup']} launched but never locked up" if c["no_lockup"] else "",
+                f"{c['stalls']} engine stalls" if c["stalls"] else ""]
+        head = f"{name}: {c['locked']} of {c['n']} launches locked up"
+        tail = ", ".join(r for r in rest if r)
+        if not tail:
+            out.append(head)
+        elif len(head) + 2 + len(tail) <= width:
+            out.append(f"{head}; {tail}")
+        else:
+            out += [head + ";", f"  {tail}"]
+    return "\n".join(out)
 
 
 def run_all(fmu: Path, sc: Scenario, table: SpringTable, variants: Iterable[str] = tuple(VARIANTS),
@@ -68,24 +128,34 @@ def summary_rows(results: dict[str, LaunchResult]) -> list[dict]:
 
 
 def peak_lines(results: dict[str, LaunchResult]) -> str:
-    """One line per TCU: the plant's peak temperatures, the TCU's peak estimate, protection and key-on."""
+    """One line per TCU: the peak temperatures of the plant it drove, its own peak estimate (if it has a thermal
+    model), the launches its protection inhibited, and (production) how it started."""
     out = []
     for name, res in results.items():
         k = peaks(res)
         # within 100 columns: the TCU on its own line, then peaks, then (production) how it started
-        out.append(f"{name + ':':<25} peak theta_cm {k['plant_theta_cm_peak_degC']:.0f} degC (TCU's estimate "
-                   f"{_f(k['tcu_theta_cm_peak_degC'], '.0f')}), theta_cs {k['plant_theta_cs_peak_degC']:.0f} degC; "
-                   f"{k['inhibited_launches']} inhibited")
+        est = k["tcu_theta_cm_peak_degC"]
+        est = "no estimate" if math.isnan(est) else f"its estimate {est:.0f}"
+        out.append(f"{name + ':':<25} peak theta_cm {k['plant_theta_cm_peak_degC']:.0f} degC ({est}), "
+                   f"theta_cs {k['plant_theta_cs_peak_degC']:.0f} degC; {k['inhibited_launches']} inhibited")
         if k["tcu_start"]:
             out.append(f"  {name} started {k['tcu_start']}; standstill touch point "
                        f"{_f(k['standstill_kiss_error_um'], '.1f')} um off")
     return "\n".join(out)
 
 
-def write_outputs(results: dict[str, LaunchResult], out: Path) -> list[Path]:
-    """``launch_<tcu>.csv`` time series, ``launch_metrics.csv``, ``launch_summary.csv`` and PNG plots."""
+def write_outputs(results: dict[str, LaunchResult], out: Path, provenance: Provenance | None = None,
+                  every: int = 1) -> list[Path]:
+    """``launch_<tcu>.csv`` time series, ``launch_metrics.csv``, ``launch_summary.csv`` and PNG plots.
+
+    ``every``: the time series keep every ``every``-th recorded row (1: all); the metrics, the summary and the
+    plots always use every recorded row. ``provenance``: scenario, version and command on every plot (None: a
+    scenario named "unnamed").
+    """
     from .plots import plot_launches
 
+    if not (isinstance(every, int) and every >= 1):
+        raise ValueError(f"every = {every!r}: must be a whole number >= 1 (keep every N-th row of the time series)")
     out.mkdir(parents=True, exist_ok=True)
     paths = []
     for name, res in results.items():
@@ -93,7 +163,7 @@ def write_outputs(results: dict[str, LaunchResult], out: Path) -> list[Path]:
         with open(path, "w", newline="") as fh:
             w = csv.writer(fh)
             w.writerow(COLUMNS)
-            for row in res.series:
+            for row in res.series[::every]:
                 w.writerow([f"{v:.9g}" for v in row])
         paths.append(path)
     path = out / "launch_metrics.csv"
@@ -111,8 +181,15 @@ def write_outputs(results: dict[str, LaunchResult], out: Path) -> list[Path]:
         w.writeheader()
         w.writerows(rows)
     paths.append(path)
-    paths += plot_launches(results, out)
+    paths += plot_launches(results, out, provenance=provenance)
     return paths
+
+
+def series_interval_s(results: dict[str, LaunchResult], every: int = 1) -> float:
+    """The time between two rows of the written time series, s (the smallest step between recorded rows,
+    times ``every``; NaN for fewer than two rows)."""
+    t = next(iter(results.values())).series["time_s"]
+    return round(float(np.min(np.diff(t))) * every, 9) if len(t) > 1 else math.nan
 
 
 def _f(v: float, fmt: str) -> str:

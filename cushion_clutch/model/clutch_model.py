@@ -49,11 +49,11 @@ __all__ = ["KELVIN", "VARIABLES", "ClutchParameters", "CoverParameters", "CoverM
 VARIABLES = (
     ("x_to", "input", "m", "throwout-bearing position, 0 = open"),
     ("theta_cm", "input", "K", "clutch facing temperature"),
-    ("torque", "output", "N.m", "transmissible clutch torque n*mu*R_eq*F"),
+    ("torque", "output", "N.m", "transmissible clutch torque n*mu*R_eq*F_pp (F_pp: clamp_force)"),
     ("force", "output", "N", "cushion-spring force F(u, theta_cs); the clamp force is clamp_force"),
     ("theta_cs", "output", "K", "cushion-spring temperature"),
     ("u_f", "output", "m", "cushion compression from the kiss point, clipped at 0"),
-    ("x_kiss", "output", "m", "kiss point at the bearing at theta_cs"),
+    ("x_kiss", "output", "m", "kiss point at the bearing at theta_cs (u_f = 0); torque starts before it"),
     ("n_surfaces", "parameter", "1", "number of friction surfaces"),
     ("mu", "parameter", "1", "dynamic friction coefficient"),
     ("R_eq", "parameter", "m", "equivalent friction radius"),
@@ -516,8 +516,11 @@ def kiss_point(theta_cs: float, table: SpringTable, p: ClutchParameters, theta_c
     """Kiss point at the bearing (m) at ``theta_cs`` and ``theta_cm`` (K; None: ``theta_cs``).
 
     The same value as ``outputs(x_to, ...).x_kiss`` for any ``x_to``, without solving the
-    cover's balance: the first contact depends on the temperatures and the wear alone. It does
+    cover's balance: the kiss point depends on the temperatures and the wear alone. It does
     not check that the diaphragm holds the fully compressed cushion (:func:`outputs` does).
+    The kiss point is where the cushion carries its kiss force (u_f = 0), not where torque begins:
+    the first contact, the torque onset, is ``x_to_for_torque(0.0, theta_cs, table, p, theta_cm=theta_cm)``,
+    earlier by the cushion's travel from first contact to the kiss force times the lever.
 
     Raises
     ------

@@ -299,8 +299,9 @@ def _check_tables(folder) -> None:
 
 
 def _build_fmu(args: argparse.Namespace) -> int:
-    from .fmu.build import build_from_args
-    _check_tables(args.tables)
+    from .fmu.build import build_from_args, table_folders
+    for folder in table_folders(args):
+        _check_tables(folder)
     with _slow_notice(ZIG_NOTICE):
         report = build_from_args(args)
     print(report)

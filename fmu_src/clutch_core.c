@@ -74,12 +74,67 @@ int cc_instantiate(CcModel *m, const char *dir, int me, CcLogger logger, void *c
     m->dirty = 1;
     m->decay_h = NAN;
     m->warm.x = NAN;
-    m->table_ok = cc_table_load(&m->table, dir, m->table_error, sizeof m->table_error) == 0;
+    m->table_ok = cc_table_sets_load(&m->sets, dir, m->table_error, sizeof m->table_error) == 0;
     if (!m->table_ok) cc_log(m, CC_ERROR, "cannot load the F(u, theta) tables: %s", m->table_error);
+    m->set = 1;
+    if (m->table_ok) m->table = m->sets.set[0];
     return m->table_ok ? 0 : -1;
 }
 
-void cc_free(CcModel *m) { cc_table_free(&m->table); }
+void cc_free(CcModel *m) {
+    cc_table_sets_free(&m->sets);
+    memset(&m->table, 0, sizeof m->table);
+}
+
+/* choose table set k (1..sets.n): everything prepared from the old one is dropped */
+static void choose_set(CcModel *m, int k) {
+    m->set = k;
+    m->table = m->sets.set[k - 1];
+    m->cover_ok = 0;
+    m->held_valid = 0;
+    m->warm.x = m->decay_h = NAN;
+    m->dirty = 1;
+}
+
+int cc_set_integer(CcModel *m, const unsigned int vr[], size_t n, const long long v[], const char *fn) {
+    size_t k;
+    if (!cc_allowed(m, PH_INSTANTIATED | PH_INIT | PH_STEP | PH_EVENT | PH_CONT, fn)) return CC_ERROR;
+    if (n && (!vr || !v)) { cc_log(m, CC_ERROR, "%s: NULL value reference or value array", fn); return CC_ERROR; }
+    for (k = 0; k < n; ++k) { /* validate all first: a refused call changes nothing */
+        if (vr[k] != CC_VR_SPRING || m->sets.n < 2) {
+            cc_log(m, CC_ERROR, "%s: unknown value reference %u (%s)", fn, vr[k], m->sets.n < 2
+                   ? "the model has Real variables only" : "the only integer variable is spring");
+            return CC_ERROR;
+        }
+        if (m->phase & (PH_STEP | PH_EVENT | PH_CONT)) {
+            cc_log(m, CC_ERROR, "%s: parameter spring (the table set) is fixed after initialization: it stays %d; "
+                   "choose the set before fmiExitInitializationMode", fn, m->set);
+            return CC_ERROR;
+        }
+        if (!(v[k] >= 1 && v[k] <= m->sets.n)) {
+            cc_log(m, CC_ERROR, "%s: spring = %lld: allowed 1..%d (the table sets this FMU carries)", fn, v[k],
+                   m->sets.n);
+            return CC_ERROR;
+        }
+    }
+    for (k = 0; k < n; ++k) choose_set(m, (int)v[k]);
+    return CC_OK;
+}
+
+int cc_get_integer(CcModel *m, const unsigned int vr[], size_t n, long long v[], const char *fn) {
+    size_t k;
+    if (!cc_allowed(m, PH_ANY & ~PH_INSTANTIATED, fn)) return CC_ERROR;
+    if (n && (!vr || !v)) { cc_log(m, CC_ERROR, "%s: NULL value reference or value array", fn); return CC_ERROR; }
+    for (k = 0; k < n; ++k) {
+        if (vr[k] != CC_VR_SPRING || m->sets.n < 2) {
+            cc_log(m, CC_ERROR, "%s: unknown value reference %u (%s)", fn, vr[k], m->sets.n < 2
+                   ? "the model has Real variables only" : "the only integer variable is spring");
+            return CC_ERROR;
+        }
+        v[k] = m->set;
+    }
+    return CC_OK;
+}
 
 void cc_reset(CcModel *m) {
     set_starts(m->r);
@@ -90,6 +145,7 @@ void cc_reset(CcModel *m) {
     m->cover_ok = 0;
     m->warm.x = m->decay_h = NAN;
     m->phase = PH_INSTANTIATED;
+    if (m->table_ok) choose_set(m, 1);
 }
 
 /* ------------------------------------------------------------------- checks */
@@ -577,6 +633,7 @@ void cc_state_save(const CcModel *m, CcState *s) {
     s->time = m->time;
     memcpy(s->r, m->r, sizeof s->r);
     s->warm = m->warm;
+    s->table_set = m->set;
     s->checksum = fnv1a(s, offsetof(CcState, checksum));
 }
 
@@ -616,12 +673,18 @@ int cc_state_check(CcModel *m, const void *bytes, size_t size, const char *fn) {
         cc_log(m, CC_ERROR, "%s: the state's time, theta_cs, flags or warm start are out of range", fn);
         return 0;
     }
+    if (!(s.table_set >= 1 && s.table_set <= m->sets.n)) {
+        cc_log(m, CC_ERROR, "%s: the state's table set spring = %d: this FMU carries sets 1..%d", fn,
+               (int)s.table_set, m->sets.n);
+        return 0;
+    }
     if (s.phase != PH_INSTANTIATED && s.phase != PH_INIT && s.phase != PH_ERROR && !check_parameters(m, s.r, fn))
         return 0;
     return 1;
 }
 
 void cc_state_load(CcModel *m, const CcState *s) {
+    if (s->table_set != m->set) choose_set(m, s->table_set);
     memcpy(m->r, s->r, sizeof m->r);
     m->phase = s->phase;
     m->range_warned = s->range_warned;

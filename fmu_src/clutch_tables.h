@@ -65,6 +65,16 @@ typedef struct {
 } Table;
 
 int cc_table_load(Table *tb, const char *dir, char *err, size_t errlen);
+/* Table sets (one FMU, several springs; cushion_clutch.fmu.table_sets): set 1 in <dir>/tables, set k >= 2 in
+   <dir>/tables_<k>, numbered without gaps, at most CC_MAX_SETS; every set is loaded (and checked) at once. The FMU's
+   enumeration parameter `spring` picks one before initialisation ends */
+#define CC_MAX_SETS 64
+typedef struct {
+    int n;      /* sets loaded */
+    Table *set; /* set[k]: table set k + 1 */
+} TableSets;
+int cc_table_sets_load(TableSets *s, const char *dir, char *err, size_t errlen);
+void cc_table_sets_free(TableSets *s);
 void cc_table_free(Table *tb);
 double cc_table_force(const Table *tb, double u, double theta_degC);
 double cc_table_delta(const Table *tb, double theta_degC);

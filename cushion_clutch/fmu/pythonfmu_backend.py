@@ -78,9 +78,13 @@ def _fresh_imports(stage: Path):
         sys.path[:] = path
 
 
-def build_python_fmu(tables: Path, output: Path) -> Path:
-    """Build the pythonfmu FMU ``output`` carrying the (checked) table set ``tables``."""
+def build_python_fmu(tables: Path, output: Path, more_tables: tuple = ()) -> Path:
+    """Build the pythonfmu FMU ``output`` carrying the (checked) table set ``tables`` (and ``more_tables``:
+    not supported by this backend yet)."""
     from pythonfmu.builder import FmuBuilder
+    if more_tables:
+        from ..errors import ParameterError
+        raise ParameterError(["several table sets (--tables more than once) need backend 'native' for now"])
     with tempfile.TemporaryDirectory(prefix="cushion_fmu_") as tmp:
         stage = Path(tmp)
         shutil.copy(FMU_SRC / f"{SLAVE}.py", stage / f"{SLAVE}.py")

@@ -345,7 +345,7 @@ def _export_ssp(args: argparse.Namespace) -> int:
     with _slow_notice(ZIG_NOTICE):
         rep = export_from_args(args)
     print(f"wrote {rep.path}: {len(rep.files)} files, SSD and {len(rep.sets)} SSV parameter sets validated "
-          "against the SSP 1.0 schemas")
+          f"against the SSP 1.0 schemas; bound to the FMU: {args.bind}")
     for name, description in rep.sets:
         print(f"  {name}: {description}")
     if len(rep.table_sets) > 1:
@@ -533,6 +533,8 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--fmi-version", type=int, choices=(2, 3), default=2, help="FMI version of the FMU built")
     sp.add_argument("-o", "--out", dest="output", type=Path, default=Path("CushionClutch.ssp"),
                     help="archive to write, ending in .ssp (default CushionClutch.ssp)")
+    sp.add_argument("--bind", default="new",
+                    help="the parameter set the SSD binds to the FMU, which a tool applies on import (default new)")
 
     ex = _command(sub, "export", _export, "write the tables for Simulink (.mat) and Modelica (CombiTable)",
                   "Write cushion_spring_tables.mat (Simulink 2-D Lookup Tables, and a 3-D clamp-force table in "

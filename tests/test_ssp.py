@@ -164,3 +164,21 @@ def test_launch_plant_start_values_keep_the_set_and_the_scenarios_duty():
 def test_layout_constants_match_the_files(archive):
     assert Path(ssp.FMU_FILE).name == "CushionClutch.fmu"
     assert {f"resources/parameters/{n}.ssv" for n, _ in archive.sets} <= set(archive.files)
+
+
+def test_the_reference_page_s_measured_block_is_today_s():
+    """docs/reference/ssp.md's generated block (the dialog view, the layout, a run per set) equals a fresh
+    render from the same two-set FMU: a stale page fails here."""
+    from cushion_clutch.fmu import ssp_doc
+    assert ssp_doc.generated_block() == ssp_doc.render(two_set_fmu(2)), \
+        "docs/reference/ssp.md is stale: python -m cushion_clutch.fmu.ssp_doc"
+
+
+def test_bind_chooses_the_set_the_ssd_binds(tmp_path, capsys):
+    out = tmp_path / "W.ssp"
+    assert main(["export-ssp", "--fmu", str(two_set_fmu(2)), "--bind", "worn_1mm", "-o", str(out)]) == 0
+    (clutch,) = read_ssd(str(out)).system.elements
+    assert [b.source for b in clutch.parameterBindings] == ["resources/parameters/worn_1mm.ssv"]
+    capsys.readouterr()
+    assert main(["export-ssp", "--fmu", str(two_set_fmu(2)), "--bind", "worn_9mm", "-o", str(out)]) == 2
+    assert "--bind worn_9mm: no such parameter set" in capsys.readouterr().err

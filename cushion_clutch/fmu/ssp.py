@@ -209,14 +209,15 @@ class SspReport:
     table_sets: tuple[tuple[int, str, str], ...]
 
 
-def export_ssp(output: Path, fmu: Path) -> SspReport:
-    """Write the SSP ``output`` (.ssp) around the clutch FMU ``fmu``.
+def export_ssp(output: Path, fmu: Path, bind: str = DEFAULT_SET) -> SspReport:
+    """Write the SSP ``output`` (.ssp) around the clutch FMU ``fmu``; the SSD binds parameter set ``bind`` to the
+    component (default :data:`DEFAULT_SET`).
 
     Raises
     ------
     FmuError
-        ``output`` is not an ``.ssp`` name, or a generated file does not validate against the SSP 1.0 schemas
-        (a bug: nothing is written).
+        ``output`` is not an ``.ssp`` name, ``bind`` is not one of its parameter sets (they are listed), or a
+        generated file does not validate against the SSP 1.0 schemas (a bug: nothing is written).
     """
     output = Path(output)
     if output.suffix.lower() != ".ssp" or output.is_dir():
@@ -225,7 +226,10 @@ def export_ssp(output: Path, fmu: Path) -> SspReport:
     units = {n: u for n, (_, u, _) in variables.items()}
     items = fmu_sets(fmu)
     files = parameter_files(fmu)
-    default = next(f for f in files if f.name == DEFAULT_SET)
+    bound = [f for f in files if f.name == bind]
+    if not bound:
+        raise FmuError(f"--bind {bind}: no such parameter set (allowed: {', '.join(f.name for f in files)})")
+    default = bound[0]
     texts = {SSD_FILE: ssd_text(variables, default, "The cushion-clutch FMU and its parameter sets (wear states, "
                                                     "thermal sets, table sets)")}
     for f in files:
@@ -258,12 +262,12 @@ def export_from_args(args) -> SspReport:
     from .build import build_fmu, table_folders
     if args.fmu:
         from .check import check_fmu
-        return export_ssp(args.output, check_fmu(args.fmu))
+        return export_ssp(args.output, check_fmu(args.fmu), args.bind)
     folders = table_folders(args)
     with tempfile.TemporaryDirectory(prefix="cushion_ssp_") as tmp:
         fmu = build_fmu(folders if len(folders) > 1 else folders[0], Path(tmp) / f"{SLAVE}.fmu",
                         fmi_version=args.fmi_version)
-        return export_ssp(args.output, fmu)
+        return export_ssp(args.output, fmu, args.bind)
 
 
 def fmu_of(ssp: Path, dest: Path) -> Path:

@@ -154,6 +154,12 @@ static int range_ok(int k, double v) {
     return isfinite(v) && (g[2] ? v > g[0] : v >= g[0]) && (g[3] ? v < g[1] : v <= g[1]);
 }
 
+/* the kiss point at the bearing the model uses, m: x_kiss_ref, plus the chosen table set's own offset in an FMU
+   that carries several (TableSets.kiss_offset; x_kiss_ref is then set 1's kiss point) */
+static double kiss_ref(const CcModel *m, const double *r) {
+    return m->sets.n > 1 ? r[VR_X_KISS_REF] + m->sets.kiss_offset[m->set - 1] : r[VR_X_KISS_REF];
+}
+
 /* the cover parameters of a variable vector (CV_* order) */
 static const double *cover_params(const double *r) { return r + VR_DIAPHRAGM_OUTER_RADIUS_M; }
 
@@ -190,7 +196,7 @@ static int cover_consistent(CcModel *m, const double *r, const char *fn) {
     }
     if (ok && m) {
         CcCover cv;
-        cc_cover_prepare(&cv, c, lever, r[VR_X_KISS_REF], &m->table);
+        cc_cover_prepare(&cv, c, lever, kiss_ref(m, r), &m->table);
         if (!(cc_cover_slope_bound(&cv) > 0.0)) {
             cc_log(m, CC_ERROR, "%s: release_compliance_m_per_N = %g: the release snaps through (x_to(s) not "
                    "monotone on the diaphragm's falling branch); reduce it", fn, c[CV_C]);
@@ -236,7 +242,7 @@ static int check_parameters(CcModel *m, const double *r, const char *fn) {
            parameters that passed are kept, so restoring states of the same instance does not repeat it) */
         CcCover cv;
         double fto = 0.0, t_cs = 0.0, t_cm = 0.0;
-        cc_cover_prepare(&cv, cover_params(r), r[VR_LEVER_RATIO], r[VR_X_KISS_REF], &m->table);
+        cc_cover_prepare(&cv, cover_params(r), r[VR_LEVER_RATIO], kiss_ref(m, r), &m->table);
         if (!cc_cover_holds(&cv, &m->table, r[VR_FACING_WEAR], THETA_MIN_K, THETA_MAX_K, &fto, &t_cs, &t_cm)) {
             double limit = cc_cover_wear_limit(&cv, &m->table, THETA_MIN_K, THETA_MAX_K);
             char where[120];
@@ -305,7 +311,7 @@ static int update_outputs(CcModel *m) {
     double mu = tb->f_mu ? cc_table_mu(tb, r[VR_THETA_CM] - KELVIN, r[VR_OMEGA_SLIP]) : r[VR_MU];
     double g = r[VR_U] + r[VR_H];
     if (!m->cover_ok) {
-        cc_cover_prepare(&m->cover, cover_params(r), r[VR_LEVER_RATIO], r[VR_X_KISS_REF], tb);
+        cc_cover_prepare(&m->cover, cover_params(r), r[VR_LEVER_RATIO], kiss_ref(m, r), tb);
         m->cover_ok = 1;
     }
     r[CC_VR_DER_THETA_CS] = (r[VR_U] * r[VR_THETA_CM] + r[VR_H] * r[VR_THETA_A] - g * r[VR_THETA_CS]) / r[VR_C];
@@ -472,6 +478,9 @@ int cc_enter_init(CcModel *m, double start_time, const char *fn) {
 
 int cc_exit_init(CcModel *m, const char *fn) {
     if (!cc_allowed(m, PH_INIT, fn)) return CC_ERROR;
+    if (kiss_ref(m, m->r) != m->r[VR_X_KISS_REF])
+        cc_log(m, CC_OK, "%s: spring = %d: kiss point x_kiss_ref %.9g m + the set's own offset %.9g m", fn, m->set,
+               m->r[VR_X_KISS_REF], kiss_ref(m, m->r) - m->r[VR_X_KISS_REF]);
     if (!check_parameters(m, m->r, fn)) {
         m->r[VR_TORQUE] = m->r[VR_FORCE] = m->r[VR_U_F] = m->r[VR_CLAMP_FORCE] = m->r[VR_BEARING_FORCE] = 0.0;
         m->r[VR_VALIDITY] = 0.0;

@@ -421,6 +421,27 @@ static void set_folder(int k, char *sub, size_t len) {
     else snprintf(sub, len, "tables_%d", k + 1);
 }
 
+/* set k's kiss-point offset (m) from its optional offset file: one finite number, |offset| < 0.1 m */
+static int read_offset(TableSets *s, int k, const char *dir, const char *sub, char *err, size_t errlen) {
+    char path[4200], rest[8];
+    double v;
+    int got;
+    FILE *f;
+    snprintf(path, sizeof path, "%s/%s/%s", dir, sub, CC_KISS_OFFSET_FILE);
+    f = cc_fopen(path, "r");
+    s->kiss_offset[k] = 0.0;
+    if (!f) return 0;
+    got = fscanf(f, "%lf", &v);
+    if (got == 1 && fscanf(f, " %7s", rest) == 1) got = 0; /* anything after the number */
+    fclose(f);
+    if (got != 1 || !isfinite(v) || !(fabs(v) < 0.1)) {
+        snprintf(err, errlen, "%s: must hold one number, the set's kiss-point offset in m, |offset| < 0.1 m", path);
+        return -1;
+    }
+    s->kiss_offset[k] = v;
+    return 0;
+}
+
 int cc_table_sets_load(TableSets *s, const char *dir, char *err, size_t errlen) {
     char sub[32], path[4200];
     int k;
@@ -442,6 +463,10 @@ int cc_table_sets_load(TableSets *s, const char *dir, char *err, size_t errlen) 
             return -1;
         }
         s->n = k + 1;
+        if (k > 0 && read_offset(s, k, dir, sub, err, errlen) != 0) {
+            cc_table_sets_free(s);
+            return -1;
+        }
     }
     return 0;
 }

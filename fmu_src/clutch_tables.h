@@ -72,7 +72,10 @@ int cc_table_load(Table *tb, const char *dir, char *err, size_t errlen);
 typedef struct {
     int n;      /* sets loaded */
     Table *set; /* set[k]: table set k + 1 */
+    double kiss_offset[CC_MAX_SETS]; /* m: set k + 1's own kiss point minus set 1's (<folder>/x_kiss_ref_offset_m.txt,
+                                        written by the build for a set measured from its own kiss point; else 0) */
 } TableSets;
+#define CC_KISS_OFFSET_FILE "x_kiss_ref_offset_m.txt"
 int cc_table_sets_load(TableSets *s, const char *dir, char *err, size_t errlen);
 void cc_table_sets_free(TableSets *s);
 void cc_table_free(Table *tb);

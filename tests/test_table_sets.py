@@ -135,3 +135,40 @@ def test_cli_builds_a_two_set_fmu_and_refuses_thermal(tmp_path, capsys):
     assert main(["build-fmu", "--tables", str(DEFAULT_TABLES), "--tables", str(soft_tables()), "--thermal",
                  "-o", str(tmp_path / "T.fmu")]) == 2
     assert "carries one table set" in capsys.readouterr().err
+
+
+def _own_kiss(dst, x_kiss_ref_m):
+    """The default tables as a tolerance set measured from its own kiss point at ``x_kiss_ref_m`` (m)."""
+    import json
+    import shutil
+    shutil.copytree(DEFAULT_TABLES, dst)
+    meta = json.loads((dst / "metadata.json").read_text())
+    meta["tolerance_study"] = {"percentile": 95.0, "sample": 3, "x_kiss_ref_m": x_kiss_ref_m}
+    (dst / "metadata.json").write_text(json.dumps(meta))
+    return dst
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_a_set_s_own_kiss_point_moves_with_the_choice(tmp_path, version):
+    """Set 2 measured from its own kiss point (4.22 mm against set 1's default 4 mm): chosen, the FMU's kiss
+    point is x_kiss_ref + 0.22 mm, as the one-set FMU of that set gives with its own start value; x_kiss_ref
+    keeps the value set, and a host's own x_kiss_ref shifts both alike."""
+    from cushion_clutch.fmu.build import build_fmu
+    p95 = _own_kiss(tmp_path / "p95", 4.22e-3)
+    two = build_fmu([DEFAULT_TABLES, p95], tmp_path / "two.fmu", fmi_version=version)
+    one = build_fmu(p95, tmp_path / "one.fmu", fmi_version=version)
+    (item,) = [i for t in read_model_description(str(two)).typeDefinitions for i in t.items if i.name == "p95"]
+    assert "x_kiss_ref +0.2200 mm" in item.description
+
+    def run(fmu, **start):
+        res = simulate_fmu(str(fmu), stop_time=0.01, output_interval=0.01, output=["x_kiss", "u_f", "x_kiss_ref"],
+                           start_values={"x_to": 5e-3, "theta_cm": 293.15, "release_compliance_m_per_N": 0.0,
+                                         **start})
+        return res["x_kiss"][-1], res["u_f"][-1], res["x_kiss_ref"][-1]
+
+    chosen, alone = run(two, spring=2), run(one)
+    assert chosen[:2] == alone[:2] and chosen[0] == pytest.approx(4.22e-3, abs=1e-9)
+    assert chosen[2] == 4e-3 and alone[2] == 4.22e-3                 # x_kiss_ref reads as set
+    moved = run(two, spring=2, x_kiss_ref=4.5e-3)
+    assert moved[0] == pytest.approx(4.72e-3, abs=1e-9)
+    assert run(two)[0] == pytest.approx(4e-3, abs=1e-9)

@@ -96,10 +96,8 @@ def parameter_files(fmu: Path) -> list[ParameterSetFile]:
         out.append(ParameterSetFile(named.name, named.description, tuple(values.items()),
                                     sets[0]["name"] if multi else None))
     if multi:
-        for s in sets:
+        for s in sets:                                  # the set's own kiss-point offset is in the FMU
             values = dict(starts)
-            if s["x_kiss_ref_m"] is not None:
-                values["x_kiss_ref"] = float(s["x_kiss_ref_m"])
             out.append(ParameterSetFile(f"spring_{s['name']}", f"table set {s['value']} ({s['name']}): "
                                         f"{s['description']}", tuple(values.items()), s["name"]))
     return out

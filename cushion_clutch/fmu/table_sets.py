@@ -9,9 +9,12 @@ enumeration with one item per set, FMI 2.0 ``SimpleType/Enumeration``, FMI 3.0 `
 reference after FMI 3's ``time``) picks one until initialisation ends; a change after that is refused with a
 message. The GUID (instantiationToken) hashes every set carried (:func:`hash_sets`).
 
-A tolerance set that measures u from its own spring's kiss point (``metadata.json``
-``tolerance_study.x_kiss_ref_m``) needs that ``x_kiss_ref`` with it: the FMU's start value is set 1's, each
-item's description names its own, and the SSP's parameter set of each table set (:mod:`.ssp`) sets both.
+A tolerance set measures u from its own spring's kiss point (``metadata.json``
+``tolerance_study.x_kiss_ref_m``, placed against the nominal spring's). In a multi-set FMU the parameter
+``x_kiss_ref`` is set 1's kiss point (its start value: set 1's own, or the model's default), and each other set
+carries its own kiss point's offset from set 1's (``resources/tables_<k>/x_kiss_ref_offset_m.txt``, read by
+``cc_table_sets_load``), which the model adds when that set is chosen: choosing P95 moves the kiss point as a
+P95 spring does, whatever installation ``x_kiss_ref`` describes.
 """
 from __future__ import annotations
 
@@ -31,6 +34,8 @@ MANIFEST = "table_sets.json"
 TYPE_NAME = "CushionClutch.Spring"
 #: the most sets one FMU carries (CC_MAX_SETS in clutch_tables.h)
 MAX_SETS = 64
+#: a set's kiss-point offset from set 1's, m (CC_KISS_OFFSET_FILE in clutch_tables.h)
+KISS_OFFSET_FILE = "x_kiss_ref_offset_m.txt"
 
 
 @dataclass(frozen=True)
@@ -44,6 +49,8 @@ class CarriedSet:
     description: str
     folder: Path
     x_kiss_ref_m: float | None
+    kiss_offset_m: float = 0.0
+
 
     @property
     def resource(self) -> str:
@@ -67,7 +74,7 @@ def _item_name(folder: Path) -> str:
     return name if name[0].isalpha() else "set_" + name
 
 
-def _description(folder: Path, x_kiss_ref_m: float | None) -> str:
+def _description(folder: Path, kiss_offset_m: float) -> str:
     meta_path = Path(folder) / METADATA
     meta = json.loads(meta_path.read_text()) if meta_path.exists() else {}
     spring = meta.get("spring", {}) if isinstance(meta.get("spring"), dict) else {}
@@ -75,8 +82,8 @@ def _description(folder: Path, x_kiss_ref_m: float | None) -> str:
     scale = meta.get("force_scale")
     if scale is not None:
         text += f"; forces x {scale}"
-    if x_kiss_ref_m is not None:
-        text += f"; measured from its own kiss point: use x_kiss_ref = {x_kiss_ref_m!r} m with it"
+    if kiss_offset_m:
+        text += f"; its own kiss point: x_kiss_ref {kiss_offset_m * 1e3:+.4f} mm (applied when chosen)"
     return text
 
 
@@ -97,13 +104,16 @@ def carried_sets(folders) -> tuple[CarriedSet, ...]:
     if problems:
         raise ParameterError(problems)
     sets, names = [], []
-    for index, folder in enumerate(folders, start=1):
+    default = clutch_model.ClutchParameters().x_kiss_ref
+    kisses = [table_set_x_kiss_ref(f) for f in folders]
+    first = default if kisses[0] is None else kisses[0]
+    for index, (folder, kiss) in enumerate(zip(folders, kisses), start=1):
         name, k = _item_name(folder), 2
         while name in names:
             name, k = f"{_item_name(folder)}_{k}", k + 1
         names.append(name)
-        kiss = table_set_x_kiss_ref(folder)
-        sets.append(CarriedSet(index, name, _description(folder, kiss), folder, kiss))
+        offset = 0.0 if index == 1 else (default if kiss is None else kiss) - first
+        sets.append(CarriedSet(index, name, _description(folder, offset), folder, kiss, offset))
     return tuple(sets)
 
 
@@ -119,10 +129,11 @@ def hash_sets(digest, sets) -> None:
 
 def manifest(sets) -> str:
     """Text of ``resources/table_sets.json``."""
-    return json.dumps({"parameter": clutch_model.TABLE_SET_VARIABLE[0], "value_reference": vr_spring(),
+    return json.dumps({"parameter": clutch_model.TABLE_SET_VARIABLE[0],
                        "sets": [{"value": s.index, "name": s.name, "description": s.description,
                                  "resource": s.resource, "source": s.folder.resolve().name,
-                                 "x_kiss_ref_m": s.x_kiss_ref_m} for s in sets]}, indent=2) + "\n"
+                                 "x_kiss_ref_m": s.x_kiss_ref_m, "kiss_offset_m": s.kiss_offset_m}
+                                for s in sets]}, indent=2) + "\n"
 
 
 def write_resources(z, sets) -> None:
@@ -131,6 +142,8 @@ def write_resources(z, sets) -> None:
         for name in FMU_FILES:
             if (s.folder / name).exists():
                 z.write(s.folder / name, f"resources/{s.resource}/{name}")
+        if s.kiss_offset_m:
+            z.writestr(f"resources/{s.resource}/{KISS_OFFSET_FILE}", f"{s.kiss_offset_m!r}\n")
     z.writestr(f"resources/{MANIFEST}", manifest(sets))
 
 
@@ -177,4 +190,4 @@ def fmu_sets(fmu: Path) -> list[dict]:
         if f"resources/{MANIFEST}" in z.namelist():
             return json.loads(z.read(f"resources/{MANIFEST}"))["sets"]
     return [{"value": 1, "name": "tables", "description": "the FMU's one table set", "resource": "tables",
-             "source": None, "x_kiss_ref_m": None}]
+             "source": None, "x_kiss_ref_m": None, "kiss_offset_m": 0.0}]

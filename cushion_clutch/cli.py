@@ -389,6 +389,9 @@ def _tolerance(args: argparse.Namespace) -> int:
     out = Path(args.out)
     if out.resolve().is_relative_to(tables_root().resolve()):
         raise ParameterError([f"--out {out} is inside the table sets shipped with cushion-clutch; give another"])
+    if args.fmu:
+        from .fmu.build import check_output
+        check_output(args.fmu)                          # before the study, not after it
     with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
                   TextColumn("{task.fields[status]}"), TimeElapsedColumn()) as bar:
         task = bar.add_task(f"{args.samples} samples + nominal", total=None, status="")
@@ -399,7 +402,7 @@ def _tolerance(args: argparse.Namespace) -> int:
         res = tolerance_study(params, samples=args.samples, temperatures=tuple(args.temperatures), out=out,
                               method=args.method, seed=args.seed, rank_by=args.rank_by,
                               cache_dir=Path(args.cache), scheduler=args.scheduler, workers=args.workers,
-                              progress=progress)
+                              progress=progress, band_fmu=args.fmu)
     b = res.bands
     print(f"{res.cases} FE cases ({res.cases_from_cache} from the cache) in {res.wall_time_s:.1f} s")
     print(f"{'theta [degC]':>12} {'delta_kiss P5/P50/P95 [mm]':>28} "
@@ -423,6 +426,10 @@ def _tolerance(args: argparse.Namespace) -> int:
     for w in res.warnings:
         print(f"warning: {w}", file=sys.stderr)
     print("wrote " + ", ".join(str(f) for f in res.files))
+    if res.band_fmu is not None:
+        from .fmu.table_sets import fmu_sets
+        print(f"wrote {res.band_fmu}: one FMU for the band, parameter spring: "
+              + ", ".join(f"{s['value']} = {s['name']}" for s in fmu_sets(res.band_fmu)))
     return 0
 
 
@@ -625,6 +632,8 @@ def build_parser() -> argparse.ArgumentParser:
     _out(to, "folder for <name>_tolerance/ and the <name>_p05/, <name>_p95/ table sets (default ./lookup_tables)",
          default="lookup_tables")
     to.add_argument("--cache", default=DEFAULT_CACHE, help="case cache folder (shared with sweep)")
+    to.add_argument("--fmu", type=Path, help="also write one native FMU (.fmu) carrying the nominal, P5 and P95 table "
+                                             "sets, chosen by its parameter spring")
     return parser
 
 

@@ -172,3 +172,30 @@ def test_a_set_s_own_kiss_point_moves_with_the_choice(tmp_path, version):
     moved = run(two, spring=2, x_kiss_ref=4.5e-3)
     assert moved[0] == pytest.approx(4.72e-3, abs=1e-9)
     assert run(two)[0] == pytest.approx(4e-3, abs=1e-9)
+
+
+def test_the_pythonfmu_backend_carries_the_sets_too(capfd):
+    """pythonfmu: the same enumeration, set 2 = the native FMU of set 2 alone and the native two-set FMU's set 2
+    (a second implementation: the Python model), and a change after initialisation refused with the message."""
+    two, alone = two_set_fmu(2, "python"), soft_fmu(2)
+    md = read_model_description(str(two))
+    (enum,) = md.typeDefinitions
+    assert [(i.name, int(i.value)) for i in enum.items] == [("default", 1), ("soft", 2)]
+    assert validate_fmu(str(two)) == []
+    for x_to, theta in POINTS[::3]:
+        chosen = _torque(two, x_to, theta, {"spring": 2})
+        assert abs(chosen - _torque(alone, x_to, theta)) <= 1e-9
+        assert abs(chosen - _torque(two_set_fmu(2), x_to, theta, {"spring": 2})) <= 1e-9
+    s, vr = _slave(two)
+    s.instantiate(loggingOn=True)
+    s.setInteger([vr["spring"]], [2])
+    s.setupExperiment(startTime=0.0)
+    s.enterInitializationMode()
+    s.exitInitializationMode()
+    assert s.getInteger([vr["spring"]]) == [2]
+    with pytest.raises(FMICallException):
+        s.setInteger([vr["spring"]], [1])
+    assert "parameter spring (the table set) is fixed after initialization" in capfd.readouterr().out
+    assert s.getInteger([vr["spring"]]) == [2]
+    s.terminate()
+    s.freeInstance()

@@ -191,3 +191,41 @@ def fmu_sets(fmu: Path) -> list[dict]:
             return json.loads(z.read(f"resources/{MANIFEST}"))["sets"]
     return [{"value": 1, "name": "tables", "description": "the FMU's one table set", "resource": "tables",
              "source": None, "x_kiss_ref_m": None, "kiss_offset_m": 0.0}]
+
+
+def stage_sets(stage: Path, sets) -> list[Path]:
+    """Sets 2.. (with their kiss-offset files) and the manifest as files in ``stage`` for the pythonfmu build
+    (its resources); return them ([] for one set)."""
+    out = []
+    for s in sets[1:]:
+        folder = stage / s.resource
+        folder.mkdir()
+        for name in FMU_FILES:
+            if (s.folder / name).exists():
+                (folder / name).write_bytes((s.folder / name).read_bytes())
+        if s.kiss_offset_m:
+            (folder / KISS_OFFSET_FILE).write_text(f"{s.kiss_offset_m!r}\n")
+        out.append(folder)
+    if sets:
+        (stage / MANIFEST).write_text(manifest(sets))
+        out.append(stage / MANIFEST)
+    return out
+
+
+def enumeration_from_integer(xml_text: str, sets) -> str:
+    """A pythonfmu modelDescription with the slave's Integer ``spring`` declared as the sets' enumeration (the
+    type added as :func:`with_table_sets` adds it); unchanged for one set."""
+    if len(sets) < 2:
+        return xml_text
+    root = ET.fromstring(xml_text)
+    name = clutch_model.TABLE_SET_VARIABLE[0]
+    (var,) = [v for v in root.find("ModelVariables") if v.get("name") == name]
+    var.remove(var.find("Integer"))
+    var.set("initial", "exact")
+    var.set("description", _variable_description())
+    ET.SubElement(var, "Enumeration", declaredType=TYPE_NAME, start="1")
+    types = ET.Element("TypeDefinitions")
+    _items(ET.SubElement(ET.SubElement(types, "SimpleType", name=TYPE_NAME), "Enumeration"), sets)
+    root.insert(list(root).index(root.find("UnitDefinitions")) + 1, types)
+    ET.indent(root)
+    return '<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="unicode") + "\n"

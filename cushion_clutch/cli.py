@@ -33,6 +33,17 @@ def _fmu_arg(args: argparse.Namespace, stage: Path) -> Path:
         return build_fmu(Path(args.tables), stage / "CushionClutch.fmu", backend=args.backend)
 
 
+def _ssp_arg(args: argparse.Namespace) -> Path | None:
+    """``--fmu`` if it names an SSP archive (``.ssp``); a ``--parameter-set`` without one is refused."""
+    fmu = getattr(args, "fmu", None)
+    if fmu and Path(fmu).suffix.lower() == ".ssp":
+        return Path(fmu)
+    if getattr(args, "parameter_set", None):
+        raise ParameterError([f"--parameter-set {args.parameter_set}: needs --fmu with an .ssp archive "
+                              "(cushion-clutch export-ssp writes one)"])
+    return None
+
+
 def _sweep(args: argparse.Namespace) -> int:
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
@@ -124,18 +135,28 @@ def _simulate(args: argparse.Namespace) -> int:
 
     from .launch.engagements import (EngagementCycle, plot_engagements, plot_thermal_step,
                                      plot_torque_characteristic, simulate)
-    from .model import load_table
+    from .model import ClutchParameters, load_table
     from .outputs import OutputSet
 
     out = _guard_out(Path(args.out), args.force)
-    _check_tables(args.tables)
-    table = load_table(args.tables)
+    ssp = _ssp_arg(args)
+    if not ssp:
+        _check_tables(args.tables)
+        table = load_table(args.tables)
     with OutputSet(out, "simulate") as stage:              # checks --out before the simulation
-        fmu = _fmu_arg(args, stage)
-        which = args.fmu or f"the {args.backend} FMU built from {args.tables}"
+        starts, p = None, ClutchParameters()
+        if ssp:
+            from .fmu.ssp import chosen_tables, plant_from_ssp
+            fmu, starts = plant_from_ssp(ssp, args.parameter_set, stage / "ssp")
+            table = load_table(chosen_tables(fmu, starts, stage / "ssp" / "tables"))
+            p = ClutchParameters.from_flat({k: v for k, v in starts.items() if k in ClutchParameters.RANGES})
+            which = f"{fmu.name} of {ssp}, parameter set {args.parameter_set or 'new'}"
+        else:
+            fmu = _fmu_arg(args, stage)
+            which = args.fmu or f"the {args.backend} FMU built from {args.tables}"
         print(f"simulating {args.engagements} engagements with {which} (fmpy, step {args.step:g} s) ...")
         start = time.perf_counter()
-        res = simulate(fmu, EngagementCycle(), n_engagements=args.engagements, step_s=args.step)
+        res = simulate(fmu, EngagementCycle(), n_engagements=args.engagements, step_s=args.step, start_values=starts)
         wall = time.perf_counter() - start
         with open(stage / "engagements.csv", "w", newline="") as fh:
             w = csv.writer(fh)
@@ -144,8 +165,8 @@ def _simulate(args: argparse.Namespace) -> int:
             for row in res:
                 w.writerow([f"{v:.9g}" for v in row])
         plots = [plot_engagements(res, stage / "engagements.png"),
-                 plot_torque_characteristic(table, stage / "torque_characteristic.png"),
-                 plot_thermal_step(stage / "thermal_step_response.png")]
+                 plot_torque_characteristic(table, stage / "torque_characteristic.png", p),
+                 plot_thermal_step(stage / "thermal_step_response.png", p)]
     plots = [out / p.name for p in plots]
     period = EngagementCycle().period_s
     print(f"{'engagement':>10} {'theta_cm max [degC]':>20} {'theta_cs max [degC]':>20} "
@@ -175,12 +196,18 @@ def _launch(args: argparse.Namespace) -> int:
 
     sc = load_scenario(scenario_path(args.scenario))
     out = _guard_out(Path(args.out), args.force)
+    ssp = _ssp_arg(args)
     _check_tables(sc.tables_path("tcu") or args.tables)
     table = load_table(sc.tables_path("tcu") or args.tables)     # a scenario may name the TCUs' table set
     prov = Provenance(sc.name, _command_line(args), sc.run.hot_degC)
     output_set = OutputSet(out, "launch", {**prov.as_dict(), "every": args.every})
+    plant_start = None
     with output_set as stage:                              # checks --out before the simulation
-        if args.fmu:
+        if ssp:
+            from .fmu.ssp import plant_from_ssp
+            fmu, plant_start = plant_from_ssp(ssp, args.parameter_set, stage / "ssp")
+            print(f"plant: {fmu.name} of {ssp} with parameter set {args.parameter_set or 'new'}")
+        elif args.fmu:
             fmu = check_fmu(args.fmu)
         else:
             _check_tables(args.tables)
@@ -190,7 +217,8 @@ def _launch(args: argparse.Namespace) -> int:
         start = time.perf_counter()
         with Progress(refresh_per_second=2) as bar:        # the bar's thread competes for the GIL
             tasks = {n: bar.add_task(f"{n} TCU", total=total) for n in VARIANTS}
-            results = run_all(fmu, sc, table, progress=lambda n, t: bar.update(tasks[n], completed=t))
+            results = run_all(fmu, sc, table, progress=lambda n, t: bar.update(tasks[n], completed=t),
+                              plant_start=plant_start)
             for task in tasks.values():
                 bar.update(task, completed=total)
         wall = time.perf_counter() - start
@@ -332,11 +360,29 @@ def _check_tables(folder) -> None:
 
 
 def _build_fmu(args: argparse.Namespace) -> int:
-    from .fmu.build import build_from_args
-    _check_tables(args.tables)
+    from .fmu.build import build_from_args, table_folders
+    for folder in table_folders(args):
+        _check_tables(folder)
     with _slow_notice(ZIG_NOTICE):
         report = build_from_args(args)
     print(report)
+    return 0
+
+
+def _export_ssp(args: argparse.Namespace) -> int:
+    from .fmu.build import table_folders
+    from .fmu.ssp import export_from_args
+    if not args.fmu:
+        for folder in table_folders(args):
+            _check_tables(folder)
+    with _slow_notice(ZIG_NOTICE):
+        rep = export_from_args(args)
+    print(f"wrote {rep.path}: {len(rep.files)} files, SSD and {len(rep.sets)} SSV parameter sets validated "
+          f"against the SSP 1.0 schemas; bound to the FMU: {args.bind}")
+    for name, description in rep.sets:
+        print(f"  {name}: {description}")
+    if len(rep.table_sets) > 1:
+        print("the FMU's parameter spring: " + ", ".join(f"{v} = {n}" for v, n, _ in rep.table_sets))
     return 0
 
 
@@ -376,6 +422,9 @@ def _tolerance(args: argparse.Namespace) -> int:
     out = Path(args.out)
     if out.resolve().is_relative_to(tables_root().resolve()):
         raise ParameterError([f"--out {out} is inside the table sets shipped with cushion-clutch; give another"])
+    if args.fmu:
+        from .fmu.build import check_output
+        check_output(args.fmu)                          # before the study, not after it
     with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
                   TextColumn("{task.fields[status]}"), TimeElapsedColumn()) as bar:
         task = bar.add_task(f"{args.samples} samples + nominal", total=None, status="")
@@ -386,7 +435,7 @@ def _tolerance(args: argparse.Namespace) -> int:
         res = tolerance_study(params, samples=args.samples, temperatures=tuple(args.temperatures), out=out,
                               method=args.method, seed=args.seed, rank_by=args.rank_by,
                               cache_dir=Path(args.cache), scheduler=args.scheduler, workers=args.workers,
-                              progress=progress)
+                              progress=progress, band_fmu=args.fmu)
     b = res.bands
     print(f"{res.cases} FE cases ({res.cases_from_cache} from the cache) in {res.wall_time_s:.1f} s")
     print(f"{'theta [degC]':>12} {'delta_kiss P5/P50/P95 [mm]':>28} "
@@ -410,6 +459,10 @@ def _tolerance(args: argparse.Namespace) -> int:
     for w in res.warnings:
         print(f"warning: {w}", file=sys.stderr)
     print("wrote " + ", ".join(str(f) for f in res.files))
+    if res.band_fmu is not None:
+        from .fmu.table_sets import fmu_sets
+        print(f"wrote {res.band_fmu}: one FMU for the band, parameter spring: "
+              + ", ".join(f"{s['value']} = {s['name']}" for s in fmu_sets(res.band_fmu)))
     return 0
 
 
@@ -478,7 +531,10 @@ def build_parser() -> argparse.ArgumentParser:
                   "cushion-clutch launch --scenario creep --out out_creep")
     la.add_argument("--scenario", default=DEFAULT_SCENARIO,
                     help="scenario TOML, or a shipped one: default, trailer, creep, cooldown, fade, wear, wear_learned, tolerance, protection")
-    la.add_argument("--fmu", help="clutch FMU (default: build one from --tables into --out)")
+    la.add_argument("--fmu", help="clutch FMU, or an SSP archive (.ssp, from export-ssp) whose FMU is the plant "
+                                  "(default: build one from --tables into --out)")
+    la.add_argument("--parameter-set", help="with an .ssp: the plant's parameter set (default new); the scenario "
+                                            "still sets ambient, soak, kiss-point offset and a wear it states")
     la.add_argument("--tables", default=DEFAULT_TABLES, help="table folder")
     add_backend(la)
     _out(la, "output folder (default: out)", default="out")
@@ -491,7 +547,9 @@ def build_parser() -> argparse.ArgumentParser:
                   "Drive the clutch FMU through fmpy over repeated engagements 60 s apart (bearing ramp, "
                   "hold, open; a prescribed facing temperature) and write engagements.csv and three plots.",
                   "cushion-clutch simulate --engagements 4 --out out_sim")
-    sm.add_argument("--fmu", help="FMU to simulate (default: build one from --tables into --out)")
+    sm.add_argument("--fmu", help="FMU to simulate, or an SSP archive (.ssp, from export-ssp) with its FMU "
+                                  "(default: build one from --tables into --out)")
+    sm.add_argument("--parameter-set", help="with an .ssp: the parameter set to simulate with (default new)")
     sm.add_argument("--tables", default=DEFAULT_TABLES, help="table folder")
     add_backend(sm)
     _out(sm, "output folder (default: out)", default="out")
@@ -505,6 +563,21 @@ def build_parser() -> argparse.ArgumentParser:
                   "pythonfmu FMU. The output must be a new or existing file ending in .fmu, not a folder.",
                   "cushion-clutch build-fmu --fmi-version 3 --out CushionClutch3.fmu")
     add_build_arguments(bf)
+
+    sp = _command(sub, "export-ssp", _export_ssp, "write the clutch FMU with its parameter sets as an SSP archive",
+                  "Write an SSP 1.0 archive (.ssp) holding the clutch FMU (from --fmu, or built from --tables, "
+                  "which may be given more than once), SystemStructure.ssd declaring it, and an SSV parameter set "
+                  "per wear state, thermal set and table set carried, each value bound by name with its unit. "
+                  "Every file is validated against the SSP 1.0 schemas shipped with FMPy.",
+                  "cushion-clutch export-ssp --tables lookup_tables/default --tables soft -o Clutch.ssp")
+    sp.add_argument("--tables", type=Path, action="append", default=None,
+                    help="table folder; more than once: one FMU carrying every set (default: the default set)")
+    sp.add_argument("--fmu", help="put this clutch FMU in the archive instead of building one")
+    sp.add_argument("--fmi-version", type=int, choices=(2, 3), default=2, help="FMI version of the FMU built")
+    sp.add_argument("-o", "--out", dest="output", type=Path, default=Path("CushionClutch.ssp"),
+                    help="archive to write, ending in .ssp (default CushionClutch.ssp)")
+    sp.add_argument("--bind", default="new",
+                    help="the parameter set the SSD binds to the FMU, which a tool applies on import (default new)")
 
     ex = _command(sub, "export", _export, "write the tables for Simulink (.mat) and Modelica (CombiTable)",
                   "Write cushion_spring_tables.mat (Simulink 2-D Lookup Tables, and a 3-D clamp-force table in "
@@ -595,6 +668,8 @@ def build_parser() -> argparse.ArgumentParser:
     _out(to, "folder for <name>_tolerance/ and the <name>_p05/, <name>_p95/ table sets (default ./lookup_tables)",
          default="lookup_tables")
     to.add_argument("--cache", default=DEFAULT_CACHE, help="case cache folder (shared with sweep)")
+    to.add_argument("--fmu", type=Path, help="also write one native FMU (.fmu) carrying the nominal, P5 and P95 table "
+                                             "sets, chosen by its parameter spring")
     return parser
 
 

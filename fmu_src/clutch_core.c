@@ -74,12 +74,67 @@ int cc_instantiate(CcModel *m, const char *dir, int me, CcLogger logger, void *c
     m->dirty = 1;
     m->decay_h = NAN;
     m->warm.x = NAN;
-    m->table_ok = cc_table_load(&m->table, dir, m->table_error, sizeof m->table_error) == 0;
+    m->table_ok = cc_table_sets_load(&m->sets, dir, m->table_error, sizeof m->table_error) == 0;
     if (!m->table_ok) cc_log(m, CC_ERROR, "cannot load the F(u, theta) tables: %s", m->table_error);
+    m->set = 1;
+    if (m->table_ok) m->table = m->sets.set[0];
     return m->table_ok ? 0 : -1;
 }
 
-void cc_free(CcModel *m) { cc_table_free(&m->table); }
+void cc_free(CcModel *m) {
+    cc_table_sets_free(&m->sets);
+    memset(&m->table, 0, sizeof m->table);
+}
+
+/* choose table set k (1..sets.n): everything prepared from the old one is dropped */
+static void choose_set(CcModel *m, int k) {
+    m->set = k;
+    m->table = m->sets.set[k - 1];
+    m->cover_ok = 0;
+    m->held_valid = 0;
+    m->warm.x = m->decay_h = NAN;
+    m->dirty = 1;
+}
+
+int cc_set_integer(CcModel *m, const unsigned int vr[], size_t n, const long long v[], const char *fn) {
+    size_t k;
+    if (!cc_allowed(m, PH_INSTANTIATED | PH_INIT | PH_STEP | PH_EVENT | PH_CONT, fn)) return CC_ERROR;
+    if (n && (!vr || !v)) { cc_log(m, CC_ERROR, "%s: NULL value reference or value array", fn); return CC_ERROR; }
+    for (k = 0; k < n; ++k) { /* validate all first: a refused call changes nothing */
+        if (vr[k] != CC_VR_SPRING || m->sets.n < 2) {
+            cc_log(m, CC_ERROR, "%s: unknown value reference %u (%s)", fn, vr[k], m->sets.n < 2
+                   ? "the model has Real variables only" : "the only integer variable is spring");
+            return CC_ERROR;
+        }
+        if (m->phase & (PH_STEP | PH_EVENT | PH_CONT)) {
+            cc_log(m, CC_ERROR, "%s: parameter spring (the table set) is fixed after initialization: it stays %d; "
+                   "choose the set before fmiExitInitializationMode", fn, m->set);
+            return CC_ERROR;
+        }
+        if (!(v[k] >= 1 && v[k] <= m->sets.n)) {
+            cc_log(m, CC_ERROR, "%s: spring = %lld: allowed 1..%d (the table sets this FMU carries)", fn, v[k],
+                   m->sets.n);
+            return CC_ERROR;
+        }
+    }
+    for (k = 0; k < n; ++k) choose_set(m, (int)v[k]);
+    return CC_OK;
+}
+
+int cc_get_integer(CcModel *m, const unsigned int vr[], size_t n, long long v[], const char *fn) {
+    size_t k;
+    if (!cc_allowed(m, PH_ANY & ~PH_INSTANTIATED, fn)) return CC_ERROR;
+    if (n && (!vr || !v)) { cc_log(m, CC_ERROR, "%s: NULL value reference or value array", fn); return CC_ERROR; }
+    for (k = 0; k < n; ++k) {
+        if (vr[k] != CC_VR_SPRING || m->sets.n < 2) {
+            cc_log(m, CC_ERROR, "%s: unknown value reference %u (%s)", fn, vr[k], m->sets.n < 2
+                   ? "the model has Real variables only" : "the only integer variable is spring");
+            return CC_ERROR;
+        }
+        v[k] = m->set;
+    }
+    return CC_OK;
+}
 
 void cc_reset(CcModel *m) {
     set_starts(m->r);
@@ -90,12 +145,19 @@ void cc_reset(CcModel *m) {
     m->cover_ok = 0;
     m->warm.x = m->decay_h = NAN;
     m->phase = PH_INSTANTIATED;
+    if (m->table_ok) choose_set(m, 1);
 }
 
 /* ------------------------------------------------------------------- checks */
 static int range_ok(int k, double v) {
     const double *g = CC_VARIABLES[k].range;
     return isfinite(v) && (g[2] ? v > g[0] : v >= g[0]) && (g[3] ? v < g[1] : v <= g[1]);
+}
+
+/* the kiss point at the bearing the model uses, m: x_kiss_ref, plus the chosen table set's own offset in an FMU
+   that carries several (TableSets.kiss_offset; x_kiss_ref is then set 1's kiss point) */
+static double kiss_ref(const CcModel *m, const double *r) {
+    return m->sets.n > 1 ? r[VR_X_KISS_REF] + m->sets.kiss_offset[m->set - 1] : r[VR_X_KISS_REF];
 }
 
 /* the cover parameters of a variable vector (CV_* order) */
@@ -134,7 +196,7 @@ static int cover_consistent(CcModel *m, const double *r, const char *fn) {
     }
     if (ok && m) {
         CcCover cv;
-        cc_cover_prepare(&cv, c, lever, r[VR_X_KISS_REF], &m->table);
+        cc_cover_prepare(&cv, c, lever, kiss_ref(m, r), &m->table);
         if (!(cc_cover_slope_bound(&cv) > 0.0)) {
             cc_log(m, CC_ERROR, "%s: release_compliance_m_per_N = %g: the release snaps through (x_to(s) not "
                    "monotone on the diaphragm's falling branch); reduce it", fn, c[CV_C]);
@@ -180,7 +242,7 @@ static int check_parameters(CcModel *m, const double *r, const char *fn) {
            parameters that passed are kept, so restoring states of the same instance does not repeat it) */
         CcCover cv;
         double fto = 0.0, t_cs = 0.0, t_cm = 0.0;
-        cc_cover_prepare(&cv, cover_params(r), r[VR_LEVER_RATIO], r[VR_X_KISS_REF], &m->table);
+        cc_cover_prepare(&cv, cover_params(r), r[VR_LEVER_RATIO], kiss_ref(m, r), &m->table);
         if (!cc_cover_holds(&cv, &m->table, r[VR_FACING_WEAR], THETA_MIN_K, THETA_MAX_K, &fto, &t_cs, &t_cm)) {
             double limit = cc_cover_wear_limit(&cv, &m->table, THETA_MIN_K, THETA_MAX_K);
             char where[120];
@@ -249,7 +311,7 @@ static int update_outputs(CcModel *m) {
     double mu = tb->f_mu ? cc_table_mu(tb, r[VR_THETA_CM] - KELVIN, r[VR_OMEGA_SLIP]) : r[VR_MU];
     double g = r[VR_U] + r[VR_H];
     if (!m->cover_ok) {
-        cc_cover_prepare(&m->cover, cover_params(r), r[VR_LEVER_RATIO], r[VR_X_KISS_REF], tb);
+        cc_cover_prepare(&m->cover, cover_params(r), r[VR_LEVER_RATIO], kiss_ref(m, r), tb);
         m->cover_ok = 1;
     }
     r[CC_VR_DER_THETA_CS] = (r[VR_U] * r[VR_THETA_CM] + r[VR_H] * r[VR_THETA_A] - g * r[VR_THETA_CS]) / r[VR_C];
@@ -416,6 +478,9 @@ int cc_enter_init(CcModel *m, double start_time, const char *fn) {
 
 int cc_exit_init(CcModel *m, const char *fn) {
     if (!cc_allowed(m, PH_INIT, fn)) return CC_ERROR;
+    if (kiss_ref(m, m->r) != m->r[VR_X_KISS_REF])
+        cc_log(m, CC_OK, "%s: spring = %d: kiss point x_kiss_ref %.9g m + the set's own offset %.9g m", fn, m->set,
+               m->r[VR_X_KISS_REF], kiss_ref(m, m->r) - m->r[VR_X_KISS_REF]);
     if (!check_parameters(m, m->r, fn)) {
         m->r[VR_TORQUE] = m->r[VR_FORCE] = m->r[VR_U_F] = m->r[VR_CLAMP_FORCE] = m->r[VR_BEARING_FORCE] = 0.0;
         m->r[VR_VALIDITY] = 0.0;
@@ -577,6 +642,7 @@ void cc_state_save(const CcModel *m, CcState *s) {
     s->time = m->time;
     memcpy(s->r, m->r, sizeof s->r);
     s->warm = m->warm;
+    s->table_set = m->set;
     s->checksum = fnv1a(s, offsetof(CcState, checksum));
 }
 
@@ -616,12 +682,18 @@ int cc_state_check(CcModel *m, const void *bytes, size_t size, const char *fn) {
         cc_log(m, CC_ERROR, "%s: the state's time, theta_cs, flags or warm start are out of range", fn);
         return 0;
     }
+    if (!(s.table_set >= 1 && s.table_set <= m->sets.n)) {
+        cc_log(m, CC_ERROR, "%s: the state's table set spring = %d: this FMU carries sets 1..%d", fn,
+               (int)s.table_set, m->sets.n);
+        return 0;
+    }
     if (s.phase != PH_INSTANTIATED && s.phase != PH_INIT && s.phase != PH_ERROR && !check_parameters(m, s.r, fn))
         return 0;
     return 1;
 }
 
 void cc_state_load(CcModel *m, const CcState *s) {
+    if (s->table_set != m->set) choose_set(m, s->table_set);
     memcpy(m->r, s->r, sizeof m->r);
     m->phase = s->phase;
     m->range_warned = s->range_warned;

@@ -29,6 +29,9 @@
 #include "clutch_cover.h"  /* CcCover, CcCoverState and their functions */
 
 #define CC_VR_TIME CC_NVARS
+/* the table set's enumeration `spring` (1-based; declared only in an FMU that carries more than one set,
+   cushion_clutch.fmu.table_sets): the value reference after time, in both FMI versions */
+#define CC_VR_SPRING (CC_VR_TIME + 1)
 /* the thermal variant (CushionClutchThermal, cushion_clutch.fmu.thermal_chain) defines CC_THERMAL, the chain
    (thermal_network.h) and CC_NSTATES (theta_cs, then the network's nodes) in its cushion_variables.h */
 #ifndef CC_THERMAL
@@ -65,7 +68,9 @@ typedef struct {
     /* the cover's warm start (update_outputs, cc_cover_solve): the last answer; x NaN (cold) after instantiation,
        reset, exit-initialisation and any parameter change; part of the saved state */
     CcWarm warm;
-    Table table;
+    Table table;      /* the chosen table set (a copy of sets.set[set - 1]: it owns nothing) */
+    TableSets sets;   /* every table set the FMU carries */
+    int set;          /* the chosen set, 1..sets.n (parameter spring; fixed after initialisation) */
     CcCover cover;
     int cover_ok;     /* cover prepared from the current parameters */
     int table_ok;
@@ -82,11 +87,11 @@ typedef struct {
 
 /* the serialized (and saved) FMU state: versioned, checksummed, validated before use */
 #define CC_STATE_MAGIC 0x43434653u /* "CCFS" */
-#define CC_STATE_VERSION 6u /* 3: the cover variables; 4: validity (range_warned = last validity 0..2); 5: warm start;
-                               6: the warm start's residual and history (CcWarm r, s1, s2) */
+#define CC_STATE_VERSION 7u /* 3: the cover variables; 4: validity (range_warned = last validity 0..2); 5: warm start;
+                               6: the warm start's residual and history (CcWarm r, s1, s2); 7: the table set */
 typedef struct {
     uint32_t magic, version, size;
-    int32_t phase, me, range_warned, terminated, reserved;
+    int32_t phase, me, range_warned, terminated, table_set; /* table_set: the chosen set, 1.. (spring) */
     double time;
     double r[CC_NVARS];
     CcWarm warm; /* the cover's warm start (CcModel) */
@@ -105,6 +110,9 @@ void cc_log(CcModel *m, int status, const char *fmt, ...)
 int cc_allowed(CcModel *m, int mask, const char *fn);
 int cc_set_real(CcModel *m, const unsigned int vr[], size_t n, const double v[], const char *fn);
 int cc_get_real(CcModel *m, const unsigned int vr[], size_t n, double v[], const char *fn);
+/* the integer (enumeration) variables: spring, the table set (only if more than one is carried) */
+int cc_set_integer(CcModel *m, const unsigned int vr[], size_t n, const long long v[], const char *fn);
+int cc_get_integer(CcModel *m, const unsigned int vr[], size_t n, long long v[], const char *fn);
 int cc_enter_init(CcModel *m, double start_time, const char *fn);
 int cc_exit_init(CcModel *m, const char *fn);
 int cc_do_step(CcModel *m, double t, double h, const char *fn);

@@ -409,15 +409,85 @@ fail:
 
 /* One F(u) curve per temperature; the groups may come in any order, rows keep their file order
    within a group (as SpringTable.from_dir). kiss_point.csv rows may come in any order too. */
+static int load_folder(Table *tb, const char *dir, const char *sub, char *err, size_t errlen);
+
 int cc_table_load(Table *tb, const char *dir, char *err, size_t errlen) {
+    return load_folder(tb, dir, "tables", err, errlen);
+}
+
+/* the folder of table set k (0-based) under the resources: tables, tables_2, tables_3, ... */
+static void set_folder(int k, char *sub, size_t len) {
+    if (k == 0) snprintf(sub, len, "tables");
+    else snprintf(sub, len, "tables_%d", k + 1);
+}
+
+/* set k's kiss-point offset (m) from its optional offset file: one finite number, |offset| < 0.1 m */
+static int read_offset(TableSets *s, int k, const char *dir, const char *sub, char *err, size_t errlen) {
+    char path[4200], rest[8];
+    double v;
+    int got;
+    FILE *f;
+    snprintf(path, sizeof path, "%s/%s/%s", dir, sub, CC_KISS_OFFSET_FILE);
+    f = cc_fopen(path, "r");
+    s->kiss_offset[k] = 0.0;
+    if (!f) return 0;
+    got = fscanf(f, "%lf", &v);
+    if (got == 1 && fscanf(f, " %7s", rest) == 1) got = 0; /* anything after the number */
+    fclose(f);
+    if (got != 1 || !isfinite(v) || !(fabs(v) < 0.1)) {
+        snprintf(err, errlen, "%s: must hold one number, the set's kiss-point offset in m, |offset| < 0.1 m", path);
+        return -1;
+    }
+    s->kiss_offset[k] = v;
+    return 0;
+}
+
+int cc_table_sets_load(TableSets *s, const char *dir, char *err, size_t errlen) {
+    char sub[32], path[4200];
+    int k;
+    memset(s, 0, sizeof *s);
+    if (strlen(dir) > 4000) { snprintf(err, errlen, "resource path too long"); return -1; }
+    s->set = (Table *)calloc(CC_MAX_SETS, sizeof(Table));
+    if (!s->set) { snprintf(err, errlen, "out of memory"); return -1; }
+    for (k = 0; k < CC_MAX_SETS; ++k) {
+        set_folder(k, sub, sizeof sub);
+        if (k > 0) { /* the sets are numbered without gaps: the first missing folder ends them */
+            FILE *probe;
+            snprintf(path, sizeof path, "%s/%s/force_deflection.csv", dir, sub);
+            probe = cc_fopen(path, "r");
+            if (!probe) break;
+            fclose(probe);
+        }
+        if (load_folder(&s->set[k], dir, sub, err, errlen) != 0) {
+            cc_table_sets_free(s);
+            return -1;
+        }
+        s->n = k + 1;
+        if (k > 0 && read_offset(s, k, dir, sub, err, errlen) != 0) {
+            cc_table_sets_free(s);
+            return -1;
+        }
+    }
+    return 0;
+}
+
+void cc_table_sets_free(TableSets *s) {
+    int k;
+    if (s->set)
+        for (k = 0; k < s->n; ++k) cc_table_free(&s->set[k]);
+    free(s->set);
+    memset(s, 0, sizeof *s);
+}
+
+static int load_folder(Table *tb, const char *dir, const char *sub, char *err, size_t errlen) {
     char path[4200], kpath[4200];
     double *fd = NULL, *kp = NULL, *uniq = NULL;
     int *fdl = NULL, *kpl = NULL, nfd, nkp, k, t, nt;
     FILE *probe;
     memset(tb, 0, sizeof *tb);
     if (strlen(dir) > 4000) { snprintf(err, errlen, "resource path too long"); return -1; }
-    snprintf(path, sizeof path, "%s/tables/force_deflection.csv", dir);
-    snprintf(kpath, sizeof kpath, "%s/tables/kiss_point.csv", dir);
+    snprintf(path, sizeof path, "%s/%s/force_deflection.csv", dir, sub);
+    snprintf(kpath, sizeof kpath, "%s/%s/kiss_point.csv", dir, sub);
     nfd = read_csv(path, "theta_degC,u_m,force_N", 3, &fd, &fdl, err, errlen);
     if (nfd < 0) return -1;
     nkp = read_csv(kpath, "theta_degC,delta_kiss_m", 2, &kp, &kpl, err, errlen);
@@ -500,7 +570,7 @@ int cc_table_load(Table *tb, const char *dir, char *err, size_t errlen) {
     free(fd); free(kp); free(fdl); free(kpl);
     fd = kp = NULL;
     fdl = kpl = NULL;
-    snprintf(path, sizeof path, "%s/tables/friction.csv", dir);
+    snprintf(path, sizeof path, "%s/%s/friction.csv", dir, sub);
     probe = cc_fopen(path, "r");
     if (probe) {
         fclose(probe);

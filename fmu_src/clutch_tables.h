@@ -65,6 +65,19 @@ typedef struct {
 } Table;
 
 int cc_table_load(Table *tb, const char *dir, char *err, size_t errlen);
+/* Table sets (one FMU, several springs; cushion_clutch.fmu.table_sets): set 1 in <dir>/tables, set k >= 2 in
+   <dir>/tables_<k>, numbered without gaps, at most CC_MAX_SETS; every set is loaded (and checked) at once. The FMU's
+   enumeration parameter `spring` picks one before initialisation ends */
+#define CC_MAX_SETS 64
+typedef struct {
+    int n;      /* sets loaded */
+    Table *set; /* set[k]: table set k + 1 */
+    double kiss_offset[CC_MAX_SETS]; /* m: set k + 1's own kiss point minus set 1's (<folder>/x_kiss_ref_offset_m.txt,
+                                        written by the build for a set measured from its own kiss point; else 0) */
+} TableSets;
+#define CC_KISS_OFFSET_FILE "x_kiss_ref_offset_m.txt"
+int cc_table_sets_load(TableSets *s, const char *dir, char *err, size_t errlen);
+void cc_table_sets_free(TableSets *s);
 void cc_table_free(Table *tb);
 double cc_table_force(const Table *tb, double u, double theta_degC);
 double cc_table_delta(const Table *tb, double theta_degC);

@@ -51,13 +51,14 @@ import sys
 import zlib
 from pathlib import Path
 
-from pythonfmu import Fmi2Causality, Fmi2Slave, Fmi2Variability, Real
+from pythonfmu import Fmi2Causality, Fmi2Slave, Fmi2Variability, Integer, Real
 from pythonfmu.enums import Fmi2Status
 
 from clutch_model import (OMEGA_SLIP_LIMIT, THETA_CM_LIMIT, VARIABLES, X_TO_LIMIT, ClutchParameters, SpringTable,
                           outputs, start_values, thermal_step)
 from clutch_model import table_problems, validity_warning  # issue 28 (validity): the shared model decides
 from table_format import table_set_x_kiss_ref
+from slave_table_sets import more_sets  # issue 42: several table sets, the enumeration spring
 
 CAUSALITY = {"input": (Fmi2Causality.input, Fmi2Variability.continuous),
              "output": (Fmi2Causality.output, Fmi2Variability.continuous),
@@ -66,7 +67,7 @@ PARAMETERS = [name for name, causality, _, _ in VARIABLES if causality == "param
 #: the outputs that clutch_model.outputs() returns (fields of Outputs): every output but the state theta_cs
 OUTPUTS = [name for name, causality, _, _ in VARIABLES if causality == "output" and name != "theta_cs"]
 #: tag of a serialized state; bump when the state's content changes
-STATE_FORMAT = "cushion_clutch.pythonfmu.state/4"
+STATE_FORMAT = "cushion_clutch.pythonfmu.state/5"
 #: "error": fmi2ExitInitializationMode refused the parameters or tables (the native FMU's Error state)
 #: log category of the status message the guard library returns as the call's status (pythonfmu_guard.c)
 STATUS_CATEGORY = "cushionReturnStatus"
@@ -137,6 +138,13 @@ class CushionClutch(Fmi2Slave):
                 self._table = SpringTable.from_dir(folder)
             except Exception as exc:  # noqa: BLE001 - reported at initialisation, never raised
                 self._table_error = f"cannot load the F(u, theta) tables: {exc}"
+        # issue 42: sets 2.. (resources/tables_<k>) and the enumeration spring (1-based) that picks one
+        self._sets = [(self._table, 0.0, self._table_error), *more_sets(self.resources)]
+        self.spring = 1
+        if len(self._sets) > 1:
+            self.register_variable(Integer("spring", start=1, causality=Fmi2Causality.parameter,
+                                           variability=Fmi2Variability.fixed,
+                                           description="spring table set the model uses [1]"))
 
     # -- logging ---------------------------------------------------------------
     def log(self, msg, status=Fmi2Status.ok, category=None, debug=None):
@@ -178,10 +186,10 @@ class CushionClutch(Fmi2Slave):
                                                                 "(only after fmi2EnterInitializationMode)"])
         self._phase = "stepping"
         # bad parameters or tables: fmi2Error, and the instance is in the error phase until fmi2Reset
+        params = self._current_parameters()         # also picks the chosen set's table (spring)
         problems = []
         if self._table is None:
             problems.append(self._table_error or "tables missing")
-        params = self._current_parameters()
         problems += [f"parameter {p}" for p in params.problems()]
         if not problems:                # issue 28: what the cover cannot hold with this table (the wear limit)
             problems += [f"parameter {p}" for p in table_problems(self._table, params)]
@@ -274,8 +282,23 @@ class CushionClutch(Fmi2Slave):
         self._refuse(call, [f"value reference {vr}: this FMU has Real variables only" for vr in vrs]
                      or ["this FMU has Real variables only"])
 
+    def _spring_problems(self, vrs) -> list[str]:
+        if len(self._sets) < 2:
+            return [f"value reference {vr}: this FMU has Real variables only" for vr in vrs]
+        return [f"value reference {vr} is not an integer variable (spring is)" for vr in vrs
+                if getattr(self.vars.get(vr), "name", None) != "spring"]
+
     def set_integer(self, vrs, values):
-        self._no_such_type("fmi2SetInteger", vrs)
+        problems = self._spring_problems(vrs)
+        if not problems and self._phase not in ("instantiated", "initialization"):
+            problems = [f"parameter spring (the table set) is fixed after initialization: it stays {self.spring}"]
+        problems += [f"spring = {v}: allowed 1..{len(self._sets)} (the table sets this FMU carries)"
+                     for v in values if not problems and not 1 <= int(v) <= len(self._sets)]
+        if problems:
+            return self._refuse("fmi2SetInteger", problems)
+        for v in values:
+            self.spring = int(v)
+            self._dirty = True
 
     def set_boolean(self, vrs, values):
         self._no_such_type("fmi2SetBoolean", vrs)
@@ -284,8 +307,11 @@ class CushionClutch(Fmi2Slave):
         self._no_such_type("fmi2SetString", vrs)
 
     def get_integer(self, vrs):
-        self._no_such_type("fmi2GetInteger", vrs)
-        return [0] * len(vrs)
+        problems = self._spring_problems(vrs)
+        if problems:
+            self._refuse("fmi2GetInteger", problems)
+            return [0] * len(vrs)
+        return [int(self.spring)] * len(vrs)
 
     def get_boolean(self, vrs):
         self._no_such_type("fmi2GetBoolean", vrs)
@@ -310,7 +336,13 @@ class CushionClutch(Fmi2Slave):
         return out
 
     def _current_parameters(self) -> ClutchParameters:
-        return ClutchParameters.from_flat({name: getattr(self, name) for name in PARAMETERS})
+        # the chosen table set (issue 42) and its own kiss-point offset (x_kiss_ref is set 1's), as the native core
+        table, offset, error = self._sets[self.spring - 1]
+        self._table, self._table_error = table, error
+        flat = {name: getattr(self, name) for name in PARAMETERS}
+        if offset:
+            flat["x_kiss_ref"] = flat["x_kiss_ref"] + offset
+        return ClutchParameters.from_flat(flat)
 
     def _refresh(self) -> None:
         """Outputs of the current inputs and state, computed on read (stale outputs only)."""
@@ -351,7 +383,7 @@ class CushionClutch(Fmi2Slave):
     # -- state -------------------------------------------------------------------
     def _get_fmu_state(self):
         state = {name: float(getattr(self, name)) for name, _, _, _ in VARIABLES}
-        state.update(_phase=self._phase, _time=self._time, _range_warned=self._range_warned)
+        state.update(_phase=self._phase, _time=self._time, _range_warned=self._range_warned, _spring=self.spring)
         return state
 
     def _state_problems(self, state) -> list[str]:
@@ -364,6 +396,8 @@ class CushionClutch(Fmi2Slave):
             v = state.get(name)
             if not (isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)):
                 out.append(f"{name} = {v!r} is missing or not finite")
+        if state.get("_spring") not in range(1, len(self._sets) + 1):
+            out.append(f"table set spring = {state.get('_spring')!r}: this FMU carries sets 1..{len(self._sets)}")
         if state.get("_phase") not in PHASES:
             out.append(f"phase {state.get('_phase')!r} is not one of {', '.join(PHASES)}")
         t = state.get("_time")
@@ -384,9 +418,11 @@ class CushionClutch(Fmi2Slave):
             setattr(self, name, float(state[name]))
         self._phase, self._time = state["_phase"], state["_time"]
         self._range_warned = int(state.get("_range_warned") or 0)
+        self.spring = int(state["_spring"])
         self._dirty = True                 # outputs of the restored inputs and state, at the next get
+        params = self._current_parameters()  # the restored set's table and kiss offset
         if self._phase in ("stepping", "terminated"):
-            self._params = ClutchParameters.from_flat({p: float(state[p]) for p in PARAMETERS})
+            self._params = params
 
     @staticmethod
     def _fmu_state_to_bytes(state) -> bytes:

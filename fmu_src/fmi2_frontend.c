@@ -328,8 +328,17 @@ static fmi2Status no_such_variables(fmi2Component comp, const char *fn, size_t n
     return fmi2Error;
 }
 
-fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2Integer v[]) {
-    (void)vr; (void)v; return no_such_variables(c, "fmi2GetInteger", n);
+/* the one integer variable: the table set's enumeration spring (clutch_core.c; more than one set carried) */
+fmi2Status fmi2GetInteger(fmi2Component comp, const fmi2ValueReference vr[], size_t n, fmi2Integer v[]) {
+    size_t k;
+    COMP(fmi2Error)
+    for (k = 0; k < n; ++k) {
+        long long x;
+        int status = cc_get_integer(m, vr ? &vr[k] : NULL, 1, v ? &x : NULL, "fmi2GetInteger");
+        if (status != CC_OK) return (fmi2Status)status;
+        v[k] = (fmi2Integer)x;
+    }
+    return fmi2OK;
 }
 fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2Boolean v[]) {
     (void)vr; (void)v; return no_such_variables(c, "fmi2GetBoolean", n);
@@ -337,8 +346,15 @@ fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t
 fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2String v[]) {
     (void)vr; (void)v; return no_such_variables(c, "fmi2GetString", n);
 }
-fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Integer v[]) {
-    (void)vr; (void)v; return no_such_variables(c, "fmi2SetInteger", n);
+fmi2Status fmi2SetInteger(fmi2Component comp, const fmi2ValueReference vr[], size_t n, const fmi2Integer v[]) {
+    size_t k;
+    COMP(fmi2Error)
+    for (k = 0; k < n; ++k) {
+        long long x = v ? v[k] : 0;
+        int status = cc_set_integer(m, vr ? &vr[k] : NULL, 1, v ? &x : NULL, "fmi2SetInteger");
+        if (status != CC_OK) return (fmi2Status)status;
+    }
+    return fmi2OK;
 }
 fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Boolean v[]) {
     (void)vr; (void)v; return no_such_variables(c, "fmi2SetBoolean", n);

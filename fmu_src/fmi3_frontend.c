@@ -209,12 +209,46 @@ static fmi3Status no_such(fmi3Instance instance, size_t n, const char *fn) {
     }
 NO_GET(fmi3Float32, fmi3GetFloat32) NO_GET(fmi3Int8, fmi3GetInt8) NO_GET(fmi3UInt8, fmi3GetUInt8)
 NO_GET(fmi3Int16, fmi3GetInt16) NO_GET(fmi3UInt16, fmi3GetUInt16) NO_GET(fmi3Int32, fmi3GetInt32)
-NO_GET(fmi3UInt32, fmi3GetUInt32) NO_GET(fmi3Int64, fmi3GetInt64) NO_GET(fmi3UInt64, fmi3GetUInt64)
+NO_GET(fmi3UInt32, fmi3GetUInt32) NO_GET(fmi3UInt64, fmi3GetUInt64)
 NO_GET(fmi3Boolean, fmi3GetBoolean) NO_GET(fmi3String, fmi3GetString)
 NO_SET(fmi3Float32, fmi3SetFloat32) NO_SET(fmi3Int8, fmi3SetInt8) NO_SET(fmi3UInt8, fmi3SetUInt8)
 NO_SET(fmi3Int16, fmi3SetInt16) NO_SET(fmi3UInt16, fmi3SetUInt16) NO_SET(fmi3Int32, fmi3SetInt32)
-NO_SET(fmi3UInt32, fmi3SetUInt32) NO_SET(fmi3Int64, fmi3SetInt64) NO_SET(fmi3UInt64, fmi3SetUInt64)
+NO_SET(fmi3UInt32, fmi3SetUInt32) NO_SET(fmi3UInt64, fmi3SetUInt64)
 NO_SET(fmi3Boolean, fmi3SetBoolean) NO_SET(fmi3String, fmi3SetString)
+
+/* Int64 (the type of FMI 3 enumerations): the table set's enumeration spring (clutch_core.c; more than one set) */
+fmi3Status fmi3GetInt64(fmi3Instance instance, const fmi3ValueReference vr[], size_t n, fmi3Int64 v[], size_t nv) {
+    size_t k;
+    INST(fmi3Error)
+    if (nv != n) {
+        cc_log(m, CC_ERROR, "fmi3GetInt64: nValues = %lu differs from nValueReferences = %lu (scalars only)",
+               (unsigned long)nv, (unsigned long)n);
+        return fmi3Error;
+    }
+    for (k = 0; k < n; ++k) {
+        long long x;
+        int status = cc_get_integer(m, vr ? &vr[k] : NULL, 1, v ? &x : NULL, "fmi3GetInt64");
+        if (status != CC_OK) return (fmi3Status)status;
+        v[k] = (fmi3Int64)x;
+    }
+    return fmi3OK;
+}
+fmi3Status fmi3SetInt64(fmi3Instance instance, const fmi3ValueReference vr[], size_t n, const fmi3Int64 v[],
+                        size_t nv) {
+    size_t k;
+    INST(fmi3Error)
+    if (nv != n) {
+        cc_log(m, CC_ERROR, "fmi3SetInt64: nValues = %lu differs from nValueReferences = %lu (scalars only)",
+               (unsigned long)nv, (unsigned long)n);
+        return fmi3Error;
+    }
+    for (k = 0; k < n; ++k) {
+        long long x = v ? (long long)v[k] : 0;
+        int status = cc_set_integer(m, vr ? &vr[k] : NULL, 1, v ? &x : NULL, "fmi3SetInt64");
+        if (status != CC_OK) return (fmi3Status)status;
+    }
+    return fmi3OK;
+}
 
 fmi3Status fmi3GetBinary(fmi3Instance i, const fmi3ValueReference vr[], size_t n, size_t sizes[], fmi3Binary v[],
                          size_t nv) {

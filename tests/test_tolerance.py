@@ -95,7 +95,7 @@ def test_study_on_a_local_cluster_equals_one_by_one_and_resumes(coarse, tmp_path
     out = tmp_path / "lookup_tables"
     assert main(["tolerance", "--spring", str(spring), "--samples", "2", "--seed", "5", "--temperatures", "20",
                  "--mesh-size", str(base.mesh.element_size_m), "--out", str(out),
-                 "--cache", str(tmp_path / "study")]) == 0
+                 "--cache", str(tmp_path / "study"), "--fmu", str(tmp_path / "band.fmu")]) == 0
     captured = capsys.readouterr()
     text = captured.out
     assert "3 FE cases (3 from the cache)" in text
@@ -114,6 +114,12 @@ def test_study_on_a_local_cluster_equals_one_by_one_and_resumes(coarse, tmp_path
         start = {v.name: v.start for v in read_model_description(str(fmu)).modelVariables}
         assert float(start["x_kiss_ref"]) == pytest.approx(pick["x_kiss_ref_m"], abs=1e-15)
     assert (out / "default_tolerance" / "tolerance_bands.png").stat().st_size > 20000
+    # one FMU for the band (issue 42): nominal, P5, P95, chosen by the enumeration spring
+    assert "spring: 1 = default_nominal, 2 = default_p05, 3 = default_p95" in text
+    md = read_model_description(str(tmp_path / "band.fmu"))
+    (band,) = md.typeDefinitions
+    assert [i.name for i in band.items] == ["default_nominal", "default_p05", "default_p95"]
+    assert validate_fmu(str(tmp_path / "band.fmu")) == []
 
 
 def test_cli_refuses_a_spring_without_tolerances_and_the_package_tables(tmp_path, capsys):

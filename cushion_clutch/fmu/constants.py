@@ -18,7 +18,8 @@ FMU_SRC = fmu_sources()
 MODEL_SRC = Path(clutch_model.__file__).parent
 #: the modules the pythonfmu slave imports (siblings inside the FMU): the slave class (from ``FMU_SRC``)
 #: and the numpy-only model (from ``MODEL_SRC``)
-SLAVE_MODULES = {"cushion_slave.py": FMU_SRC, "clutch_model.py": MODEL_SRC, "spring_table.py": MODEL_SRC,
+SLAVE_MODULES = {"cushion_slave.py": FMU_SRC, "slave_table_sets.py": FMU_SRC, "clutch_model.py": MODEL_SRC,
+                 "spring_table.py": MODEL_SRC,
                  "friction.py": MODEL_SRC, "table_format.py": MODEL_SRC, "cover.py": MODEL_SRC}
 
 #: the native model core (shared) and the front end of each FMI version, as shipped in sources/

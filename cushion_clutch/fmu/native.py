@@ -28,13 +28,15 @@ from .variable_table import HEADER as VARIABLE_HEADER
 from .variable_table import variable_header
 from .thermal_chain import NETWORK_HEADERS, NETWORK_SOURCES, THERMAL_SLAVE, Chain, thermal_header  # noqa: F401
 from .thermal_descriptions import thermal_descriptions_into, thermal_sources
+from .table_sets import carried_sets, hash_sets, with_table_sets, write_resources
 
 log = logging.getLogger(__name__)
 
 
-def model_guid(tables: Path, fmi_version: int, chain: "Chain | None" = None) -> str:
+def model_guid(tables: Path, fmi_version: int, chain: "Chain | None" = None, sets: tuple = ()) -> str:
     """GUID / instantiationToken: a hash of the tables, the C sources, the variable table and the FMI version
-    (and, for the thermal variant, the network's sources and its variable table)."""
+    (and, for the thermal variant, the network's sources and its variable table; for an FMU with several table
+    sets (``sets``, :mod:`.table_sets`) every set after the first)."""
     digest = hashlib.sha256(f"fmi{fmi_version}".encode())
     for name in FMU_FILES:
         if (tables / name).exists():
@@ -43,6 +45,7 @@ def model_guid(tables: Path, fmi_version: int, chain: "Chain | None" = None) -> 
     for name in (*CORE_HEADERS, *CORE_SOURCES, FRONT_ENDS[fmi_version], *network):
         digest.update((FMU_SRC / name).read_bytes())
     digest.update((variable_header() if chain is None else thermal_header(chain)).encode())
+    hash_sets(digest, sets)
     return "{" + str(uuid.uuid5(uuid.NAMESPACE_URL, "cushion_clutch:" + digest.hexdigest())) + "}"
 
 
@@ -71,17 +74,21 @@ def stage_sources(dest: Path, guid: str, fmi_version: int, x_kiss_ref_m: float |
 
 
 def build_native_fmu(tables: Path, output: Path, fmi_version: int = 2,
-                     platforms: tuple[str, ...] | None = None, chain: "Chain | None" = None) -> Path:
+                     platforms: tuple[str, ...] | None = None, chain: "Chain | None" = None,
+                     more_tables: tuple = ()) -> Path:
     """Build the native FMU (FMI ``fmi_version`` 2 or 3) carrying the table set ``tables``.
 
     ``chain`` (:class:`.thermal_chain.Chain`), if given, builds the thermal variant
-    ``CushionClutchThermal`` with that network inside (:mod:`.thermal_chain`).
+    ``CushionClutchThermal`` with that network inside (:mod:`.thermal_chain`). ``more_tables``: further table
+    folders; the FMU then carries every set and the enumeration parameter ``spring`` picks one
+    (:mod:`.table_sets`).
     """
     if fmi_version not in FRONT_ENDS:
         raise ValueError(f"fmi_version = {fmi_version!r}: allowed 2 or 3")
     tables, output = Path(tables), Path(output)
-    guid = model_guid(tables, fmi_version, chain)
-    has_friction = (tables / FRICTION).exists()
+    sets = carried_sets([tables, *more_tables]) if more_tables else ()
+    guid = model_guid(tables, fmi_version, chain, sets)
+    has_friction = any((folder / FRICTION).exists() for folder in (tables, *more_tables))
     x_kiss_ref = table_set_x_kiss_ref(tables)
     thermal = chain is not None
     with tempfile.TemporaryDirectory(prefix="cushion_native_") as tmp:
@@ -92,8 +99,9 @@ def build_native_fmu(tables: Path, output: Path, fmi_version: int = 2,
         tmp_out = output.with_suffix(".fmu.tmp")
         try:                                            # no half-written .fmu.tmp left behind
             with zipfile.ZipFile(tmp_out, "w", zipfile.ZIP_DEFLATED) as z:
-                z.writestr("modelDescription.xml", fmi2_description(guid, has_friction, x_kiss_ref)
-                           if fmi_version == 2 else fmi3_description(guid, has_friction, x_kiss_ref))
+                z.writestr("modelDescription.xml", with_table_sets(
+                    fmi2_description(guid, has_friction, x_kiss_ref) if fmi_version == 2
+                    else fmi3_description(guid, has_friction, x_kiss_ref), sets, fmi_version))
                 for platform, lib in sorted(libs.items()):
                     z.write(lib, f"binaries/{platform}/{lib.name}")
                 for name in staged:
@@ -103,6 +111,8 @@ def build_native_fmu(tables: Path, output: Path, fmi_version: int = 2,
                 for name in FMU_FILES:
                     if (tables / name).exists():
                         z.write(tables / name, f"resources/tables/{name}")
+                if sets:
+                    write_resources(z, sets)
             tmp_out.replace(output)
         except BaseException:
             tmp_out.unlink(missing_ok=True)

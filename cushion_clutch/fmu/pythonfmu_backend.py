@@ -42,6 +42,8 @@ def complete_model_description(xml_text: str) -> str:
     for index, var in enumerate(root.find("ModelVariables"), start=1):
         real = var.find("Real")
         name = var.get("name")
+        if name == clutch_model.TABLE_SET_VARIABLE[0] and var.find("Integer") is not None:
+            continue                                            # the table sets' enumeration (table_sets.py)
         if real is None or name not in var_units:
             raise ValueError(f"variable {name!r} has no unit in clutch_model.VARIABLES")
         real.set("unit", var_units[name])
@@ -78,9 +80,13 @@ def _fresh_imports(stage: Path):
         sys.path[:] = path
 
 
-def build_python_fmu(tables: Path, output: Path) -> Path:
-    """Build the pythonfmu FMU ``output`` carrying the (checked) table set ``tables``."""
+def build_python_fmu(tables: Path, output: Path, more_tables: tuple = ()) -> Path:
+    """Build the pythonfmu FMU ``output`` carrying the (checked) table set ``tables`` (and ``more_tables``: the
+    FMU then carries every set and its enumeration ``spring`` picks one, :mod:`.table_sets`)."""
     from pythonfmu.builder import FmuBuilder
+
+    from .table_sets import carried_sets, enumeration_from_integer, stage_sets
+    sets = carried_sets([tables, *more_tables]) if more_tables else ()
     with tempfile.TemporaryDirectory(prefix="cushion_fmu_") as tmp:
         stage = Path(tmp)
         shutil.copy(FMU_SRC / f"{SLAVE}.py", stage / f"{SLAVE}.py")
@@ -90,9 +96,10 @@ def build_python_fmu(tables: Path, output: Path) -> Path:
         for name in FMU_FILES:
             if (tables / name).exists():
                 shutil.copy(tables / name, stage / "tables" / name)
+        extra = stage_sets(stage, sets)                 # tables_2, ... and table_sets.json (none for one set)
         with _fresh_imports(stage):
             built = FmuBuilder.build_FMU(stage / f"{SLAVE}.py", dest=stage / "out",
-                                         project_files=[*(stage / m for m in SLAVE_MODULES), stage / "tables"],
-                                         **FMU_OPTIONS)
-        guard_fmu(Path(built), output, complete_model_description)
+                                         project_files=[*(stage / m for m in SLAVE_MODULES), stage / "tables",
+                                                        *extra], **FMU_OPTIONS)
+        guard_fmu(Path(built), output, lambda xml: enumeration_from_integer(complete_model_description(xml), sets))
     return output

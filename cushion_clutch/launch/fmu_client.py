@@ -52,8 +52,12 @@ class ClutchFmu:
         s.instantiate()
         try:
             s.setupExperiment(startTime=0.0)
-            if start:
-                s.setReal([vr[k] for k in start], list(start.values()))
+            ints = {k: v for k, v in start.items() if isinstance(v, int) and not isinstance(v, bool)}
+            reals = {k: v for k, v in start.items() if k not in ints}     # ints: the table set (spring)
+            if ints:
+                s.setInteger([vr[k] for k in ints], list(ints.values()))
+            if reals:
+                s.setReal([vr[k] for k in reals], list(reals.values()))
             s.enterInitializationMode()
             s.exitInitializationMode()
         except Exception as exc:            # fmpy raises FMICallException; keep one typed error

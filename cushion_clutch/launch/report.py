@@ -81,20 +81,23 @@ def lockup_lines(results: dict[str, LaunchResult], width: int = 100) -> str:
 
 
 def run_all(fmu: Path, sc: Scenario, table: SpringTable, variants: Iterable[str] = tuple(VARIANTS),
-            progress: Callable[[str, float], None] | None = None) -> dict[str, LaunchResult]:
+            progress: Callable[[str, float], None] | None = None,
+            plant_start: dict | None = None) -> dict[str, LaunchResult]:
     """Every TCU variant on the same scenario and plant FMU; each launch's metrics carry the peak temperatures
-    and the time beyond the tables and above the facing damage limit (metrics.add_temperature_metrics)."""
+    and the time beyond the tables and above the facing damage limit (metrics.add_temperature_metrics).
+    ``plant_start``: the plant's start values from an SSP parameter set (``simulate.plant_start_values``)."""
     out = {}
     damage = ClutchParameters().facing_damage_temperature_K
     for name in variants:
         cb = (lambda t, n=name: progress(n, t)) if progress else None
-        out[name] = simulate_launches(fmu, sc, table, name, progress=cb)
+        out[name] = simulate_launches(fmu, sc, table, name, progress=cb, plant_start=plant_start)
         add_temperature_metrics(out[name].metrics, out[name].series, table.theta_min_K, table.theta_max_K, damage)
     return out
 
 
 def run_both(fmu: Path, sc: Scenario, table: SpringTable,
-             progress: Callable[[str, float], None] | None = None) -> dict[str, LaunchResult]:
+             progress: Callable[[str, float], None] | None = None,
+            plant_start: dict | None = None) -> dict[str, LaunchResult]:
     """The naive and the ideal temperature-aware TCU (the study before the estimated variants)."""
     return run_all(fmu, sc, table, ("naive", "aware"), progress)
 

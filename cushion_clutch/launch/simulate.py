@@ -117,7 +117,7 @@ def _retracted_error(t: float, t_cap: float, x_act: float, x_kiss: float) -> Run
 
 def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bool = "naive",
                       record_every: int = 10, progress: Callable[[float], None] | None = None,
-                      plant: str = "native") -> LaunchResult:
+                      plant: str = "native", plant_start: dict | None = None) -> LaunchResult:
     """Run the scenario's launches with one TCU variant (a name of :data:`VARIANTS`).
 
     ``tcu`` True/False are the ``aware``/``naive`` variants. ``table`` is
@@ -126,6 +126,7 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
     ``plant``: ``"native"`` runs the plant steps between two TCU cycles in one compiled call
     (:mod:`.plant_block`; with the plant's thermal network, else, or if it cannot be built, the Python
     loop), ``"python"`` the Python loop (the reference). Both give the same results.
+    ``plant_start``: start values of the plant FMU from an SSP parameter set (:func:`plant_start_values`).
     """
     name = {True: "aware", False: "naive"}.get(tcu, tcu) if isinstance(tcu, bool) else tcu
     if name not in VARIANTS:
@@ -173,6 +174,8 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
 
     clutch_start = {"theta_a": theta_a, "theta_cs_start": theta0, "x_kiss_ref": p.x_kiss_ref + sc.clutch.x_kiss_offset_m,
                     **({"facing_wear": sc.clutch.facing_wear_m} if sc.clutch.facing_wear_m else {})}
+    if plant_start:
+        clutch_start = plant_start_values(plant_start, clutch_start, p.x_kiss_ref, sc)
     keyed = (key_on(ctl, sc, fmu, clutch_start, sc.driveline.disc_inertia_kg_m2, engine.w_idle)
              if name == "production" else None)
     clutch = ClutchFmu(fmu, clutch_start)
@@ -409,3 +412,16 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
     return LaunchResult(name, series, metrics, dl.en, events, wall, total, cpu, learned, n_quiet * h_quiet, keyed,
                         ctl.protection.events if ctl.protection is not None else [],
                         "native" if native is not None else "python")
+
+
+def plant_start_values(plant_start: dict, scenario_start: dict, x_kiss_ref_m: float, sc: Scenario) -> dict:
+    """The plant FMU's start values with an SSP parameter set (``launch --fmu X.ssp --parameter-set S``): the set's
+    values (every parameter, and the table set ``spring``), then the scenario's duty: its ambient and soak
+    temperatures, its kiss-point offset added to the set's ``x_kiss_ref`` (m; ``x_kiss_ref_m`` without one) and
+    its facing wear if it states one."""
+    out = dict(plant_start)
+    out.update(theta_a=scenario_start["theta_a"], theta_cs_start=scenario_start["theta_cs_start"])
+    out["x_kiss_ref"] = float(plant_start.get("x_kiss_ref", x_kiss_ref_m)) + sc.clutch.x_kiss_offset_m
+    if sc.clutch.facing_wear_m:
+        out["facing_wear"] = sc.clutch.facing_wear_m
+    return out

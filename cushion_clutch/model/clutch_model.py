@@ -95,6 +95,10 @@ VARIABLES = (
     ("validity", "output", "1", "0: inside the tables; 1: a temperature beyond the tables (clamped, see docs); "
                                 "2: facing temperature above facing_damage_temperature_K"),
 )
+#: The table-set selector of an FMU that carries several spring table sets (cushion_clutch.fmu.table_sets):
+#: (name, causality, unit, description) as in VARIABLES; an enumeration (one item per set), value reference
+#: after the others (and after FMI 3's time), declared only when more than one set is carried.
+TABLE_SET_VARIABLE = ("spring", "parameter", "1", "spring table set the model uses (fixed after initialisation)")
 #: start value of the optional slip-speed input, rad/s (mu does not depend on it without a friction table)
 OMEGA_SLIP_START = 0.0
 #: largest |omega_slip| accepted, rad/s: 1500 rad/s = 14300 rpm, twice a passenger-car engine's speed limit

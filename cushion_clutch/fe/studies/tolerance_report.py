@@ -227,6 +227,21 @@ def write_percentile_set(summ: list[SampleSummary], outcomes: list[dict[float, C
     return Path(out_dir)
 
 
+def write_nominal_set(summ: list[SampleSummary], outcomes: list[dict[float, CaseOutcome]], out_dir: Path) -> Path:
+    """The nominal spring's table set (sample 0) in ``out_dir``, its kiss point in metadata.json (for the band's FMU)."""
+    s = summ[0]
+    p = s.sample.params.replace(sweep={"temperatures_degC": tuple(outcomes[0])})
+    build_tables(p, outcomes[0], out_dir)
+    meta_path = Path(out_dir) / "metadata.json"
+    meta = json.loads(meta_path.read_text())
+    meta["tolerance_study"] = {"sample": s.sample.index, "nominal": True, "x_kiss_ref_m": s.x_kiss_ref_m,
+                               "note": "the study's nominal spring, on the study's mesh"}
+    tmp = meta_path.with_suffix(".json.tmp")
+    tmp.write_text(json.dumps(meta, indent=2) + "\n")
+    os.replace(tmp, meta_path)
+    return Path(out_dir)
+
+
 @dataclass(frozen=True)
 class StudyResult:
     """What :func:`tolerance_study` wrote and found."""
@@ -241,15 +256,19 @@ class StudyResult:
     cases: int
     cases_from_cache: int
     wall_time_s: float
+    band_fmu: Path | None = None
 
 
 def tolerance_study(params, *, samples: int, temperatures: tuple, out: Path, method: str = "lhs",
                     seed: int = 0, rank_by: str = "torque", cache_dir: Path | None = None,
-                    scheduler=None, workers: int | None = None, progress=None) -> StudyResult:
+                    scheduler=None, workers: int | None = None, progress=None,
+                    band_fmu: Path | None = None) -> StudyResult:
     """Run a whole study: draw, solve (Dask, cached), summarize, bands, plot, P5/P95 table sets.
 
     Writes ``<out>/<name>_tolerance/`` (samples.csv, *_bands.csv, tolerance_bands.png,
-    samples/s###/) and the table sets ``<out>/<name>_p05/`` and ``<out>/<name>_p95/``.
+    samples/s###/) and the table sets ``<out>/<name>_p05/`` and ``<out>/<name>_p95/``. With ``band_fmu``
+    (a ``.fmu`` path) also ``<out>/<name>_nominal/`` and one native FMU carrying the nominal, P5 and P95 sets,
+    chosen by its parameter ``spring`` (:mod:`cushion_clutch.fmu.table_sets`).
     """
     import time
 
@@ -287,5 +306,10 @@ def tolerance_study(params, *, samples: int, temperatures: tuple, out: Path, met
                            for q, v in picks.items()},
         "cases": len(drawn) * len(temperatures), "cases_from_cache": n_cached, "wall_time_s": wall,
         "warnings": warnings}, indent=2) + "\n")
+    fmu = None
+    if band_fmu is not None:
+        from ...fmu.build import build_fmu
+        nominal = write_nominal_set(summ, outcomes, Path(out) / f"{params.name}_nominal")
+        fmu = build_fmu([nominal, *(sets[q] for q in sorted(sets))], Path(band_fmu))
     return StudyResult(study_dir, bands, summ, picks, sets, files, warnings, len(drawn) * len(temperatures),
-                       n_cached, wall)
+                       n_cached, wall, fmu)

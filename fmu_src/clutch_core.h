@@ -8,7 +8,8 @@
  *   x_kiss  = x_kiss_ref - lever_ratio * delta_kiss(theta_cs);
  *   u       = (x_to - x_kiss) / lever_ratio,  u_f = max(u, 0);
  *   F       = PCHIP in u per table temperature, linear in theta, clamped;
- *   torque  = n_surfaces * mu * R_eq * F  (mu: parameter, or friction.csv mu(theta_cm, |omega_slip|)).
+ *   torque  = n_surfaces * mu * R_eq * F  (mu: parameter, or friction.csv mu(theta_cm, |omega_slip|); the
+ *             thermal FMU reads it at its friction surface, theta_friction).
  *
  * Value references follow cushion_clutch.model.clutch_model.VARIABLES: the enum VR_<NAME>, the names,
  * causalities, start values and parameter ranges are generated from it at build time into

@@ -39,15 +39,18 @@ static void params(const double *r, TnParams *p) {
     p->w_ref = r[TN_VR_WREF];
 }
 
-/* node temperatures th (K) into the variables, and theta_cm = their weighted mean */
+/* node temperatures th (K) into the variables, theta_cm and the friction surface's theta_friction (mu is read
+   there) = their weighted means */
 static void store(double *r, const double *th) {
-    double mean = 0.0;
+    double mean = 0.0, surface = 0.0;
     int i;
     for (i = 0; i < TN_N; ++i) {
         r[TN_VR_THETA[i]] = th[i];
         mean += TN_WEIGHT[i] * th[i];
+        surface += TN_FRICTION_WEIGHT[i] * th[i];
     }
     r[VR_THETA_CM] = mean;
+    r[CC_VR_THETA_MU] = surface;
 }
 
 /* slip_power and the nodes' derivatives at the operating point op */
@@ -126,6 +129,11 @@ int cc_net_step(CcModel *m, double h, const char *fn, int (*outputs)(CcModel *))
     if (!(r[VR_THETA_CM] > 0.0 && r[VR_THETA_CM] < THETA_CM_LIMIT)) {
         cc_log(m, CC_DISCARD, "%s: t = %g s: the facing temperature theta_cm = %g K left (0, %g) K; step refused", fn,
                m->time, r[VR_THETA_CM], THETA_CM_LIMIT);
+        return CC_DISCARD;
+    }
+    if (!(r[CC_VR_THETA_MU] >= THETA_MIN_K && r[CC_VR_THETA_MU] <= THETA_MAX_K)) {
+        cc_log(m, CC_DISCARD, "%s: t = %g s: the friction-surface temperature theta_friction = %g K left [%g, %g] K; "
+               "step refused", fn, m->time, r[CC_VR_THETA_MU], THETA_MIN_K, THETA_MAX_K);
         return CC_DISCARD;
     }
     m->net_skip = 1;   /* the outputs at the step's end; the derivatives here, at the step's speeds */

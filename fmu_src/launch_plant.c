@@ -166,6 +166,41 @@ static void record_step(const lp_consts *c, lp_state *s, double accel, double t_
     }
 }
 
+/* model.friction._bracket: index i and weight w with v between g[i] and g[i + 1] (clamped; w = 0 for one point) */
+static void bracket(const double *g, int n, double v, int *i, double *w)
+{
+    if (n == 1 || v <= g[0]) {
+        *i = 0;
+        *w = 0.0;
+        return;
+    }
+    if (v >= g[n - 1]) {
+        *i = n - 2;
+        *w = 1.0;
+        return;
+    }
+    int k = 0;                                      /* bisect_right(g, v) - 1 */
+    while (k + 1 < n && g[k + 1] <= v)
+        k++;
+    *i = k;
+    *w = (v - g[k]) / (g[k + 1] - g[k]);
+}
+
+/* model.friction.FrictionTable.__call__: mu at theta (degC) and |omega| (rad/s), bilinear, clamped */
+static double friction_mu(const lp_consts *c, double theta_degC, double omega)
+{
+    int i, j, nw = c->f_nw;
+    double wi, wj;
+    bracket(c->f_theta, c->f_nt, theta_degC, &i, &wi);
+    bracket(c->f_omega, nw, fabs(omega), &j, &wj);
+    const double *m = c->f_mu;
+    int i1 = i + 1 < c->f_nt - 1 ? i + 1 : c->f_nt - 1;
+    int j1 = j + 1 < nw - 1 ? j + 1 : nw - 1;
+    double lo = (1.0 - wj) * m[i * nw + j] + wj * m[i * nw + j1];
+    double hi = (1.0 - wj) * m[i1 * nw + j] + wj * m[i1 * nw + j1];
+    return (1.0 - wi) * lo + wi * hi;
+}
+
 /* model.thermal_network.ThermalNetwork.step: advance the nodes th by dt with the slip power p_slip (W), the
  * speeds (rad/s) and the clamp state held, node by node with the exact exponential for the neighbours held
  * (the fixed nodes' decay factors are those of the step net_dt, recomputed as ThermalNetwork._prepare does
@@ -217,6 +252,7 @@ static void net_due(lp_consts *c, lp_state *s, double w_engine, double w_disc, i
     double dt = s->net_n * c->h;
     net_step(c, s->theta, dt, s->net_e / (s->net_n * c->h), w_engine, w_disc, clamped);
     s->theta_cm = 0.5 * (s->theta[c->net_cm[0]] + s->theta[c->net_cm[1]]);
+    s->theta_fs = 0.5 * (s->theta[c->net_surface[0]] + s->theta[c->net_surface[1]]);
     s->net_n = 0.0;
     s->net_e = 0.0;
 }
@@ -250,8 +286,8 @@ static int clutch_step(const lp_consts *c, lp_state *s, double t, double h, doub
         *fmi_status = st;
         return -2;
     }
-    double v_out[3];
-    st = c->get_real(c->comp, c->vr_out, 3, v_out);
+    double v_out[4];
+    st = c->get_real(c->comp, c->vr_out, 4, v_out);
     if (st > 1) {
         *fmi_status = st;
         return -3;
@@ -259,6 +295,7 @@ static int clutch_step(const lp_consts *c, lp_state *s, double t, double h, doub
     s->t_cap = v_out[0];
     s->theta_cs = v_out[1];
     s->x_kiss = v_out[2];
+    s->clamp = v_out[3];
     return 0;
 }
 
@@ -281,9 +318,12 @@ HOST_EXPORT int lp_run_block(lp_consts *c, lp_state *s, const lp_block *blk, lp_
         double x_cmd = blk->x_cmd;
         s->x_act = x_cmd + (s->x_act - x_cmd) * c->act;
         double w_e = s->w_e;
-        int st = clutch_step(c, s, t, h, w_e - s->w_d, fmi_status);
+        double omega_slip = w_e - s->w_d;
+        int st = clutch_step(c, s, t, h, omega_slip, fmi_status);
         if (st < 0)
             return st;
+        if (c->mu_surface)
+            s->t_cap = c->n_surfaces * friction_mu(c, s->theta_fs - 273.15, omega_slip) * c->r_eq * s->clamp;
         double t_cap = s->t_cap;
         if (engaged && !s->lifted && s->has_lock && w_e > c->w_lift)
             s->lifted = 1;

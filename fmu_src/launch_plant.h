@@ -22,7 +22,7 @@ typedef struct {
     lp_do_step do_step;
     lp_get_real get_real;
     unsigned int vr_in[3];          /* x_to, theta_cm, omega_slip */
-    unsigned int vr_out[3];         /* torque, theta_cs, x_kiss */
+    unsigned int vr_out[4];         /* torque, theta_cs, x_kiss, clamp_force */
     /* engine (engine.EngineGovernor) */
     int n_curve;
     double curve_w[32];
@@ -40,6 +40,12 @@ typedef struct {
     double net_h0, net_hr, net_wr, net_ta; /* still air, rotating W/(m2 K), its reference speed rad/s, air K */
     double net_dt[2];               /* the step the fixed nodes' decay factors are for, per clamp state, s */
     lp_net_node net[2][16];
+    /* mu at the friction surface (simulate.py, issue 37): with mu_surface != 0 the torque is
+     * n_surfaces mu(theta_fs, |omega_slip|) r_eq clamp_force, mu from this table (model.friction.FrictionTable:
+     * bilinear, clamped; f_mu row-major, f_nt temperatures degC x f_nw slip speeds rad/s) */
+    int mu_surface, f_nt, f_nw;
+    double n_surfaces, r_eq;
+    double f_theta[16], f_omega[16], f_mu[256];
 } lp_consts;
 
 /* The state carried across calls, doubles only (flags 0/1, counts exact), so that it is also a double[] the
@@ -64,6 +70,8 @@ typedef struct {
     double rec_stall, rec_slip_J, a_filt, jerk, sq_err, max_err, sum_creep, n_err, n_creep;
     /* the thermal network's node temperatures, K */
     double theta[16];
+    double theta_fs;                /* the friction-surface temperature, K: the two metal surfaces' mean */
+    double clamp;                   /* the clutch FMU's clamp_force of the last step, N */
 } lp_state;
 
 /* held over a block: set by the TCU cycle before it */

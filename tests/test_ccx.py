@@ -39,6 +39,19 @@ def test_free_thermal_expansion(tmp_path):
     assert np.abs(end[:, 2]).max() < 1e-3 * expected      # stays flat
 
 
+@pytest.mark.parametrize("theta", [-40.0, -10.0, 300.0])
+def test_free_thermal_expansion_with_a_secant_table(tmp_path, theta):
+    # alpha(theta) as a secant coefficient from ZERO (the default spring's table below 20 degC):
+    # the strip's strain is alpha(theta) (theta - 20), alpha linear between the table points
+    mat = Material(temperatures_degC=(-40.0, 20.0, 350.0), youngs_modulus_Pa=(209.2e9, 206e9, 186e9),
+                   expansion_coefficients_per_K=(1.088e-5, 1.12e-5, 1.12e-5))
+    mesh = strip_mesh(L, B, T, 2e-3)
+    end = _end1(tmp_path, strip_deck(mesh, mat, theta_degC=theta))
+    alpha = float(np.interp(theta, [-40.0, 20.0], [1.088e-5, 1.12e-5]))
+    assert mat.expansion_coefficient(theta) == pytest.approx(alpha, rel=1e-12)
+    assert end[:, 0] == pytest.approx(np.full(len(end), alpha * (theta - 20.0) * L), rel=1e-3)
+
+
 def test_missing_ccx_says_how_to_install(monkeypatch, tmp_path):
     monkeypatch.setenv("CCX", "ccx-not-installed-here")
     with pytest.raises(CalculixNotFoundError, match="apt-get install -y calculix-ccx"):

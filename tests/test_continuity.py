@@ -43,10 +43,11 @@ def test_python_model_has_no_jump_at_any_table_temperature(table):
 
 
 def test_python_model_is_continuous_over_the_whole_temperature_range(table):
-    """Every 0.5 K from -20 to 360 degC (beyond the tables too): no change larger than a steep but smooth
-    slope allows (the old steps were 11.6-27.7 N.m at single temperatures)."""
+    """Every 0.5 K from -50 to 370 degC (the tables' -40-350 degC and beyond them): no change larger than a steep
+    but smooth slope allows (the old steps were 11.6-27.7 N.m at single temperatures)."""
     p = ClutchParameters()
-    thetas = np.arange(-20.0, 360.0, 0.5) + KELVIN
+    assert table.theta_degC[0] == -40.0 and table.theta_degC[-1] == 350.0
+    thetas = np.arange(-50.0, 370.0, 0.5) + KELVIN
     x = X_GRID[::4]
     torque = np.array([_model_scan(table, p, th, x)["torque"] for th in thetas])
     step = np.max(np.abs(np.diff(torque, axis=0)))

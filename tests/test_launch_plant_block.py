@@ -173,3 +173,15 @@ def test_quiet_period_refusals(fmu):
             native.quiet(0.02, 10 * h, 1.0)
     finally:
         clutch.close()
+
+
+def test_friction_at_the_surface_native_equals_python(tmp_path):
+    """With a friction table (fade) the plant's torque is n mu(theta_friction, |omega_slip|) R_eq F_clamp (issue 37):
+    mu looked up in C (launch_plant.c friction_mu) as in Python (FrictionTable), to the last bit."""
+    sc = _scenario("fade", 1)
+    fmu = build_plant_fmu(DEFAULT_TABLES, sc, tmp_path / "CushionClutch.fmu")
+    table = load_table()
+    py = simulate_launches(fmu, sc, table, "naive", plant="python")
+    nat = simulate_launches(fmu, sc, table, "naive", plant="native")
+    _assert_same(py, nat)
+    assert py.lock_events

@@ -150,6 +150,23 @@ def test_native_follows_the_cover_parameters_and_the_issue_bar(fmus):
     assert s.getReal([vr["torque"]])[0] - worn.getReal([vr["torque"]])[0] > 5.0
 
 
+def test_issue37_bar_from_a_winter_start_to_the_damage_limit(fmus):
+    """Issue 37's bar: the default native FMU at theta_cm = theta_cs = 233.15 K (-40 degC) and 623.15 K (350 degC)
+    is inside its tables (validity 0; damage is strictly above 350 degC) with a finite, non-zero closed torque,
+    the Python model's."""
+    table = load_table()
+    assert table.theta_min_K <= 233.15 and table.theta_max_K >= 623.15
+    for theta in (233.15, 623.15):
+        s, vr = open_slave(fmus["native"], name=f"bar37_{theta}", theta_cs_start=theta, theta_a=theta)
+        s.setReal([vr["x_to"], vr["theta_cm"]], [0.020, theta])
+        s.doStep(0.0, 1.0)
+        torque, validity, theta_cs = s.getReal([vr["torque"], vr["validity"], vr["theta_cs"]])
+        assert theta_cs == theta and validity == 0.0, (theta, validity)
+        assert math.isfinite(torque) and torque > 100.0, (theta, torque)
+        assert torque == pytest.approx(outputs(0.020, theta, table, ClutchParameters(), theta).torque, rel=1e-9)
+        s.terminate()
+
+
 def test_shared_object_does_not_need_python(fmus, tmp_path):
     with zipfile.ZipFile(fmus["native"]) as z:
         z.extract("binaries/linux64/CushionClutch.so", tmp_path)

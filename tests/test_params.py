@@ -11,10 +11,14 @@ def test_default_file_loads_and_matches_paper():
     assert p.n_pairs == 8
     assert p.geometry.thickness_m == pytest.approx(0.42e-3)     # 0.4 mm in the paper, see the TOML
     assert p.geometry.wave_height_m == pytest.approx(0.7e-3)
-    assert p.material.youngs_modulus_Pa == (206e9, 202e9, 196e9, 186e9)
-    assert p.material.temperatures_degC == (20.0, 80.0, 200.0, 350.0)
-    assert p.sweep.temperatures_degC == (20.0, 80.0, 195.0, 250.0, 300.0)
+    # the paper's Table 1, extended to -40 degC by ASME's carbon-steel ratios (see the TOML and fe_model.md)
+    assert p.material.youngs_modulus_Pa == (209.2e9, 206e9, 202e9, 196e9, 186e9)
+    assert p.material.temperatures_degC == (-40.0, 20.0, 80.0, 200.0, 350.0)
+    assert p.material.expansion_coefficients_per_K == (1.088e-5, 1.12e-5, 1.12e-5, 1.12e-5, 1.12e-5)
+    assert p.sweep.temperatures_degC == (-40.0, 20.0, 80.0, 195.0, 250.0, 300.0, 350.0)
     assert p.material.expansion_coefficient_per_K == pytest.approx(1.12e-5)
+    assert p.material.expansion_coefficient(-10.0) == pytest.approx(0.5 * (1.088e-5 + 1.12e-5))
+    assert p.material.expansion_coefficient(300.0) == 1.12e-5
 
 
 def test_youngs_modulus_interpolates_table():
@@ -22,6 +26,16 @@ def test_youngs_modulus_interpolates_table():
     assert m.youngs_modulus(20.0) == pytest.approx(206e9)
     assert m.youngs_modulus(140.0) == pytest.approx(199e9)
     assert m.youngs_modulus(400.0) == pytest.approx(186e9)
+    assert m.youngs_modulus(-40.0) == pytest.approx(209.2e9) and m.youngs_modulus(-10.0) == pytest.approx(207.6e9)
+
+
+def test_expansion_table_is_checked():
+    with pytest.raises(ParameterError, match=r"expansion_coefficients_per_K: needs one value per temperatures_degC"):
+        params_from_dict({"material": {"expansion_coefficients_per_K": [1e-5, 1.1e-5]}})
+    with pytest.raises(ParameterError, match=r"expansion_coefficient_per_K = 1.12e-05: must equal"):
+        params_from_dict({"material": {"expansion_coefficients_per_K": [1e-5, 1e-5, 1e-5, 1e-5]}})
+    with pytest.raises(ParameterError, match=r"expansion_coefficients_per_K\[1\] = -1e-05: out of range"):
+        params_from_dict({"material": {"expansion_coefficients_per_K": [1.12e-5, -1e-5, 1e-5, 1e-5]}})
 
 
 def test_unknown_key_is_named(tmp_path):
@@ -95,10 +109,10 @@ def test_old_penalty_key_is_rejected_and_new_ones_checked():
 
 def test_a_carrier_clearance_below_the_thermal_growth_is_refused_with_the_minimum():
     p = load_params()
-    need = p.material.expansion_coefficient_per_K * (300.0 - 20.0) * 0.5 * p.geometry.thickness_m
+    need = p.material.expansion_coefficient_per_K * (350.0 - 20.0) * 0.5 * p.geometry.thickness_m
     assert p.min_carrier_clearance_m() == pytest.approx(need)
     with pytest.raises(ParameterError, match=rf"carrier_clearance_m = 0: below the sheet's thermal growth .* "
-                                             rf"at 300 degC .*allowed >= {need:.3g} m"):
+                                             rf"at 350 degC .*allowed >= {need:.3g} m"):
         p.replace(geometry={"carrier_clearance_m": 0.0})
     # no heating above the reference, or no thermal distortion: no minimum
     assert p.replace(geometry={"carrier_clearance_m": 0.0}, sweep={"temperatures_degC": (20.0,)})

@@ -251,3 +251,36 @@ def test_network_steps_do_not_depend_on_the_instance_history(fmus, launch_inputs
         for s in (whole, first, fresh):
             s.close()
     assert got == ref[half:]                        # bit for bit, every output of every step
+
+
+def test_mu_is_read_at_the_friction_surface(tmp_path):
+    """Issue 37: with a friction table the thermal FMU reads mu at its output theta_friction, the mean of the two
+    metal friction surfaces (declared in K with the theta_cm range), not at theta_cm: the torque is
+    n mu(theta_friction, |omega_slip|) R_eq clamp_force at every step, and during a slip the surfaces run far
+    ahead of the facings' mean, so the two lookups differ."""
+    from cushion_clutch.model.friction import FrictionTable
+    tables = tmp_path / "tables"
+    shutil.copytree(DEFAULT_TABLES, tables)
+    rows = ["theta_degC,omega_slip_rad_s,mu"] + [f"{t},{w},{mu}" for t, mu in ((0, 0.30), (60, 0.25), (400, 0.20))
+                                                 for w in (0, 500)]
+    (tables / "friction.csv").write_text("\n".join(rows) + "\n")
+    fmu = build_fmu(tables, tmp_path / "T.fmu", thermal=True)
+    md = read_model_description(str(fmu))
+    tf = next(v for v in md.modelVariables if v.name == "theta_friction")
+    assert tf.causality == "output" and tf.unit == "K" and float(tf.min) == 200.0 and float(tf.max) == 800.0
+    table = FrictionTable.from_csv(tables / "friction.csv")
+    p = ClutchParameters()
+    s = Slave(fmu)
+    names = ["torque", "clamp_force", "theta_friction", "theta_cm", "theta_flywheel_surface",
+             "theta_pressure_plate_surface"]
+    apart = 0.0
+    try:
+        for k in range(300):                                    # 3 s slip at 150 rad/s
+            torque, clamp, tf_k, cm, fs, ps = s.step(0.01, names, x_to=0.007, omega_slip=150.0, omega_engine=200.0)
+            assert tf_k == pytest.approx(0.5 * (fs + ps), rel=1e-15)
+            expected = p.n_surfaces * table(tf_k - 273.15, 150.0) * p.R_eq * clamp
+            assert torque == pytest.approx(expected, rel=1e-12)
+            apart = max(apart, abs(table(tf_k - 273.15, 150.0) - table(cm - 273.15, 150.0)))
+    finally:
+        s.close()
+    assert tf_k - cm > 5.0 and apart > 0.005        # 3 s at ~10 kW: the surface 9 K ahead, mu 0.0077 apart

@@ -36,9 +36,15 @@ def test_chain_arrays_and_derived_values():
     assert caps[SURFACES[0]] == pytest.approx(7200.0 * 500.0 * area * 1e-3)
     assert sum(caps[:3]) == pytest.approx(p.flywheel_capacity_J_per_K)
     assert sum(caps[5:]) == pytest.approx(p.pressure_plate_capacity_J_per_K)
-    assert caps[FACINGS[0]] == pytest.approx(2000.0 * 1100.0 * area * 3.5e-3)
+    # the measured lining (Gkinis et al. 2019, Table A2): k 0.652, c 542, alpha 8.3e-7 -> rho = k / (alpha c)
+    rho = 0.652 / (8.3e-7 * 542.0)
+    assert rho == pytest.approx(1449.3, abs=0.1)
+    assert caps[FACINGS[0]] == pytest.approx(rho * 542.0 * area * 3.5e-3)
+    assert caps[FACINGS[0]] == pytest.approx(93.3, abs=0.05)          # issue 37: about 93 J/K, not 261
+    e_f, e_m = math.sqrt(0.652 * rho * 542.0), math.sqrt(50.0 * 7200.0 * 500.0)
+    assert p.facing_share == pytest.approx(e_f / (e_f + e_m)) and p.facing_share == pytest.approx(0.051, abs=5e-4)
     # facing to metal while clamped: facing half thickness, contact, surface half layer in series
-    r = 1.75e-3 / (0.6 * area) + 1.0 / (3000.0 * area) + 0.5e-3 / (50.0 * area)
+    r = 1.75e-3 / (0.652 * area) + 1.0 / (3000.0 * area) + 0.5e-3 / (50.0 * area)
     assert links[2] == pytest.approx(1.0 / r) and links[4] == pytest.approx(1.0 / r)
     assert chain(p, TA, 300.0, 0.0, False)[1][2] == 0.0
     # the pressure plate turns with the engine, the facings with the disc (0 here: still air)

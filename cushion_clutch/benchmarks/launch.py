@@ -91,7 +91,9 @@ def markdown(scenarios: list[str], backend: str = "native", keep: dict | None = 
     from cushion_clutch.model import load_table
     from cushion_clutch.launch.driveline import first_mode_hz
     from cushion_clutch.launch.plant import build_plant_fmu
+    from cushion_clutch.errors import FmuCallError
     from cushion_clutch.launch.report import ratio_line, run_all, summary_table
+    from cushion_clutch.launch.tcu import VARIANTS
     from cushion_clutch.launch.scenario import load_scenario, scenario_path
 
     with tempfile.TemporaryDirectory() as tmp:
@@ -99,7 +101,13 @@ def markdown(scenarios: list[str], backend: str = "native", keep: dict | None = 
             parts = []
             sc = load_scenario(scenario_path(name))
             fmu = build_plant_fmu(DEFAULT_TABLES, sc, Path(tmp) / name / "CushionClutch.fmu", backend=backend)
-            results = run_all(fmu, sc, load_table(sc.tables_path("tcu") or DEFAULT_TABLES))
+            table = load_table(sc.tables_path("tcu") or DEFAULT_TABLES)
+            results, failed = {}, {}
+            for variant in VARIANTS:      # one at a time: a run that leaves the model's domain is reported, not hidden
+                try:
+                    results.update(run_all(fmu, sc, table, (variant,)))
+                except (ValueError, FmuCallError) as exc:
+                    failed[variant] = str(exc).splitlines()[0]
             groups = sorted({g for r in results.values() for m in r.metrics
                              for g in (("hot",) if m["hot"] and m["phase"] == "repeated" else ())
                              + (("cool-down",) if m["phase"] == "cool-down" else ())})
@@ -113,6 +121,9 @@ def markdown(scenarios: list[str], backend: str = "native", keep: dict | None = 
                 parts.append(f"Group `{g}`:\n\n" + summary_table(results, (g,)))
                 parts.append("- " + ratio_line(results, g))
                 parts.append("- " + production_line(results, g))
+            if failed:
+                parts.append("- stopped outside the model's domain (no row above): " + "; ".join(
+                    f"`{n}`: {msg}" for n, msg in failed.items()))
             parts.append("- real-time factor (wall / CPU time): " + ", ".join(
                 f"{n} {sim / r.wall_time_s:.0f}x / {sim / r.cpu_time_s:.0f}x" for n, r in results.items()))
             yield "\n\n".join(parts)

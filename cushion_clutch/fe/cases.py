@@ -191,6 +191,8 @@ def case_key(params: SpringParams, theta_degC: float, paddles: int, ccx: str) ->
     if params.geometry.surface_file:          # the scan's content, wherever the file lies
         d["geometry"]["surface_file"] = surface_digest(params.geometry.surface_file)
     d["sweep"].pop("temperatures_degC", None)
+    if not d["material"].get("expansion_coefficients_per_K"):   # no table: the key as before the table existed
+        d["material"].pop("expansion_coefficients_per_K", None)
     d["solver"].pop("threads", None)          # effort limits do not change a converged result
     d["solver"].pop("max_increments", None)
     blob = json.dumps([d, float(theta_degC), paddles, ccx, __version__], sort_keys=True)

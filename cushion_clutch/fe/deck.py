@@ -63,11 +63,16 @@ def _mesh_block(mesh: ShellMesh, elset: str = "PADDLE", element_type: str = "S4"
 
 
 def _material_block(material: Material, thermal_distortion: bool = True) -> list[str]:
-    alpha = material.expansion_coefficient_per_K if thermal_distortion else 0.0
     out = ["*MATERIAL, NAME=STEEL", "*ELASTIC"]
     out += [f"{_fmt(e * MPA)}, {_fmt(material.poisson_ratio)}, {_fmt(t)}"
             for t, e in zip(material.temperatures_degC, material.youngs_modulus_Pa)]
-    out += [f"*EXPANSION, ZERO={_fmt(material.reference_temperature_degC)}", _fmt(alpha)]
+    out.append(f"*EXPANSION, ZERO={_fmt(material.reference_temperature_degC)}")
+    if not thermal_distortion:
+        out.append(_fmt(0.0))
+    elif not material.expansion_coefficients_per_K:
+        out.append(_fmt(material.expansion_coefficient_per_K))
+    else:                                    # secant coefficients from ZERO, one per temperature
+        out += [f"{_fmt(a)}, {_fmt(t)}" for a, t in material.expansion_table()]
     return out
 
 
@@ -142,8 +147,10 @@ def carrier_displacement(nodes_m: np.ndarray, params: SpringParams, theta_degC: 
     ``theta_ref + kappa (theta - theta_ref)``.
     """
     mat = params.material
-    alpha = mat.expansion_coefficient_per_K if params.sweep.thermal_distortion else 0.0
-    strain = alpha * params.carrier.temperature_ratio * (theta_degC - mat.reference_temperature_degC)
+    theta_carrier = mat.reference_temperature_degC + params.carrier.temperature_ratio * (
+        theta_degC - mat.reference_temperature_degC)
+    alpha = mat.expansion_coefficient(theta_carrier) if params.sweep.thermal_distortion else 0.0
+    strain = alpha * (theta_carrier - mat.reference_temperature_degC)
     return strain * np.asarray(nodes_m)[:, :2]
 
 

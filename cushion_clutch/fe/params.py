@@ -222,13 +222,25 @@ class Carrier(Checked):
 
 @dataclass(frozen=True)
 class Material(Checked):
-    """Isotropic linear elastic material, E(theta) piecewise linear (paper Table 1)."""
+    """Isotropic linear elastic material, E(theta) piecewise linear (paper Table 1).
+
+    The thermal strain is ``alpha(theta) (theta - reference_temperature_degC)``
+    with ``alpha`` the secant (mean) coefficient from the reference temperature,
+    as CalculiX's ``*EXPANSION, ZERO=`` takes it: ``expansion_coefficient_per_K``
+    at every temperature, or, with ``expansion_coefficients_per_K`` (one value
+    per ``temperatures_degC``), linear between the table points and constant
+    outside; the table's value at the reference temperature must then equal
+    ``expansion_coefficient_per_K``.
+    """
 
     temperatures_degC: tuple[float, ...] = (20.0, 80.0, 200.0, 350.0)
     youngs_modulus_Pa: tuple[float, ...] = (206e9, 202e9, 196e9, 186e9)
     poisson_ratio: float = 0.3
     expansion_coefficient_per_K: float = 1.12e-5
     reference_temperature_degC: float = 20.0
+    expansion_coefficients_per_K: tuple[float, ...] = ()
+    """Secant expansion coefficients from the reference temperature at
+    ``temperatures_degC``, 1/K; empty: ``expansion_coefficient_per_K`` throughout."""
 
     _section = "material"
 
@@ -252,11 +264,42 @@ class Material(Checked):
                 yield msg
         if all(isinstance(t, (int, float)) for t in temps) and list(temps) != sorted(set(temps)):
             yield "material.temperatures_degC: must be strictly increasing"
+        alphas = self.expansion_coefficients_per_K
+        if alphas:
+            if len(alphas) != len(temps):
+                yield (f"material.expansion_coefficients_per_K: needs one value per temperatures_degC "
+                       f"({len(temps)}), got {len(alphas)}")
+                return
+            bad = [msg for i, a in enumerate(alphas)
+                   if (msg := range_problem(f"material.expansion_coefficients_per_K[{i}]", a, 0.0, 1e-3))]
+            yield from bad
+            if not bad and all(isinstance(t, (int, float)) for t in temps) and \
+                    isinstance(self.expansion_coefficient_per_K, (int, float)):
+                at_ref = self.expansion_coefficient(self.reference_temperature_degC)
+                if abs(at_ref - self.expansion_coefficient_per_K) > 1e-9 * abs(at_ref):
+                    yield (f"material.expansion_coefficient_per_K = {self.expansion_coefficient_per_K!r}: must equal "
+                           f"expansion_coefficients_per_K at reference_temperature_degC ({at_ref:.6g})")
 
     def youngs_modulus(self, theta_degC: float) -> float:
         """E at ``theta_degC`` in Pa, linear between table points, constant outside."""
         import numpy as np
         return float(np.interp(theta_degC, self.temperatures_degC, self.youngs_modulus_Pa))
+
+    def expansion_coefficient(self, theta_degC: float) -> float:
+        """Secant expansion coefficient from the reference temperature at ``theta_degC``, 1/K.
+
+        Linear between table points and constant outside, as CalculiX interpolates it.
+        """
+        if not self.expansion_coefficients_per_K:
+            return float(self.expansion_coefficient_per_K)
+        import numpy as np
+        return float(np.interp(theta_degC, self.temperatures_degC, self.expansion_coefficients_per_K))
+
+    def expansion_table(self) -> list[tuple[float, float]]:
+        """``(alpha 1/K, theta degC)`` rows for ``*EXPANSION`` (one row without a table)."""
+        if not self.expansion_coefficients_per_K:
+            return [(float(self.expansion_coefficient_per_K), float(self.reference_temperature_degC))]
+        return [(float(a), float(t)) for a, t in zip(self.expansion_coefficients_per_K, self.temperatures_degC)]
 
 
 @dataclass(frozen=True)
@@ -436,8 +479,9 @@ class SpringParams(Checked):
         """
         if not self.sweep.thermal_distortion:
             return 0.0
-        dt = max(float(t) for t in self.sweep.temperatures_degC) - float(self.material.reference_temperature_degC)
-        return max(0.0, float(self.material.expansion_coefficient_per_K) * dt * 0.5 * float(self.geometry.thickness_m))
+        t_max = max(float(t) for t in self.sweep.temperatures_degC)
+        dt = t_max - float(self.material.reference_temperature_degC)
+        return max(0.0, self.material.expansion_coefficient(t_max) * dt * 0.5 * float(self.geometry.thickness_m))
 
     def replace(self, **sections: Any) -> "SpringParams":
         """Return a copy with top-level fields or whole sections replaced.

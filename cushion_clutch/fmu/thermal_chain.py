@@ -43,6 +43,8 @@ OMEGA_ENGINE_START = 0.0
 SPEEDS = {"engine": "TN_ENGINE", "disc": "TN_DISC"}
 #: the most nodes the C chain holds (thermal_network.h TN_MAX)
 TN_MAX = 32
+#: the output of the friction-surface temperature (K), at which mu of a friction table is read
+FRICTION_OUTPUT = "theta_friction"
 
 
 @dataclass(frozen=True)
@@ -53,7 +55,8 @@ class Chain:
     clamped. Sink of node i: convection ``cooled_area_m2[i] (h_still + h_rot (|w| / w_ref)^0.8)`` to the air,
     ``w`` the speed of ``speed[i]`` ("engine" or "disc"), plus ``engine_W_per_K[i]`` to the engine block at
     ``engine_K``. Slip power P puts ``heat_share[i] P`` into node i.
-    ``theta_cm`` = sum of ``theta_cm_weights[i] theta_i``.
+    ``theta_cm`` = sum of ``theta_cm_weights[i] theta_i``; the friction-surface temperature
+    ``theta_friction`` (mu is read there) = sum of ``friction_weights[i] theta_i``.
     """
 
     nodes: tuple[str, ...]
@@ -69,6 +72,8 @@ class Chain:
     still_air_W_per_m2_K: float
     rotating_W_per_m2_K: float
     convection_reference_rad_s: float
+    friction_weights: tuple[float, ...] = ()
+    """weights of ``theta_friction``; empty: those of ``theta_cm``"""
 
     def __post_init__(self) -> None:
         n = len(self.nodes)
@@ -84,8 +89,16 @@ class Chain:
             problems.append(f"heat shares add up to {sum(self.heat_share)!r}, not 1")
         if abs(sum(self.theta_cm_weights) - 1.0) > 1e-12:
             problems.append(f"theta_cm weights add up to {sum(self.theta_cm_weights)!r}, not 1")
+        if self.friction_weights and (len(self.friction_weights) != n or abs(sum(self.friction_weights) - 1.0) > 1e-12):
+            problems.append(f"friction weights: {len(self.friction_weights)} entries for {n} nodes adding up to "
+                            f"{sum(self.friction_weights)!r} (need one per node, adding up to 1)")
         if problems:
             raise ValueError("thermal chain: " + "; ".join(problems))
+
+    @property
+    def theta_friction_weights(self) -> tuple[float, ...]:
+        """Weights of the friction-surface temperature ``theta_friction``, one per node."""
+        return self.friction_weights or self.theta_cm_weights
 
     def links(self) -> list[tuple[str, str]]:
         """(node i, node i + 1) of every link."""
@@ -108,6 +121,7 @@ def chain_of(p=None) -> Chain:
                  engine_W_per_K=tuple(c["engine"]), link_always_W_per_K=tuple(c["link_always"]),
                  link_clamped_W_per_K=tuple(c["link_clamped"]),
                  theta_cm_weights=tuple(0.5 if i in tn.FACINGS else 0.0 for i in range(n)),
+                 friction_weights=tuple(0.5 if i in tn.SURFACES else 0.0 for i in range(n)),
                  engine_K=p.engine_degC + KELVIN, still_air_W_per_m2_K=p.still_air_W_per_m2_K,
                  rotating_W_per_m2_K=p.rotating_W_per_m2_K,
                  convection_reference_rad_s=p.convection_reference_rad_s)
@@ -166,6 +180,9 @@ def thermal_variables(chain: Chain) -> tuple[tuple, tuple]:
                                                      "(clamp force > 0)")]
     extra += [(n, "parameter", u, d) for n, (u, d, _) in GLOBALS.items()]
     extra += [(f"der({node_output(k)})", "local", "K/s", f"rate of change of {node_output(k)}") for k in chain.nodes]
+    extra.append((FRICTION_OUTPUT, "output", "K", "friction-surface temperature "
+                  + " + ".join(f"{w:g} {node_output(k)}" for k, w in zip(chain.nodes, chain.theta_friction_weights)
+                               if w) + "; mu(theta, omega_slip) of a friction table is read here (issue 37)"))
     return base, tuple(extra)
 
 
@@ -175,7 +192,8 @@ def thermal_starts(chain: Chain, p: "clutch_model.ClutchParameters | None" = Non
     starts = clutch_model.start_values(p)
     theta0 = p.theta_cs_start
     starts["theta_cm"] = sum(w * theta0 for w in chain.theta_cm_weights)
-    starts.update({"omega_engine": OMEGA_ENGINE_START, "slip_power": 0.0})
+    starts.update({"omega_engine": OMEGA_ENGINE_START, "slip_power": 0.0,
+                   FRICTION_OUTPUT: sum(w * theta0 for w in chain.theta_friction_weights)})
     for i, k in enumerate(chain.nodes):
         q = _node_params(k)
         starts.update({node_output(k): theta0, f"der({node_output(k)})": 0.0, q["cap"]: chain.capacity_J_per_K[i],
@@ -201,6 +219,7 @@ def thermal_ranges(chain: Chain) -> dict[str, tuple]:
         ranges.update({v: (0.0, 1e6, False, False) for v in _link_params(a, b).values()})
     ranges.update({n: r for n, (_, _, r) in GLOBALS.items()})
     ranges["omega_engine"] = (-clutch_model.OMEGA_SLIP_LIMIT, clutch_model.OMEGA_SLIP_LIMIT, False, False)
+    ranges[FRICTION_OUTPUT] = clutch_model.INPUT_RANGES["theta_cm"]      # as theta_cm; a step leaving it is refused
     return ranges
 
 
@@ -225,6 +244,7 @@ def _block(chain: Chain) -> str:
         _c_array("int", "TN_VR_CLAMPED", [vr(q["clamped"]) for q in links]),
         _c_array("int", "TN_SPEED", [SPEEDS[s] for s in chain.speed]),
         _c_array("double", "TN_WEIGHT", [repr(float(w)) for w in chain.theta_cm_weights]),
+        _c_array("double", "TN_FRICTION_WEIGHT", [repr(float(w)) for w in chain.theta_friction_weights]),
         _c_array("char *const", "TN_NAME", [f'"{node_output(k)}"' for k in chain.nodes]),
     ]
     names = ", ".join(f'"{k}"' for k in chain.nodes)
@@ -240,6 +260,7 @@ def _block(chain: Chain) -> str:
 #define TN_VR_H_ROT {enum_name("h_rotating")}
 #define TN_VR_WREF {enum_name("convection_reference_omega")}
 #define TN_VR_THETA0 {enum_name("theta_network_start")}
+#define CC_VR_THETA_MU {enum_name(FRICTION_OUTPUT)} /* mu is read at the friction surface (clutch_core.c) */
 #ifdef CC_DEFINE_THERMAL_TABLE /* clutch_thermal.c */
 {chr(10).join(arrays)}
 #endif

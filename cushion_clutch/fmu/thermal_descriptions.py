@@ -18,8 +18,8 @@ from ..model import clutch_model
 from .constants import sources
 from .descriptions import (_finish, dependencies, float64_attributes, fmi2_description, fmi3_build_description,
                            fmi3_description, scalar_real, vr_der)
-from .thermal_chain import (NETWORK_SOURCES, THERMAL_SLAVE, Chain, node_output, thermal_ranges, thermal_starts,
-                            thermal_variables)
+from .thermal_chain import (FRICTION_OUTPUT, NETWORK_SOURCES, THERMAL_SLAVE, Chain, node_output, thermal_ranges,
+                            thermal_starts, thermal_variables)
 
 DESCRIPTION = ("Dry-clutch torque (the CushionClutch model) with the clutch's thermal network inside: a chain of "
                "lumped nodes heated by the slip power torque*|omega_slip| and cooled by speed-dependent "
@@ -60,9 +60,14 @@ def thermal_dependencies(chain: Chain, has_friction: bool) -> tuple[dict[int, li
         deps[thermal_vr_der(chain) if out == vr_der() else out] = sorted(
             {x for v in d for x in (facings if v == theta_cm else [v])})
     deps[theta_cm] = sorted(facings)
+    surfaces = [vr[node_output(k)] for k, w in zip(chain.nodes, chain.theta_friction_weights) if w]
+    if has_friction:                      # mu(theta_friction, omega_slip): the torque and validity see the surfaces
+        for out in (vr["torque"], vr["validity"]):
+            deps[out] = sorted(set(deps[out]) | set(surfaces))
     deps[vr["slip_power"]] = sorted(set(deps[vr["torque"]]) | {vr["omega_slip"]})
     for k in nodes:
         deps[k] = [k]
+    deps[vr[FRICTION_OUTPUT]] = sorted(surfaces)
     ders = [thermal_vr_der(chain)] + [vr[f"der({node_output(k)})"] for k in chain.nodes]
     for d in ders[1:]:
         deps[d] = sorted({vr["theta_cs"], *nodes, *inputs})
@@ -135,6 +140,7 @@ def thermal_fmi2_description(guid: str, has_friction: bool, chain: Chain, x_kiss
         real = scalar_real(variables, vr, name, causality, unit, desc)
         if causality in ("input", "parameter"):
             real.set("start", repr(starts[name]))
+        if causality in ("input", "parameter") or name == FRICTION_OUTPUT:
             for k, v in _bounds(chain, name).items():
                 real.set(k, v)
         if name.startswith("der("):
@@ -185,6 +191,7 @@ def thermal_fmi3_description(token: str, has_friction: bool, chain: Chain, x_kis
             attrs["derivative"] = str(vrs[name[4:-1]])
         if causality in ("input", "parameter"):
             attrs["start"] = repr(starts[name])
+        if causality in ("input", "parameter") or name == FRICTION_OUTPUT:
             attrs.update(_bounds(chain, name))
         ET.SubElement(variables, "Float64", attrs)
     variables.append(der_cs)

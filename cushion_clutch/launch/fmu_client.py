@@ -23,6 +23,9 @@ from ..errors import FmuCallError
 #: inputs and outputs exchanged every step, in this order
 INPUTS = ("x_to", "theta_cm", "omega_slip")
 OUTPUTS = ("torque", "theta_cs", "x_kiss")
+#: read with them every step, kept in :attr:`ClutchFmu.out` (index 3): the plant's torque with mu read at the
+#: friction surface is n mu R_eq clamp_force (simulate.py)
+EXTRA_OUTPUTS = ("clamp_force",)
 
 
 class ClutchFmu:
@@ -42,7 +45,7 @@ class ClutchFmu:
 
         md = read_model_description(str(fmu))
         vr = {v.name: v.valueReference for v in md.modelVariables}
-        missing = [n for n in INPUTS + OUTPUTS if n not in vr]
+        missing = [n for n in INPUTS + OUTPUTS + EXTRA_OUTPUTS if n not in vr]
         if missing:
             raise ValueError(f"{fmu}: the FMU has no variable(s) {', '.join(missing)}")
         self.unzip = extract(str(fmu))
@@ -72,8 +75,10 @@ class ClutchFmu:
         self._lib = ffi.dlopen(s.dll._name)          # the library fmpy loaded: the same handle
         self._c = ffi.cast("void *", s.component)
         self._vr_in = ffi.new("unsigned int[3]", [vr[n] for n in INPUTS])
-        self._vr_out = ffi.new("unsigned int[3]", [vr[n] for n in OUTPUTS])
-        self._v_in, self._v_out = ffi.new("double[3]"), ffi.new("double[3]")
+        self._vr_out = ffi.new("unsigned int[4]", [vr[n] for n in OUTPUTS + EXTRA_OUTPUTS])
+        self._v_in, self._v_out = ffi.new("double[3]"), ffi.new("double[4]")
+        #: the last step's outputs: :data:`OUTPUTS` then :data:`EXTRA_OUTPUTS` (``out[3]`` the clamp force, N)
+        self.out = self._v_out
         self.step = self._make_step()
 
     def _make_step(self):
@@ -107,12 +112,20 @@ class ClutchFmu:
             st = do_step(comp, t, h, 1)
             if st > 1:
                 raise FmuCallError("fmi2DoStep", st, f"t={t!r}, h={h!r}")
-            st = get_real(comp, vr_out, 3, o)
+            st = get_real(comp, vr_out, 4, o)
             if st > 1:
                 raise FmuCallError("fmi2GetReal", st)
             return o[0], o[1], o[2]
 
         return step
+
+    def friction_table(self):
+        """The FMU's own friction table (``friction.csv`` in its resources) as a
+        :class:`~cushion_clutch.model.friction.FrictionTable`, or None (the FMU's mu is the constant parameter)."""
+        from ..model.friction import FrictionTable
+        from ..model.table_format import FRICTION
+        found = sorted(Path(self.unzip, "resources").rglob(FRICTION))
+        return FrictionTable.from_csv(found[0]) if found else None
 
     def close(self) -> None:
         """Terminate and free the instance, delete the extracted FMU."""

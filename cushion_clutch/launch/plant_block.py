@@ -33,6 +33,8 @@ HEAD = ("steps", "n_events", "w_e", "w_d", "v", "phi", "locked", "t_e", "x_act",
         "x_kiss", "stalled", "has_lock", "lock_time", "throttle", "theta_cm_step", "theta_surface", "theta_last")
 #: the most nodes of a thermal network the C step takes (lp_state.theta)
 MAX_NODES = 16
+#: the most temperatures and slip speeds of a friction table the C step takes (lp_consts.f_theta, f_omega)
+MAX_FRICTION = 16
 
 
 #: the compiled plant step (built on first use, cached by the sources' hash)
@@ -61,7 +63,8 @@ class NativePlant:
     """
 
     def __init__(self, clutch, engine, dl, net, h: float, act: float, w_lift: float, prefill: float,
-                 tcu_every: int, net_every: int, alpha_jerk: float, creep_nm: float):
+                 tcu_every: int, net_every: int, alpha_jerk: float, creep_nm: float, mu_surface=None,
+                 n_surfaces: float = 0.0, r_eq: float = 0.0):
         if len(engine.w) > MAX_CURVE:
             raise ValueError(f"engine torque curve: {len(engine.w)} points, the native plant takes {MAX_CURVE}")
         if len(net.theta) > MAX_NODES:
@@ -76,7 +79,10 @@ class NativePlant:
         c.do_step = ffi.cast("lp_do_step", fl.fmi2DoStep)
         c.get_real = ffi.cast("lp_get_real", fl.fmi2GetReal)
         for i in range(3):
-            c.vr_in[i], c.vr_out[i] = clutch._vr_in[i], clutch._vr_out[i]
+            c.vr_in[i] = clutch._vr_in[i]
+        for i in range(4):
+            c.vr_out[i] = clutch._vr_out[i]
+        self._friction(mu_surface, n_surfaces, r_eq)
         c.n_curve = len(engine.w)
         for i, (w, t) in enumerate(zip(engine.w, engine.t)):
             c.curve_w[i], c.curve_t[i] = w, t
@@ -114,6 +120,21 @@ class NativePlant:
         self._rows = [self._o + j * self.width for j in range(tcu_every)]
         self.n_row = len(ROW_FIELDS)
 
+    def _friction(self, mu, n_surfaces: float, r_eq: float) -> None:
+        """mu at the friction surface (``mu``: a FrictionTable, or None: the FMU's torque), as simulate.py."""
+        c = self.c
+        c.mu_surface = mu is not None
+        if mu is None:
+            return
+        nt, nw = len(mu.theta_degC), len(mu.omega_rad_s)
+        if nt > MAX_FRICTION or nw > MAX_FRICTION:
+            raise ValueError(f"friction table: {nt} x {nw} points, the native plant takes {MAX_FRICTION} x "
+                             f"{MAX_FRICTION}")
+        c.f_nt, c.f_nw, c.n_surfaces, c.r_eq = nt, nw, n_surfaces, r_eq
+        c.f_theta[0:nt] = mu.theta_degC
+        c.f_omega[0:nw] = mu.omega_rad_s
+        c.f_mu[0:nt * nw] = [v for row in mu.mu for v in row]
+
     def _network(self, net, dt: float) -> None:
         """The network's constants for both clamp states, the fixed nodes' decay factors at the step ``dt``
         (s), as :meth:`.ThermalNetwork.step` prepares them."""
@@ -145,6 +166,7 @@ class NativePlant:
         s.x_act, s.theta_cm, s.t_e, s.t_cap, s.theta_cs, s.x_kiss = x_act, theta_cm, t_e, t_cap, theta_cs, x_kiss
         s.net_n, s.net_e, s.lifted, s.stalled, s.n_events = 0.0, 0.0, 0.0, 0.0, 0.0
         s.theta[0:len(self.net.theta)] = self.net.theta
+        s.theta_fs = self.net.theta_friction
         self._load(rec)
 
     def _load(self, rec) -> None:

@@ -98,12 +98,14 @@ def _facing_profile(path: str) -> Callable[[float], float]:
     return lambda x: float(np.interp(x, t, th))
 
 
-def _native_plant(clutch, engine, dl, net, h, act, w_lift, prefill, tcu_every, net_every, alpha):
+def _native_plant(clutch, engine, dl, net, h, act, w_lift, prefill, tcu_every, net_every, alpha, mu_surface=None,
+                  n_surfaces=0.0, r_eq=0.0):
     """The compiled plant steps (:mod:`.plant_block`), or None (logged) if the library cannot be built."""
     from .metrics import CREEP_NM
     from .plant_block import NativePlant
     try:
-        return NativePlant(clutch, engine, dl, net, h, act, w_lift, prefill, tcu_every, net_every, alpha, CREEP_NM)
+        return NativePlant(clutch, engine, dl, net, h, act, w_lift, prefill, tcu_every, net_every, alpha, CREEP_NM,
+                           mu_surface, n_surfaces, r_eq)
     except (RuntimeError, ValueError, OSError) as exc:
         log.warning("the native launch plant is not available, running the Python loop: %s", exc)
         return None
@@ -179,6 +181,15 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
     keyed = (key_on(ctl, sc, fmu, clutch_start, sc.driveline.disc_inertia_kg_m2, engine.w_idle)
              if name == "production" else None)
     clutch = ClutchFmu(fmu, clutch_start)
+    # mu at the friction surface (issue 37): with the network and a friction table the plant's torque is
+    # n mu(theta_friction, |omega_slip|) R_eq F_clamp, the clutch FMU's own torque formula with mu read at the
+    # network's friction-surface temperature (ThermalNetwork.theta_friction, held over the step as theta_cm is)
+    # instead of at the facings' mean; the clutch FMU still gets theta_cm (the cushion spring's ODE, the stack's
+    # growth, validity); the table is the FMU's own (friction.csv in its resources). Without the network or a
+    # friction table: the FMU's torque (mu at theta_cm, or constant)
+    mu_surface = clutch.friction_table() if net is not None else None
+    theta_fs = net.theta_friction if net is not None else theta0
+    n_surfaces, r_eq = p.n_surfaces, p.R_eq
     theta_cm = theta0
     x_act = 0.0
     theta_cs, x_kiss = theta0, p.x_kiss_ref
@@ -192,6 +203,7 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
     engaged = braking = launching = sampling = lifted = False
     countdown = 0
     clutch_step, engine_torque, dl_step, facing_step = clutch.step, engine.torque, dl.step, facing.step
+    clutch_out = clutch.out
     n_slots = len(starts)
     next_switch = slot_end - 0.5 * h if n_slots > 1 else math.inf
     stalled = False
@@ -206,7 +218,7 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
     native = None
     if plant == "native" and net is not None:
         native = _native_plant(clutch, engine, dl, net, h, act, w_lift, prefill, tcu_every, net_every,
-                               recs[0].alpha)
+                               recs[0].alpha, mu_surface, n_surfaces, r_eq)
     if native is not None:               # the plant's state moves into C; where a step's figures are in its list
         native.start(rec, x_act, theta_cm, t_e, t_cap, theta_cs, x_kiss)
         native_block, native_quiet, native_row, native_accels = native.block, native.quiet, native.row, native.accels
@@ -275,6 +287,7 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
                         if net_n >= net_every:
                             net.step(net_n * h, net_e / (net_n * h), dl.w_e, 0.0, False)
                             theta_cm, net_n, net_e = net.theta_cm, 0, 0.0
+                            theta_fs = net.theta_friction
                     elif profile is not None:
                         theta_cm = profile(t + h_quiet)
                     else:
@@ -343,7 +356,10 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
             x_act = x_cmd + (x_act - x_cmd) * act
             w_e = dl.w_e
             # -- clutch FMU, inputs held over the step
-            t_cap, theta_cs, x_kiss = clutch_step(t, h, x_act, theta_cm, w_e - dl.w_d)
+            omega_slip = w_e - dl.w_d
+            t_cap, theta_cs, x_kiss = clutch_step(t, h, x_act, theta_cm, omega_slip)
+            if mu_surface is not None:
+                t_cap = n_surfaces * mu_surface(theta_fs - KELVIN, omega_slip) * r_eq * clutch_out[3]
             if engaged and not rec.started:
                 rec.start(ctl.kiss_now - x_kiss, theta_cs, ctl.theta_now - theta_cs)
             if cycled and sampling:
@@ -367,6 +383,7 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
                 if net_n == net_every:
                     net.step(net_n * h, net_e / (net_n * h), dl.w_e, dl.w_d, engaged)
                     theta_cm, net_n, net_e = net.theta_cm, 0, 0.0
+                    theta_fs = net.theta_friction
             elif slip_J != 0.0:
                 rec.slip_J += slip_J
                 theta_cm = profile(t + h) if profile is not None else facing_step(theta_cm, dl.slip_W)

@@ -126,7 +126,10 @@ class TcuController:
             table.friction = None
         self.v, self.sc, self.table, self.p = variant, sc, table, p
         self.period = sc.tcu.period_s
-        self.theta_ref = table.theta_degC[0] + KELVIN
+        # the characteristic a temperature-blind TCU believes: the table's reference temperature (its kiss point,
+        # delta_kiss = 0; 20 degC), not its first row (-40 degC since the tables run from a winter start)
+        self.theta_ref = next((t for t, d in zip(table.theta_degC, table.delta_kiss_m) if d == 0.0),
+                              table.theta_degC[0]) + KELVIN
         self.theta_ideal = theta0
         self.theta_cm_ideal = theta0      # the ideal TCU's facing temperature (it is told the true one), K
         self.observer = (FacingObserver(sc.observer, p.theta_a, theta0, self.period)

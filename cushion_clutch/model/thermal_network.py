@@ -15,9 +15,10 @@ Node chain (:data:`NODES`), temperatures in K, axial order::
   rise over a duty.
 * **Slip heat.** Each friction interface takes half of ``P = T w_slip``, divided between facing and metal
   by their thermal effusivities ``e = sqrt(k rho c)`` (two semi-infinite bodies in perfect contact, the
-  Blok/Charron partition): the facing takes ``e_f / (e_f + e_m)`` (7.9 %), the metal surface layer the rest.
+  Blok/Charron partition): the facing takes ``e_f / (e_f + e_m)`` (5.1 % with the measured lining of
+  :data:`LINING`), the metal surface layer the rest.
 * **Facing.** One node per facing (its mean temperature; the facing's own diffusion time
-  ``t_f^2 / alpha_f`` is about 45 s, so its mean lags its surface). While clamped it conducts into the
+  ``t_f^2 / alpha_f`` is about 15 s (the measured lining), so its mean lags its surface). While clamped it conducts into the
   metal's surface layer through its half thickness in series with the contact conductance; the two facings
   exchange heat through the disc (``disc_W_per_K``, always).
 * **Sinks.** Convection to the bell-housing air (at ambient) from the bulk nodes and the facings:
@@ -60,6 +61,14 @@ SURFACES = (2, 5)
 #: which speed drives each node's convection: 0 engine, 1 disc
 SPEED_OF_NODE = (0, 0, 0, 1, 1, 0, 0, 0)
 
+#: the measured dry-clutch lining (new): Gkinis, Rahmani, Rahnejat, O'Mahony, "Integrated Thermal and Dynamic
+#: Analysis of Dry Automotive Clutch Linings", Appl. Sci. 9(20):4287, 2019, doi:10.3390/app9204287, Table A2:
+#: thermal conductivity 0.652 +- 0.13 W/(m K), specific heat 542 +- 35 J/(kg K), thermal diffusivity
+#: (8.3 +- 0.3)e-7 m2/s; the density follows as k / (alpha c) = 1449 kg/m3 (+-21 %: the paper's uncertainties of
+#: k and alpha)
+LINING = {"conductivity_W_per_m_K": 0.652, "heat_J_per_kg_K": 542.0, "diffusivity_m2_per_s": 8.3e-7}
+LINING_DENSITY_KG_M3 = LINING["conductivity_W_per_m_K"] / (LINING["diffusivity_m2_per_s"] * LINING["heat_J_per_kg_K"])
+
 
 @dataclass(frozen=True)
 class NetworkParams(Checked):
@@ -73,8 +82,9 @@ class NetworkParams(Checked):
       model's ``R_eq`` 89 mm (+-5 % on the area);
     * grey cast iron k 50 W/(m K), rho 7200 kg/m3, c 500 J/(kg K) (pearlitic grey iron at 20-200 degC:
       k 45-55, c 460-560; +-10 %);
-    * organic (resin-bonded) facing k 0.6 W/(m K), rho 2000 kg/m3, c 1100 J/(kg K), 3.5 mm thick
-      (published ranges k 0.3-1.0, rho 1800-2300, c 1000-1300: k +-50 %, rho c +-15 %);
+    * organic (resin-bonded) facing: the measured new lining of :data:`LINING` (Gkinis et al. 2019, Table A2):
+      k 0.652 W/(m K) (+-20 %), c 542 J/(kg K) (+-6.5 %), rho = k / (alpha c) = 1449 kg/m3 (rho c +-20 %),
+      3.5 mm thick (typical 3.2-3.5 mm, +-10 %);
     * heat capacities of the metal parts that take part over a duty of minutes: the pressure plate
       (3.5 kg cast iron, 1750 J/K, +-20 %) and the flywheel's friction ring and web within ~25 mm of the face
       (5 kg, 2500 J/K, +-30 %; a single-mass flywheel weighs 8-12 kg, its hub and starter ring warm later);
@@ -94,9 +104,9 @@ class NetworkParams(Checked):
     metal_conductivity_W_per_m_K: float = 50.0
     metal_density_kg_m3: float = 7200.0
     metal_heat_J_per_kg_K: float = 500.0
-    facing_conductivity_W_per_m_K: float = 0.6
-    facing_density_kg_m3: float = 2000.0
-    facing_heat_J_per_kg_K: float = 1100.0
+    facing_conductivity_W_per_m_K: float = LINING["conductivity_W_per_m_K"]
+    facing_density_kg_m3: float = LINING_DENSITY_KG_M3
+    facing_heat_J_per_kg_K: float = LINING["heat_J_per_kg_K"]
     facing_thickness_m: float = 0.0035
     surface_layer_m: float = 0.001
     """thickness of each metal part's surface node"""
@@ -192,14 +202,14 @@ class TcuNetworkBase(NetworkParams):
     """The same physical network as a TCU maker would parametrise it, mismatched with the plant by default.
 
     Stated mismatch: every metal capacity +15 % (2875 and 2012.5 J/K: the participating mass is a
-    judgement), the facings +15 % through their density (2300 kg/m3), every heat-transfer coefficient
+    judgement), the facings +15 % through their density (1667 kg/m3), every heat-transfer coefficient
     -20 % (contact 2400, still air 8, rotating 40 W/(m2 K)) and the engine-block conductance -20 % (1.6 W/K).
     Geometry and materials' conductivities as the plant (from the drawing).
     """
 
     flywheel_capacity_J_per_K: float = 2875.0
     pressure_plate_capacity_J_per_K: float = 2012.5
-    facing_density_kg_m3: float = 2300.0
+    facing_density_kg_m3: float = 1.15 * LINING_DENSITY_KG_M3
     contact_W_per_m2_K: float = 2400.0
     engine_W_per_K: float = 1.6
     still_air_W_per_m2_K: float = 8.0
@@ -285,6 +295,18 @@ class ThermalNetwork:
     def theta_cm(self) -> float:
         """Facing temperature for the clutch model: mean of the two facings, K."""
         return 0.5 * (self.theta[FACINGS[0]] + self.theta[FACINGS[1]])
+
+    @property
+    def theta_friction(self) -> float:
+        """Friction-surface temperature, K: the mean of the two metal friction surfaces (their 1 mm layers).
+
+        mu is read here (issue 37): the interface is at the metal's surface temperature (the metal's
+        effusivity is 19 times the lining's, so the contact temperature sits within a few per cent of the
+        metal side's rise), not at the facings' mean, which lags it by the lining's 15 s diffusion time.
+        Each interface carries half the torque at the same clamp force, so the torque's mu is the mean of
+        the two interfaces' mu; the mean of the temperatures gives it exactly where both lie between the
+        same two rows of a piecewise-linear friction table."""
+        return 0.5 * (self.theta[SURFACES[0]] + self.theta[SURFACES[1]])
 
     @property
     def theta_surface(self) -> float:

@@ -1,0 +1,124 @@
+"""The disc-sector thermal FE (cushion-clutch heat-path): mesh invariants, a lumped closed form through the
+same deck writer and ccx runner, and the coarse run's checks (C against mass x c, energy, mesh, tau)."""
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from cushion_clutch.fe.heat_deck import Phase, Schedule, write_deck, parse_temperatures
+from cushion_clutch.fe.heat_mesh import HeatMesh, sector_mesh
+from cushion_clutch.fe.heat_params import STEEL_C_RANGE_J_PER_KG_K, HeatPathParams
+from cushion_clutch.fe.heat_path import first_order, schedule_for
+from cushion_clutch.fe.params import load_params
+
+
+@pytest.fixture(scope="module")
+def spring():
+    return load_params()
+
+
+def test_paddle_mass_is_the_spring_files_sector(spring):
+    """The mesh's paddle steel equals the annular sector of the spring file (radii, span, thickness)."""
+    g = spring.geometry
+    hp = HeatPathParams()
+    m = sector_mesh(spring, hp, 6e-3)
+    analytic = 0.5 * (g.outer_radius_m ** 2 - g.inner_radius_m ** 2) * math.radians(g.span_deg) * g.thickness_m \
+        * hp.steel_density_kg_m3
+    assert m.mass_kg("PADDLE") == pytest.approx(analytic, rel=2e-3)       # chords instead of arcs
+    assert m.disc_factor == 2 * spring.n_pairs
+
+
+def test_interface_conductance_does_not_depend_on_the_mesh(spring):
+    """Cell conductances are area means of the local h: the layer's total conductance is mesh-independent."""
+    hp = HeatPathParams()
+    totals = []
+    for e in (8e-3, 4e-3, 2e-3):
+        m = sector_mesh(spring, hp, e)
+        s = m.element_sets["INTERFACE"]
+        t = m.nodes[m.elements[s, 4], 2] - m.nodes[m.elements[s, 0], 2]
+        totals.append(np.sum(m.conductivity_W_per_m_K[s] * m.volume_m3[s] / t ** 2))
+    assert max(totals) / min(totals) - 1 < 0.02
+
+
+def test_schedule_puts_the_launch_energy_in_exactly(spring):
+    hp = HeatPathParams()
+    m = sector_mesh(spring, hp, 8e-3)
+    for dt in (0.25, 0.5, 1.0):
+        s = schedule_for(m, hp, dt)
+        t = s.increment_times()
+        heat = np.sum(np.diff(np.r_[0.0, t]) * s.flux(t)) * m.face_area_m2["FRICTION"].sum() * m.disc_factor
+        assert heat == pytest.approx(hp.launches * hp.slip_energy_J * hp.facing_heat_share, rel=1e-9)
+
+
+def test_first_order_matches_the_exponential():
+    """The backward-Euler ODE converges to the closed form of a step in theta_cm."""
+    dt = np.full(4000, 0.005)
+    t = np.cumsum(dt)
+    y = first_order(np.full_like(t, 120.0), dt, 20.0, 7.0, 0.7)
+    exact = 20.0 + 0.7 * 100.0 * (1.0 - np.exp(-t / 7.0))
+    assert np.max(np.abs(y - exact)) < 0.02
+
+
+def _slab(n: int = 2, size: float = 0.01, thick: float = 1e-3) -> HeatMesh:
+    """n x n x 1 steel bricks, top faces FRICTION."""
+    xs = np.linspace(0.0, size, n + 1)
+    nodes = np.array([(x, y, z) for x in xs for y in xs for z in (0.0, thick)])
+    idx = lambda i, j, k: (i * (n + 1) + j) * 2 + k  # noqa: E731
+    el = np.array([[idx(i, j, 0), idx(i + 1, j, 0), idx(i + 1, j + 1, 0), idx(i, j + 1, 0),
+                    idx(i, j, 1), idx(i + 1, j, 1), idx(i + 1, j + 1, 1), idx(i, j + 1, 1)]
+                   for i in range(n) for j in range(n)])
+    ne = len(el)
+    vol = np.full(ne, (size / n) ** 2 * thick)
+    faces = {"FRICTION": np.column_stack([np.arange(ne), np.full(ne, 2)])}
+    return HeatMesh(nodes, el, np.full(ne, 45.0), np.full(ne, 7850.0), np.full(ne, 477.0), vol, {"ALL": np.arange(ne)},
+                    faces, {"FRICTION": np.full(ne, (size / n) ** 2)}, 1, size / n)
+
+
+@pytest.mark.ccx
+def test_lumped_slab_closed_form(tmp_path):
+    """A thin steel slab (Biot 2e-5) under a constant flux with a film on the same face is a lumped body:
+    T(t) = Ta + q/h (1 - exp(-t h A / (rho c V))). Same deck writer, runner and reader as heat-path."""
+    from cushion_clutch.fe.ccx import run_ccx
+    mesh = _slab()
+    q, h, ta = 5000.0, 500.0, 20.0
+    sched = Schedule((0.0, 1e3), (q, q), (Phase(40.0, 400, 1),), ta)
+    run_ccx(write_deck(mesh, sched, {"FRICTION": h}), tmp_path, "slab")
+    times, temps = parse_temperatures((tmp_path / "slab.dat").read_text(), len(mesh.nodes))
+    tau = 7850.0 * 477.0 * 1e-3 / h
+    exact = ta + q / h * (1.0 - np.exp(-times / tau))
+    mean = temps.mean(axis=1)
+    assert np.max(np.abs(mean - exact)) / (q / h) < 0.01               # backward Euler, dt = tau / 75
+    # and the backward-Euler recursion of the lumped body (the rest: the through-thickness gradient)
+    be = first_order(np.full_like(times, ta + q / h), np.full_like(times, 0.1), ta, tau, 1.0)
+    assert np.max(np.abs(mean - be)) / (q / h) < 2e-3
+
+
+@pytest.mark.ccx
+def test_coarse_heat_path_meets_the_bars(tmp_path, spring):
+    from cushion_clutch.fe.heat_path import run_heat_path
+    res = run_heat_path(spring, HeatPathParams(), tmp_path, coarse=True, uncertainty=False)
+    on_disk = json.loads((tmp_path / "heat_path.json").read_text())
+    for key in ("U_W_per_K", "H_W_per_K", "C_J_per_K", "tau_s", "steel_mass_kg", "energy_balance_error",
+                "tau_mesh_change"):
+        assert on_disk[key] == pytest.approx(res[key])
+        assert math.isfinite(res[key])
+    lo, hi = (res["steel_mass_kg"] * c for c in STEEL_C_RANGE_J_PER_KG_K)
+    assert 0.9 * lo <= res["C_J_per_K"] <= 1.1 * hi
+    assert res["energy_balance_error"] < 0.01
+    assert res["tau_mesh_change"] < 0.05
+    assert 0 < res["tau_s"] < 1e3
+    assert res["tau_s"] == pytest.approx(res["C_J_per_K"] / (res["U_W_per_K"] + res["H_W_per_K"]))
+    # 16 paddles of 0.42 mm steel on the spring file's sector
+    g = spring.geometry
+    assert res["steel_mass_kg"] == pytest.approx(2 * spring.n_pairs * 7850 * g.thickness_m * 0.5 * math.radians(
+        g.span_deg) * (g.outer_radius_m ** 2 - g.inner_radius_m ** 2), rel=2e-3)
+    assert res["ode_rms_error_K"] < 0.1 * res["theta_cs_max_rise_K"]
+    assert all(res["checks"].values())
+    for f in ("heat_path.png", "heat_path_series.csv", "heat_path_set.toml", "heat_path_numbers.md"):
+        assert (tmp_path / f).stat().st_size > 0
+    from cushion_clutch.model.thermal_set import load_thermal_set
+    s = load_thermal_set(tmp_path / "heat_path_set.toml")
+    assert s.tau_s == pytest.approx(res["tau_s"], rel=1e-9)

@@ -328,6 +328,7 @@ def _import_scan(args: argparse.Namespace) -> int:
 
 
 def _heat_path(args: argparse.Namespace) -> int:
+    from .data import DEFAULT_SPRING
     from .fe.heat_params import HeatPathParams
     from .fe.heat_path import run_heat_path
     from .fe.params import load_params
@@ -345,10 +346,10 @@ def _heat_path(args: argparse.Namespace) -> int:
     def progress(msg: str) -> None:
         print(f"[{time.perf_counter() - start:6.0f} s] {msg}", flush=True)
 
-    command = "cushion-clutch heat-path " + " ".join(sys.argv[2:]) if sys.argv[1:2] == ["heat-path"] else \
-        "cushion-clutch heat-path --out " + str(out) + (" --coarse" if args.coarse else "")
-    from .data import DEFAULT_SPRING as shipped
-    source = (f"{params.name} (shipped)" if Path(args.spring).resolve() == Path(shipped).resolve()
+    command = ("cushion-clutch heat-path" + (f" --spring {Path(args.spring).name}" if args.spring != DEFAULT_SPRING
+                                             else "") + f" --out {out.name}" + (" --coarse" if args.coarse else "")
+               + (" --no-uncertainty" if args.no_uncertainty else ""))     # no paths in the provenance
+    source = (f"{params.name} (shipped)" if Path(args.spring).resolve() == Path(DEFAULT_SPRING).resolve()
               else Path(args.spring).name)
     if args.jobs is None or args.jobs < 1:
         raise ParameterError([f"--jobs {args.jobs}: must be at least 1"])

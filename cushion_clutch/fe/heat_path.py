@@ -253,6 +253,7 @@ def run_heat_path(spring: SpringParams, hp: HeatPathParams, out: Path, coarse: b
     Returns the JSON's content.
     """
     say = progress or (lambda msg: None)
+    commit = _commit()                                  # before the runs: the code that made the numbers
     out.mkdir(parents=True, exist_ok=True)
     meshes = COARSE_MESHES_M if coarse else MESHES_M
     dt_s = COARSE_DT_S if coarse else DT_S
@@ -329,7 +330,7 @@ def run_heat_path(spring: SpringParams, hp: HeatPathParams, out: Path, coarse: b
         "spring": spring_source or spring.name,
         "coarse": coarse,
         "command": command,
-        "commit": _commit(),
+        "commit": commit,
         "ccx_version": ccx_version(),
     }
     (out / "heat_path.json").write_text(json.dumps(result, indent=2) + "\n")
@@ -344,13 +345,14 @@ def run_heat_path(spring: SpringParams, hp: HeatPathParams, out: Path, coarse: b
 
 
 def _commit() -> str:
-    """The package's git commit (``-dirty`` with uncommitted changes), or ``unknown``."""
+    """The package's git commit, ``-dirty`` if the FE code (``cushion_clutch/fe``, which holds the spring
+    files too) has uncommitted changes; ``unknown`` outside a git checkout."""
     import subprocess
     here = Path(__file__).resolve().parent
     try:
         rev = subprocess.run(["git", "-C", str(here), "rev-parse", "--short=12", "HEAD"], capture_output=True,
                              text=True, timeout=10).stdout.strip()
-        dirty = subprocess.run(["git", "-C", str(here), "status", "--porcelain", "--untracked-files=no"],
+        dirty = subprocess.run(["git", "-C", str(here), "status", "--porcelain", "--untracked-files=no", "--", "."],
                                capture_output=True, text=True, timeout=10).stdout.strip()
     except (OSError, subprocess.SubprocessError):
         return "unknown"

@@ -122,3 +122,91 @@ def test_coarse_heat_path_meets_the_bars(tmp_path, spring):
     from cushion_clutch.model.thermal_set import load_thermal_set
     s = load_thermal_set(tmp_path / "heat_path_set.toml")
     assert s.tau_s == pytest.approx(res["tau_s"], rel=1e-9)
+
+
+DOCS = __import__("pathlib").Path(__file__).resolve().parents[1] / "docs"
+
+
+def test_docs_numbers_are_the_shipped_sets():
+    """The docs page's numbers block is what heat-path wrote for the shipped fe_default set."""
+    from cushion_clutch.fe.heat_report import numbers_markdown
+    from cushion_clutch.model.thermal_set import load_thermal_set, sets_folder
+    res = json.loads((sets_folder() / "fe_default.json").read_text())
+    text = (DOCS / "explanation" / "heat_path.md").read_text(encoding="utf-8")
+    block = text.split("<!-- heat-path numbers: begin -->", 1)[1].split("<!-- heat-path numbers: end -->", 1)[0]
+    assert block.strip() == numbers_markdown(res).strip()
+    s = load_thermal_set("fe_default")
+    assert (s.U_W_per_K, s.H_W_per_K, s.C_J_per_K) == (res["U_W_per_K"], res["H_W_per_K"], res["C_J_per_K"])
+    assert s.provenance["commit"] == res["commit"] and not res["coarse"]
+    assert all(res["checks"].values())
+
+
+def test_fmu_default_stays_the_papers_set():
+    from cushion_clutch.model.clutch_model import start_values
+    from cushion_clutch.model.thermal_set import load_thermal_set
+    sv = start_values()
+    assert (sv["U"], sv["H"], sv["C"]) == (0.1, 0.04, 1.0)
+    assert load_thermal_set("paper").parameters() == {"U": 0.1, "H": 0.04, "C": 1.0}
+
+
+def test_bad_thermal_set_names_the_key(tmp_path):
+    from cushion_clutch.errors import ParameterError
+    from cushion_clutch.model.thermal_set import load_thermal_set
+    with pytest.raises(ParameterError, match="not found"):
+        load_thermal_set("no_such_set")
+    bad = tmp_path / "bad.toml"
+    bad.write_text('U_W_per_K = -1.0\nH_W_per_K = 0.1\nC_J_per_K = 0.0\nextra = 1\n')
+    with pytest.raises(ParameterError) as exc:
+        load_thermal_set(bad)
+    text = str(exc.value)
+    assert "U_W_per_K" in text and "C_J_per_K" in text and "extra" in text
+
+
+def test_default_scenario_uses_the_fe_set_and_the_tcus_follow(tmp_path):
+    from cushion_clutch.errors import ParameterError
+    from cushion_clutch.launch.scenario import load_scenario, scenario_path
+    from cushion_clutch.model.thermal_set import load_thermal_set
+    sc = load_scenario(scenario_path("default"))
+    fe = load_thermal_set("fe_default")
+    assert sc.clutch.spring_thermal == "fe_default" and sc.spring_thermal_set() == fe
+    for sec in (sc.observer, sc.tcu_thermal):
+        assert (sec.spring_U_W_per_K, sec.spring_H_W_per_K, sec.spring_C_J_per_K) == \
+            (fe.U_W_per_K, fe.H_W_per_K, fe.C_J_per_K)
+    own = tmp_path / "own.toml"
+    own.write_text('extends = "default"\n[clutch]\nspring_thermal = "paper"\n[observer]\nspring_C_J_per_K = 2.0\n')
+    sc2 = load_scenario(own)
+    assert sc2.spring_thermal_set().C_J_per_K == 1.0 and sc2.observer.spring_C_J_per_K == 2.0
+    assert sc2.tcu_thermal.spring_C_J_per_K == 1.0
+    own.write_text('extends = "default"\n[clutch]\nspring_thermal = "nope"\n')
+    with pytest.raises(ParameterError, match="clutch.spring_thermal"):
+        load_scenario(own)
+
+
+def test_cli_heat_path_bad_input_exits_2(tmp_path, capsys):
+    from cushion_clutch.cli import main
+    f = tmp_path / "file"
+    f.write_text("x")
+    assert main(["heat-path", "--out", str(f)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error:") and "--out" in err and "Traceback" not in err
+    assert main(["heat-path", "--out", str(tmp_path / "o"), "--spring", str(tmp_path / "missing.toml")]) == 2
+
+
+@pytest.mark.fmu
+def test_native_fmu_takes_the_fe_set_as_start_values(tmp_path):
+    """The default FMU declares the paper's U, H, C; given fe_default's as start values, its theta_cs follows
+    a step of theta_cm with the set's tau and gain (a start-value set, as the launch plant applies it)."""
+    import fmpy
+    from cushion_clutch.data import DEFAULT_TABLES
+    from cushion_clutch.fmu.build import build_fmu
+    from cushion_clutch.model.thermal_set import load_thermal_set
+    fmu = build_fmu(DEFAULT_TABLES, tmp_path / "c.fmu", backend="native")
+    md = fmpy.read_model_description(str(fmu))
+    starts = {v.name: float(v.start) for v in md.modelVariables if v.name in ("U", "H", "C")}
+    assert starts == {"U": 0.1, "H": 0.04, "C": 1.0}
+    s = load_thermal_set("fe_default")
+    res = fmpy.simulate_fmu(str(fmu), stop_time=s.tau_s, output_interval=s.tau_s / 50, fmi_type="CoSimulation",
+                            start_values={**s.parameters(), "theta_a": 293.15, "theta_cs_start": 293.15,
+                                          "theta_cm": 393.15}, output=["theta_cs"])
+    rise = res["theta_cs"][-1] - 293.15
+    assert rise == pytest.approx(100.0 * s.gain * (1.0 - math.exp(-1.0)), rel=1e-3)

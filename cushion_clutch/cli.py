@@ -348,13 +348,15 @@ def _heat_path(args: argparse.Namespace) -> int:
 
     command = ("cushion-clutch heat-path" + (f" --spring {Path(args.spring).name}" if args.spring != DEFAULT_SPRING
                                              else "") + f" --out {out.name}" + (" --coarse" if args.coarse else "")
-               + (" --no-uncertainty" if args.no_uncertainty else ""))     # no paths in the provenance
+               + (" --no-uncertainty" if args.no_uncertainty else "")
+               + (" --kiss-shift" if args.kiss_shift else ""))                # no paths in the provenance
     source = (f"{params.name} (shipped)" if Path(args.spring).resolve() == Path(DEFAULT_SPRING).resolve()
               else Path(args.spring).name)
     if args.jobs is None or args.jobs < 1:
         raise ParameterError([f"--jobs {args.jobs}: must be at least 1"])
     res = run_heat_path(params, HeatPathParams(), out, coarse=args.coarse, uncertainty=not args.no_uncertainty,
-                        jobs=args.jobs, progress=progress, spring_source=source, command=command)
+                        jobs=args.jobs, progress=progress, spring_source=source, command=command,
+                        kiss_shift=args.kiss_shift)
     u = res["uncertainty"]
 
     def band(key: str) -> str:
@@ -367,6 +369,11 @@ def _heat_path(args: argparse.Namespace) -> int:
           f"tau change between the two finest meshes {res['tau_mesh_change']:.1%}")
     print(f"first-order ODE against the FE: RMS {res['ode_rms_error_K']:.3g} K, max {res['ode_max_error_K']:.3g} K "
           f"(theta_cs rise {res['theta_cs_max_rise_K']:.3g} K); two lags: RMS {res['two_lags']['rms_error_K']:.3g} K")
+    ks = res.get("kiss_shift")
+    if ks:
+        d = {k: ("failed" if v is None else f"{v * 1e3:.3f} mm") for k, v in ks["delta_kiss_m"].items()}
+        print(f"kiss shift at {ks['theta_degC']:g} degC (paper: 0.1 mm): " + ", ".join(f"{k} {v}" for k, v in d.items())
+              + f" (kappa FE {ks['kappa_fe']:.3f}, spring file {ks['kappa_spring']:g})")
     for w in res["warnings"]:
         print(f"warning: {w}", file=sys.stderr)
     print(f"wrote {out / 'heat_path.json'}, heat_path.png, heat_path_series.csv, heat_path_set.toml, "
@@ -602,6 +609,9 @@ def build_parser() -> argparse.ArgumentParser:
                                                           "a quick check, not the shipped numbers")
     hp.add_argument("--no-uncertainty", action="store_true",
                     help="skip the re-solves at the uncertain inputs' bounds (no uncertainty in the output)")
+    hp.add_argument("--kiss-shift", action="store_true",
+                    help="also solve the paddle FE at 195 degC under the FE's temperature field and uniformly "
+                         "(kiss shift, in heat_path.json; the table sets are not changed)")
     _jobs(hp, "parallel ccx jobs (default 2)", default=2)
 
     to = _command(sub, "tolerance", _tolerance, "tolerance study: sampled springs swept on Dask, P5/P50/P95 bands",

@@ -210,3 +210,18 @@ def test_native_fmu_takes_the_fe_set_as_start_values(tmp_path):
                                           "theta_cm": 393.15}, output=["theta_cs"])
     rise = res["theta_cs"][-1] - 293.15
     assert rise == pytest.approx(100.0 * s.gain * (1.0 - math.exp(-1.0)), rel=1e-3)
+
+
+def test_field_shape_of_a_uniform_rise_is_one(spring):
+    """A uniform rise gives the shape 1 everywhere and a carrier-to-paddle ratio of 1; a doubled carrier 2."""
+    from cushion_clutch.fe.kiss_field import field_shape
+    m = sector_mesh(spring, HeatPathParams(), 8e-3)
+    t = np.array([10.0, 20.0, 30.0])
+    temps = np.full((3, len(m.nodes)), 50.0)
+    centres, shape, kappa = field_shape(m, t, temps, 20.0, (15.0, 30.0))
+    assert np.allclose(shape, 1.0) and kappa == pytest.approx(1.0)
+    assert centres[:, 0].min() > spring.geometry.inner_radius_m and centres[:, 1].max() < spring.geometry.span_deg
+    car = np.unique(m.elements[m.element_sets["CARRIER"]])
+    only = np.setdiff1d(car, np.unique(m.elements[m.element_sets["JOINT"]]))
+    temps[:, only] = 80.0
+    assert field_shape(m, t, temps, 20.0, (15.0, 30.0))[2] == pytest.approx(2.0, rel=0.05)

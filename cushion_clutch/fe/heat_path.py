@@ -34,6 +34,7 @@ from .ccx import ccx_version, run_ccx
 from .heat_deck import Schedule, launch_schedule, parse_temperatures, write_deck
 from .heat_mesh import HeatMesh, sector_mesh
 from .heat_params import STEEL_C_RANGE_J_PER_KG_K, UNCERTAIN, HeatPathParams
+from .kiss_field import field_shape
 from .params import SpringParams
 
 #: in-plane element sizes, m (3x finer across the crest strip and the rivets): the default run and
@@ -71,6 +72,10 @@ class CaseResult:
         Cumulative heat in, heat stored (above the initial state), heat lost (whole disc), J.
     paddle_mass_kg : float
         Steel of the paddles (whole disc), kg.
+    paddle_field : tuple
+        Paddle element centres (r m, phi deg), their temperature rise over the paddle's mean rise, and the
+        carrier's mean rise over the paddle's, averaged over the last launch period
+        (:func:`.kiss_field.field_shape`).
     """
 
     element_size_m: float
@@ -89,6 +94,7 @@ class CaseResult:
     stored_J: np.ndarray
     lost_J: np.ndarray
     paddle_mass_kg: float
+    paddle_field: tuple = ()
 
 
 def films(hp: HeatPathParams) -> dict[str, float]:
@@ -140,7 +146,9 @@ def reduce_case(mesh: HeatMesh, hp: HeatPathParams, sched: Schedule, times: np.n
     return CaseResult(mesh.element_size_m, len(mesh.nodes), len(mesh.elements), len(t_inc), wall_time_s, t_inc, dt,
                       mean("FACING"), mean("PADDLE"), mean("CARRIER"),
                       _flow(mesh, temps, "INTERFACE") * -f, _flow(mesh, temps, "JOINT") * -f,
-                      np.cumsum(q_in * dt) * f, stored, np.cumsum(loss * dt) * f, mesh.mass_kg("PADDLE") * f)
+                      np.cumsum(q_in * dt) * f, stored, np.cumsum(loss * dt) * f, mesh.mass_kg("PADDLE") * f,
+                      field_shape(mesh, t_inc, temps, hp.ambient_degC,
+                                  ((hp.launches - 1) * hp.launch_period_s, hp.launches * hp.launch_period_s)))
 
 
 def solve_case(spring: SpringParams, hp: HeatPathParams, element_size_m: float, workdir: Path,
@@ -246,7 +254,7 @@ def _solve_all(spring: SpringParams, jobs_: list[tuple[str, HeatPathParams, floa
 
 def run_heat_path(spring: SpringParams, hp: HeatPathParams, out: Path, coarse: bool = False,
                   uncertainty: bool = True, jobs: int = 2, progress: Callable[[str], None] | None = None,
-                  spring_source: str = "", command: str = "") -> dict:
+                  spring_source: str = "", command: str = "", kiss_shift: bool = False) -> dict:
     """Solve the meshes, identify, propagate the uncertain inputs; write ``heat_path.json``, the plot, the
     series, the parameter set (``heat_path_set.toml``) and the docs table (``heat_path_numbers.md``).
 
@@ -333,6 +341,10 @@ def run_heat_path(spring: SpringParams, hp: HeatPathParams, out: Path, coarse: b
         "commit": commit,
         "ccx_version": ccx_version(),
     }
+    if kiss_shift:
+        from .kiss_field import kiss_shift_study
+        say("kiss shift at 195 degC: the FE's paddle field against a uniform temperature (4 structural cases)")
+        result["kiss_shift"] = kiss_shift_study(spring, best.paddle_field, out, jobs=jobs, say=say)
     (out / "heat_path.json").write_text(json.dumps(result, indent=2) + "\n")
     _write_series(best, ident, hp, out / "heat_path_series.csv")
     from .heat_plots import plot_heat_path

@@ -39,4 +39,17 @@ def numbers_markdown(result: dict) -> str:
             f"RMS / max | {tl['rms_error_K']:.3f} K / {tl['max_error_K']:.3f} K | - |",
             f"| U from the integrated heat flow instead (identification spread) | "
             f"{result['U_integrated_W_per_K']:.3g} W/K | - |"]
+    ks = result.get("kiss_shift")
+    if ks:
+        names = {"uniform_kappa_spring": f"uniform paddle temperature, carrier at κ = {ks['kappa_spring']:g} of its rise "
+                                         "(the sweep's case)",
+                 "uniform_kappa_fe": f"uniform paddle temperature, carrier at the FE's κ = {ks['kappa_fe']:.3f}",
+                 "field_kappa_fe": f"the FE's paddle field ({ks['field_min_over_mean']:.2f} to "
+                                   f"{ks['field_max_over_mean']:.2f} of its mean rise), carrier at κ = {ks['kappa_fe']:.3f}"}
+        out += ["", f"| kiss shift at {ks['theta_degC']:g} °C (paddle mean), pair, structural mesh "
+                    f"{ks['mesh_m'] * 1e3:g} mm | Δ kiss | paper |", "|---|---|---|"]
+        for key, label in names.items():
+            v = ks["delta_kiss_m"].get(key)
+            out.append(f"| {label} | {'failed: ' + ks['errors'].get(key, '') if v is None else f'{v * 1e3:.3f} mm'} | "
+                       f"{ks['paper_delta_kiss_m'] * 1e3:g} mm |")
     return "\n".join(out) + "\n"

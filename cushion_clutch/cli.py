@@ -406,6 +406,60 @@ def _import_scan(args: argparse.Namespace) -> int:
     return 0
 
 
+def _heat_path(args: argparse.Namespace) -> int:
+    from .data import DEFAULT_SPRING
+    from .fe.heat_params import HeatPathParams
+    from .fe.heat_path import run_heat_path
+    from .fe.params import load_params
+
+    if not args.out:
+        raise ParameterError(["--out is required: the folder for heat_path.json, the plot and the series"])
+    params = load_params(args.spring)
+    out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        raise ParameterError([f"--out {out} is a file; give a folder"])
+    from .outputs import check_writable
+    check_writable(out)
+    start = time.perf_counter()
+
+    def progress(msg: str) -> None:
+        print(f"[{time.perf_counter() - start:6.0f} s] {msg}", flush=True)
+
+    command = ("cushion-clutch heat-path" + (f" --spring {Path(args.spring).name}" if args.spring != DEFAULT_SPRING
+                                             else "") + f" --out {out.name}" + (" --coarse" if args.coarse else "")
+               + (" --no-uncertainty" if args.no_uncertainty else "")
+               + (" --kiss-shift" if args.kiss_shift else ""))                # no paths in the provenance
+    source = (f"{params.name} (shipped)" if Path(args.spring).resolve() == Path(DEFAULT_SPRING).resolve()
+              else Path(args.spring).name)
+    if args.jobs is None or args.jobs < 1:
+        raise ParameterError([f"--jobs {args.jobs}: must be at least 1"])
+    res = run_heat_path(params, HeatPathParams(), out, coarse=args.coarse, uncertainty=not args.no_uncertainty,
+                        jobs=args.jobs, progress=progress, spring_source=source, command=command,
+                        kiss_shift=args.kiss_shift)
+    u = res["uncertainty"]
+
+    def band(key: str) -> str:
+        return f" (-{u[key]['minus_fraction']:.0%}/+{u[key]['plus_fraction']:.0%})" if key in u else ""
+    print(f"U = {res['U_W_per_K']:.3g} W/K{band('U_W_per_K')}, H = {res['H_W_per_K']:.3g} W/K{band('H_W_per_K')}, "
+          f"C = {res['C_J_per_K']:.3g} J/K{band('C_J_per_K')}, tau = {res['tau_s']:.3g} s{band('tau_s')} "
+          f"(paper: 0.1 W/K, 0.04 W/K, 1 J/K, 7.1 s)")
+    print(f"C / (steel mass {res['steel_mass_kg'] * 1e3:.1f} g x c {res['steel_specific_heat_J_per_kg_K']:g} J/(kg K)) = "
+          f"{res['C_over_mass_c']:.3f}; energy balance error {res['energy_balance_error']:.2e}; "
+          f"tau change between the two finest meshes {res['tau_mesh_change']:.1%}")
+    print(f"first-order ODE against the FE: RMS {res['ode_rms_error_K']:.3g} K, max {res['ode_max_error_K']:.3g} K "
+          f"(theta_cs rise {res['theta_cs_max_rise_K']:.3g} K); two lags: RMS {res['two_lags']['rms_error_K']:.3g} K")
+    ks = res.get("kiss_shift")
+    if ks:
+        d = {k: ("failed" if v is None else f"{v * 1e3:.3f} mm") for k, v in ks["delta_kiss_m"].items()}
+        print(f"kiss shift at {ks['theta_degC']:g} degC (paper: 0.1 mm): " + ", ".join(f"{k} {v}" for k, v in d.items())
+              + f" (kappa FE {ks['kappa_fe']:.3f}, spring file {ks['kappa_spring']:g})")
+    for w in res["warnings"]:
+        print(f"warning: {w}", file=sys.stderr)
+    print(f"wrote {out / 'heat_path.json'}, heat_path.png, heat_path_series.csv, heat_path_set.toml, "
+          f"heat_path_numbers.md in {time.perf_counter() - start:.0f} s")
+    return 0
+
+
 def _tolerance(args: argparse.Namespace) -> int:
     import numpy as np
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
@@ -647,6 +701,27 @@ def build_parser() -> argparse.ArgumentParser:
     im.add_argument("--datum", choices=("rigid", "offset"), default="rigid",
                     help="fit tilt and offset on the rivet zone (default) or the offset only")
     im.add_argument("--crop", action="store_true", help="drop points off the paddle sector instead of refusing")
+
+    hp = _command(sub, "heat-path", _heat_path,
+                  "identify the cushion spring's heat path (U, H, C) from a transient thermal CalculiX FE",
+                  "Solve a transient heat-transfer FE of one paddle pair's sector of the disc (facing, paddle, "
+                  "rivets, carrier, with contact conductances and films) under a launch-like flux history on "
+                  "two or three meshes, and fit the paper's first-order ODE (eq. 2-4) of the cushion-spring "
+                  "temperature to it: U, H, C and tau for the whole disc, with uncertainties from re-solving at "
+                  "the bounds of the uncertain inputs, the ODE's error, a two-time-constant alternative, the "
+                  "energy balance and the mesh change of tau. Writes heat_path.json, a plot, the time series, "
+                  "a thermal parameter set (TOML) and a markdown table for the docs. Needs ccx on the PATH.",
+                  "cushion-clutch heat-path --coarse --out out_heat")
+    hp.add_argument("--spring", default=DEFAULT_SPRING, help="spring parameter TOML (geometry of the paddles)")
+    _out(hp, "output folder (required)")
+    hp.add_argument("--coarse", action="store_true", help="two coarse meshes (6 and 4 mm) and larger time steps: "
+                                                          "a quick check, not the shipped numbers")
+    hp.add_argument("--no-uncertainty", action="store_true",
+                    help="skip the re-solves at the uncertain inputs' bounds (no uncertainty in the output)")
+    hp.add_argument("--kiss-shift", action="store_true",
+                    help="also solve the paddle FE at 195 degC under the FE's temperature field and uniformly "
+                         "(kiss shift, in heat_path.json; the table sets are not changed)")
+    _jobs(hp, "parallel ccx jobs (default 2)", default=2)
 
     to = _command(sub, "tolerance", _tolerance, "tolerance study: sampled springs swept on Dask, P5/P50/P95 bands",
                   "Draw springs from the [tolerances] of a spring TOML (Latin hypercube or Monte Carlo), sweep "

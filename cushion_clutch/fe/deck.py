@@ -154,8 +154,13 @@ def carrier_displacement(nodes_m: np.ndarray, params: SpringParams, theta_degC: 
     return strain * np.asarray(nodes_m)[:, :2]
 
 
-def paddle_deck(assembly: Assembly, params: SpringParams, theta_degC: float) -> tuple[str, DeckInfo]:
+def paddle_deck(assembly: Assembly, params: SpringParams, theta_degC: float,
+                node_temperatures_degC: np.ndarray | None = None) -> tuple[str, DeckInfo]:
     """CalculiX deck of one temperature case.
+
+    ``node_temperatures_degC`` (one per paddle node, in the mesh's order), if given, replaces the uniform
+    ``theta_degC`` of step 1 by that field (``cushion-clutch heat-path --kiss-shift``); the carrier still
+    follows ``theta_degC`` through ``carrier.temperature_ratio``.
 
     Step 1 heats the paddle(s) uniformly from the reference temperature to
     ``theta_degC`` with both plates held, the clamped zone and the far-end
@@ -204,7 +209,10 @@ def paddle_deck(assembly: Assembly, params: SpringParams, theta_degC: float) -> 
               "0.25, 1.0, 1e-6, 0.5", "*BOUNDARY"]
     for n, (ux, uy) in zip(held_ids, disp):
         lines += [f"{n}, 1, 1, {_fmt(ux)}", f"{n}, 2, 2, {_fmt(uy)}"]
-    lines += ["*TEMPERATURE", f"NPADDLE, {_fmt(theta_degC)}"]
+    if node_temperatures_degC is None:
+        lines += ["*TEMPERATURE", f"NPADDLE, {_fmt(theta_degC)}"]
+    else:
+        lines += ["*TEMPERATURE", *(f"{i + 1}, {_fmt(t)}" for i, t in enumerate(node_temperatures_degC))]
     lines += _print_block()
     lines.append("*END STEP")
 

@@ -256,12 +256,17 @@ class Clutch(Checked):
     """table-set folder of the plant (relative to the scenario's folder); "" = the command's --tables"""
     tcu_tables: str = ""
     """table-set folder the TCUs believe; "" = the command's --tables"""
+    spring_thermal: str = "paper"
+    """the cushion spring's heat path (U, H, C of eq. 2) in the plant clutch FMU and, unless [observer] or
+    [tcu_thermal] give their own, in the TCUs' models: a named set (``paper``: the paper's 0.1 W/K, 0.04 W/K,
+    1 J/K, the FMU's defaults; ``fe_default``: identified by ``cushion-clutch heat-path``) or a set TOML
+    relative to the scenario's folder (:mod:`cushion_clutch.model.thermal_set`)"""
 
     _section = "clutch"
 
     def _problems(self) -> Iterable[str]:
         yield from self._ranges({"x_kiss_offset_m": (-0.005, 0.005), "facing_wear_m": (0.0, 0.004)})
-        for key in ("friction_csv", "plant_tables", "tcu_tables"):
+        for key in ("friction_csv", "plant_tables", "tcu_tables", "spring_thermal"):
             if not isinstance(getattr(self, key), str):
                 yield f"clutch.{key} = {getattr(self, key)!r}: must be a file or folder name or \"\""
 
@@ -347,6 +352,10 @@ class Scenario(Checked):
             return None
         path = Path(name)
         return path if path.is_absolute() else Path(self.folder or ".") / path
+
+    def spring_thermal_set(self):
+        """The plant's cushion-spring heat path (:class:`~cushion_clutch.model.thermal_set.ThermalSet`)."""
+        return _thermal_set(self.clutch.spring_thermal, self.folder)
 
     def friction_path(self) -> Path | None:
         """The plant's friction table file, or None (mu constant)."""
@@ -439,6 +448,34 @@ def _blame(problem: str, origin: dict, top: Path) -> str:
     return f"{problem} (set in {src})" if src is not None and src != top else problem
 
 
+def _thermal_set(name: str, folder: str):
+    """A thermal set by shipped name or a TOML file relative to ``folder``."""
+    from ..model.thermal_set import load_thermal_set
+    path = Path(name)
+    if path.suffix and not path.is_absolute():
+        path = Path(folder or ".") / path
+    return load_thermal_set(path if path.suffix else name)
+
+
+def _spring_thermal_defaults(data: dict, origin: dict, top: Path) -> None:
+    """The TCUs' cushion-spring models ([observer], [tcu_thermal] spring_*) default to the plant's set."""
+    clutch = data.get("clutch", {})
+    name = clutch.get("spring_thermal", "paper") if isinstance(clutch, dict) else "paper"
+    if not isinstance(name, str):
+        return                                      # the Clutch section's check names it
+    try:
+        ts = _thermal_set(name, str(top.parent))
+    except ParameterError as exc:
+        raise ParameterError([_blame(f"clutch.spring_thermal = {name!r}: " + "; ".join(exc.problems), origin, top)],
+                             str(top)) from None
+    for section in ("observer", "tcu_thermal"):
+        sec = data.setdefault(section, {})
+        if isinstance(sec, dict):
+            for key, value in (("spring_U_W_per_K", ts.U_W_per_K), ("spring_H_W_per_K", ts.H_W_per_K),
+                               ("spring_C_J_per_K", ts.C_J_per_K)):
+                sec.setdefault(key, value)
+
+
 def load_scenario(path: str | Path = DEFAULT_SCENARIO) -> Scenario:
     """Load and check a scenario TOML file (unknown keys and bad ranges rejected, naming the file that set them).
 
@@ -450,6 +487,7 @@ def load_scenario(path: str | Path = DEFAULT_SCENARIO) -> Scenario:
     top = Path(path).resolve()
     data, origin = merged_data(top)
     data["folder"] = str(top.parent)
+    _spring_thermal_defaults(data, origin, top)
     try:
         sc = build_checked(Scenario, data, str(path))
     except ParameterError as exc:

@@ -140,7 +140,9 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
     fac, tc, run, drv = sc.facing, sc.tcu, sc.run, sc.driver
     h = run.step_s
     theta_a, theta0 = fac.ambient_degC + KELVIN, fac.initial_degC + KELVIN
-    p = ClutchParameters(theta_a=theta_a, theta_cs_start=theta0)
+    spring_heat = sc.spring_thermal_set()               # the cushion spring's heat path (clutch.spring_thermal)
+    p = ClutchParameters(theta_a=theta_a, theta_cs_start=theta0, U=spring_heat.U_W_per_K, H=spring_heat.H_W_per_K,
+                         C=spring_heat.C_J_per_K)
     engine = EngineGovernor(sc.engine, h)
     dl = Driveline(sc, engine.w_idle)
     if name == "production":
@@ -175,6 +177,7 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
     prefill, drive_end = tc.prefill_s, tc.prefill_s + tc.drive_time_s
 
     clutch_start = {"theta_a": theta_a, "theta_cs_start": theta0, "x_kiss_ref": p.x_kiss_ref + sc.clutch.x_kiss_offset_m,
+                    **spring_heat.parameters(),
                     **({"facing_wear": sc.clutch.facing_wear_m} if sc.clutch.facing_wear_m else {})}
     if plant_start:
         clutch_start = plant_start_values(plant_start, clutch_start, p.x_kiss_ref, sc)

@@ -85,14 +85,38 @@ def test_lockup_counts_and_lines():
             {"engagement_time_s": 2.5, "protection_level": 2, "engine_stall": False},
             {"engagement_time_s": nan, "protection_level": 3, "engine_stall": False},
             {"engagement_time_s": nan, "protection_level": 1, "engine_stall": True}]
-    res = SimpleNamespace(metrics=rows)
+    res = SimpleNamespace(metrics=rows, stopped="")
     assert lockup_counts(res) == {"n": 4, "locked": 2, "inhibited": 1, "no_lockup": 1, "stalls": 1}
-    lines = lockup_lines({"production": res, "naive": SimpleNamespace(metrics=rows[:1])}).splitlines()
+    lines = lockup_lines({"production": res, "naive": SimpleNamespace(metrics=rows[:1], stopped="")}).splitlines()
     assert lines[1] == ("production: 2 of 4 launches locked up; 1 inhibited, 1 launched but never locked up, "
                         "1 engine stalls")
     assert lines[2] == "naive: 1 of 1 launches locked up"
     narrow = lockup_lines({"production": res}, width=40).splitlines()
     assert narrow[1] == "production: 2 of 4 launches locked up;" and narrow[2].startswith("  1 inhibited")
+    early = SimpleNamespace(metrics=rows[:1], stopped="launch 1, t = 3.00 s: the plant left the model's domain")
+    assert lockup_lines({"aware": early}).splitlines()[2] == (
+        "aware STOPPED EARLY, launch 1, t = 3.00 s: the plant left the model's domain")
+
+
+def test_a_run_that_leaves_the_model_s_domain_stops_there_and_says_so(tmp_path):
+    """A plant driven past the model's range (a facing above 800 K) ends the run at the refused step: the
+    launches up to it are kept, ``stopped`` names the launch and the time, and no later launch is invented."""
+    import dataclasses
+
+    from cushion_clutch.data import DEFAULT_TABLES
+    from cushion_clutch.launch.plant import build_plant_fmu
+    from cushion_clutch.launch.scenario import load_scenario, scenario_path
+    from cushion_clutch.launch.simulate import simulate_launches
+    from cushion_clutch.model import load_table
+
+    sc = load_scenario(scenario_path("fade"))
+    sc = dataclasses.replace(sc, run=dataclasses.replace(sc.run, launches=3),
+                             facing=dataclasses.replace(sc.facing, initial_degC=400.0))
+    fmu = build_plant_fmu(DEFAULT_TABLES, sc, tmp_path / "CushionClutch.fmu")
+    res = simulate_launches(fmu, sc, load_table(), "naive")
+    assert res.stopped.startswith("launch 2, t = ") and "left the model's domain" in res.stopped
+    assert len(res.metrics) == 2 and res.series["launch"].max() == 2.0
+    assert res.series["theta_cm_K"].max() <= 800.0
 
 
 def test_cli_protection_summary_counts_lock_ups_and_plots_name_the_scenario(tmp_path, capsys):

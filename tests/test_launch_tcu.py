@@ -31,10 +31,13 @@ def quiet(sc):
 
 
 def matched(sc):
-    """The observer's network with the plant's parameters."""
-    p = sc.plant_thermal
+    """The observer's network and cushion-spring heat path with the plant's parameters."""
+    p, spring = sc.plant_thermal, sc.spring_thermal_set()
     return dataclasses.replace(sc, observer=Observer(**{f.name: getattr(p, f.name)
-                                                        for f in dataclasses.fields(NetworkParams)}))
+                                                        for f in dataclasses.fields(NetworkParams)},
+                                                     spring_U_W_per_K=spring.U_W_per_K,
+                                                     spring_H_W_per_K=spring.H_W_per_K,
+                                                     spring_C_J_per_K=spring.C_J_per_K))
 
 
 def test_observer_with_matched_parameters_reproduces_theta_cm(fmu):

@@ -138,7 +138,7 @@ import numpy as np
 
 from ..config import Checked
 from ..model import ClutchParameters, SpringTable
-from ..model.clutch_model import THETA_MAX_K, THETA_MIN_K
+from ..model.clutch_model import hold_theta_cm
 from ..model.thermal_network import FACINGS, N_NODES, TcuNetworkBase, ThermalNetwork
 from .tcu_model import TcuClutchModel
 
@@ -427,13 +427,13 @@ class ClutchEkf:
         """The facing temperature the TCU's clutch model is evaluated at: :attr:`theta_cm` within the model's
         range ``[THETA_MIN_K, THETA_MAX_K]`` (an estimate beyond it, far past the facings' damage limit, must not
         stop the TCU), K."""
-        return min(max(self.theta_cm, THETA_MIN_K), THETA_MAX_K)
+        return hold_theta_cm(self.theta_cm)
 
     def _model_temperatures(self, s: np.ndarray) -> tuple[float, float]:
         """The temperatures the characteristic is evaluated at for state ``s``: ``theta_cs`` within the
         table's range and the facings' mean within the model's (the stack's growth there), K."""
         return (min(max(s.item(IX_CS), self.table.theta_min_K), self.table.theta_max_K),
-                min(max(0.5 * (s.item(F1) + s.item(F2)), THETA_MIN_K), THETA_MAX_K))
+                hold_theta_cm(0.5 * (s.item(F1) + s.item(F2))))
 
     @property
     def dx_kiss(self) -> float:

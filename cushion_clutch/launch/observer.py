@@ -11,6 +11,7 @@ from __future__ import annotations
 import random
 
 from ..model import ClutchParameters, thermal_step
+from ..model.clutch_model import hold_theta_cm
 from .tcu_params import Observer, Sensors
 from .thermal import FacingModel
 from ..model.thermal_network import ThermalNetwork
@@ -62,7 +63,8 @@ class FacingObserver:
 
     def update(self, p_slip_W: float, w_engine: float = 0.0, w_disc: float = 0.0, clamped: bool = False) -> None:
         """Advance over the last period; remember ``p_slip_W`` (W), the speeds (rad/s) and the clamp state."""
-        self.theta_cs = thermal_step(self.theta_cs, self.theta_cm, self.dt, self.p)
+        # the spring's ODE is driven by the facing estimate held within the model's range (hold_theta_cm)
+        self.theta_cs = thermal_step(self.theta_cs, hold_theta_cm(self.theta_cm), self.dt, self.p)
         if self.net is not None:
             self.net.step(self.dt, self.p_prev, *self.prev)
             self.theta_cm = self.net.theta_cm

@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import csv
 import math
+import textwrap
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Iterable
@@ -62,7 +63,8 @@ def lockup_counts(res: LaunchResult) -> dict:
 
 def lockup_lines(results: dict[str, LaunchResult], width: int = 100) -> str:
     """A heading, then one line per TCU: how many of its launches locked up, how many the thermal protection
-    inhibited (no launch) and how many launched but never locked up (a longer line continues indented)."""
+    inhibited (no launch) and how many launched but never locked up (a longer line continues indented); a run
+    that stopped early (the plant left the model's domain) says where and why."""
     out = ["launches locked up per TCU (inhibited: the TCU's thermal protection allowed no launch):"]
     for name, res in results.items():
         c = lockup_counts(res)
@@ -77,6 +79,8 @@ def lockup_lines(results: dict[str, LaunchResult], width: int = 100) -> str:
             out.append(f"{head}; {tail}")
         else:
             out += [head + ";", f"  {tail}"]
+        if res.stopped:                       # the plant left the model's domain: the run ended early
+            out += textwrap.wrap(f"{name} STOPPED EARLY, {res.stopped}", width, subsequent_indent="  ")
     return "\n".join(out)
 
 

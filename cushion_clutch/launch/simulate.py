@@ -38,6 +38,7 @@ import numpy as np
 from ..model import KELVIN, ClutchParameters, SpringTable
 from .driveline import Driveline, Energy
 from .engine import EngineGovernor
+from ..errors import FmuCallError
 from .fmu_client import ClutchFmu
 from .metrics import LaunchRecord
 from .observer import SpeedSensors
@@ -47,6 +48,9 @@ from .production import KeyOn, ProductionTcu, key_off, key_on
 from .tcu import CLOSE, LAUNCH, OPEN, PREFILL, VARIANTS, TcuController
 from .thermal import FacingModel
 from ..model.thermal_network import ThermalNetwork
+
+#: fmi2Discard: the status of a step the plant FMU refuses for an input outside its range
+DISCARD = 2
 
 __all__ = ["COLUMNS", "Energy", "LaunchResult", "PLANTS", "simulate_launches"]
 
@@ -90,6 +94,9 @@ class LaunchResult:
     """(s into the launch slot, launch, level, message): what the thermal protection told the driver"""
     plant: str = "python"
     """the plant loop that ran: ``native`` (compiled blocks, :mod:`.plant_block`) or ``python``"""
+    stopped: str = ""
+    """why and where the run ended early ("" for a complete run): the plant FMU refused a step because the plant
+    left the model's domain (e.g. a facing past 800 K); ``metrics`` then hold the launches up to that one"""
 
 
 def _facing_profile(path: str) -> Callable[[float], float]:
@@ -228,6 +235,7 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
         values, width, ix = native.values, native.width, native.ix
         o_kiss, o_theta_cs, o_t_cap, o_event = ix["x_kiss"], ix["theta_cs"], ix["t_cap"], ix["event"]
     wall0, cpu0 = time.perf_counter(), time.process_time()
+    stopped = ""
     try:
         k = 0
         while k < n_steps:
@@ -419,6 +427,17 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
             k += 1
         if native is not None:
             native.finish(rec)
+    except FmuCallError as exc:
+        if exc.status != DISCARD:
+            raise
+        # the plant FMU refused a step: the plant left the model's domain (its log names the input, e.g. a
+        # facing past THETA_MAX_K). The run ends there, honestly: the launches up to it are kept and the
+        # result says where and why it stopped (LaunchResult.stopped); nothing after it is invented.
+        stopped = (f"launch {n + 1}, t = {t:.2f} s: the plant left the model's domain ({exc}; the FMU's log "
+                   f"names the input); the run stops there")
+        if native is not None:
+            native.finish(rec)
+        recs = recs[:n + 1]
     finally:
         clutch.close()
     wall, cpu = time.perf_counter() - wall0, time.process_time() - cpu0
@@ -431,7 +450,7 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
         key_off(ctl, sc, keyed)
     return LaunchResult(name, series, metrics, dl.en, events, wall, total, cpu, learned, n_quiet * h_quiet, keyed,
                         ctl.protection.events if ctl.protection is not None else [],
-                        "native" if native is not None else "python")
+                        "native" if native is not None else "python", stopped)
 
 
 def plant_start_values(plant_start: dict, scenario_start: dict, x_kiss_ref_m: float, sc: Scenario) -> dict:

@@ -53,6 +53,7 @@ import math
 from dataclasses import dataclass
 
 from ..model import KELVIN, ClutchParameters, SpringTable, kiss_point, outputs, thermal_step, x_to_for_torque
+from ..model.clutch_model import hold_theta_cm
 from .adaptation import KissLearner
 from .observer import FacingObserver
 from .protection import LIMIT, ThermalProtection
@@ -186,10 +187,17 @@ class TcuController:
         return self.theta_cm_ideal if self.v.temperature == "ideal" else self.theta_cm_estimate()
 
     def theta_cm_used(self) -> float | None:
-        """The facing temperature the TCU's clutch model assumes (the stack's growth), K; None: theta_cs."""
+        """The facing temperature the TCU's clutch model assumes (the stack's growth), K; None: theta_cs.
+
+        Held within the model's range (:func:`~cushion_clutch.model.clutch_model.hold_theta_cm`), as the
+        production TCU's EKF holds it: an estimate past it must not stop the TCU."""
         if self.v.temperature == "ideal":
-            return self.theta_cm_ideal
-        return self.observer.theta_cm if self.observer is not None else None
+            theta = self.theta_cm_ideal
+        elif self.observer is not None:
+            theta = self.observer.theta_cm
+        else:
+            return None
+        return hold_theta_cm(theta)
 
     def model_kiss(self, theta: float) -> float:
         """The model's kiss point at ``theta`` (K), m (the cover's balance: cushion, growth, wear).
@@ -296,7 +304,7 @@ class TcuController:
         prot = self.protection
         self.mu_cal = tc.mu_calibration(w_e - w_d)
         if self.v.temperature == "ideal":
-            self.theta_ideal = thermal_step(self.theta_ideal, theta_cm_true, self.period, self.p)
+            self.theta_ideal = thermal_step(self.theta_ideal, hold_theta_cm(theta_cm_true), self.period, self.p)
             self.theta_cm_ideal = theta_cm_true
         elif self.observer is not None:
             slip = abs(w_e - w_d)

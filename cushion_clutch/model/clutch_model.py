@@ -115,6 +115,14 @@ X_TO_MAX = 0.025
 #: (a tolerance study's P95 spring on a coarse mesh) push the default cover past its hold at 950 K
 THETA_MIN_K = 200.0
 THETA_MAX_K = 800.0
+def hold_theta_cm(theta_cm: float) -> float:
+    """``theta_cm`` (K) held within the model's range ``[THETA_MIN_K, THETA_MAX_K]``: what a TCU's model is
+    evaluated at when its own facing estimate runs past the range (far beyond the facings' damage limit);
+    a characteristic holds its last point there, and the estimate itself is kept unclamped."""
+    return min(max(theta_cm, THETA_MIN_K), THETA_MAX_K)
+
+
+
 #: legacy names of the bounds (the pythonfmu slave): |x_to| <= X_TO_LIMIT, theta_cm < THETA_CM_LIMIT
 X_TO_LIMIT = X_TO_MAX
 THETA_CM_LIMIT = THETA_MAX_K

@@ -41,5 +41,18 @@ autodoc_typehints = "description"
 
 html_theme = "furo"
 html_title = f"cushion-clutch {__version__}"
-html_static_path = []
+html_static_path = ["_static"]
+html_css_files = ["cc.css"]                  # wide tables and code wrap at 1280 px (tests/test_site_browser.py)
 smartquotes = False                          # keep -- in option names as typed
+
+
+def _relative_paths(app, pagename, templatename, context, doctree) -> None:
+    """The checkout's absolute path (in argparse defaults and autodoc signatures: the package's data files)
+    written relative to the repository, so that no page names the machine that built it."""
+    for key in ("body", "toc", "metatags"):
+        if isinstance(context.get(key), str):
+            context[key] = context[key].replace(str(ROOT) + "/", "").replace(str(ROOT), ".")
+
+
+def setup(app):
+    app.connect("html-page-context", _relative_paths)

@@ -27,6 +27,7 @@ extensions = [
     "sphinx.ext.napoleon",
     "sphinxarg.ext",
     "fmu_variables",
+    "cc_numbers",                             # {cc}`name(args)`: numbers computed at build time
 ]
 source_suffix = {".md": "markdown", ".rst": "restructuredtext"}
 exclude_patterns = ["_build", "Thumbs.db", ".DS_Store"]

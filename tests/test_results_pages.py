@@ -102,3 +102,17 @@ def test_launch_page_layout_on_a_short_run(repo):
             key_rows += [line] if re.search(r"\| \d+ of \d+ \|", line) else []
     assert opened == closed == 2                              # one collapsed section per scenario
     assert len(key_rows) == 6 + 6 + 6                          # default; cooldown all + its cool-down group
+
+
+def test_doc_numbers_are_the_model_s():
+    """The {cc} role's numbers: the closed torque from the cover's budget equals the clutch model's torque with
+    the bearing far past lift-off (a second path through the model); an unknown name is refused by name."""
+    from cushion_clutch.benchmarks.doc_numbers import closed_torque_Nm, evaluate
+    from cushion_clutch.model import ClutchParameters, load_table, outputs
+
+    for theta, wear in ((20.0, 0.0), (195.0, 0.0), (300.0, 0.0), (20.0, 1.0)):
+        o = outputs(0.02, theta + 273.15, load_table(), ClutchParameters(facing_wear=wear * 1e-3))
+        assert closed_torque_Nm(theta, wear) == pytest.approx(o.torque, rel=1e-9), (theta, wear)
+    assert evaluate("closed_torque_Nm(20):.2f") == f"{closed_torque_Nm(20):.2f}"
+    with pytest.raises(KeyError, match="nonsense"):
+        evaluate("nonsense(1)")

@@ -115,6 +115,11 @@ def _fmt(value: float, spec: str) -> str:
     return "–" if value != value else format(value, spec)
 
 
+def _breakable(name: str) -> str:
+    """A TCU name that a narrow table column may wrap after its underscores (HTML ``<wbr>``, no character)."""
+    return name.replace("_", "_<wbr>")
+
+
 def key_table(rows: list[dict], group: str) -> str:
     """Markdown: the few figures that matter per TCU in ``group`` (rows of ``report.summary_rows``): the
     worst launch's largest characteristic error, the launches' mean RMS characteristic error, the worst
@@ -124,10 +129,10 @@ def key_table(rows: list[dict], group: str) -> str:
     for r in rows:
         if r["group"] != group:
             continue
-        cells = [r["tcu"], str(r["n"]), _fmt(r["characteristic_error_max_Nm_worst"], ".3f"),
+        cells = [_breakable(r["tcu"]), str(r["n"]), _fmt(r["characteristic_error_max_Nm_worst"], ".3f"),
                  _fmt(r["characteristic_error_rms_Nm_mean"], ".3f"), _fmt(r["theta_cs_error_K_worst"], "+.1f"),
                  _fmt(r["plant_theta_cm_peak_degC"], ".0f"), _fmt(r["plant_theta_cs_peak_degC"], ".0f"),
-                 f"{r['n'] - r['no_lockup']} of {r['n']}", str(r["inhibited_launches"])]
+                 f"{r['n'] - r['no_lockup']}\u00a0of\u00a0{r['n']}", str(r["inhibited_launches"])]
         lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines)
 
@@ -136,7 +141,7 @@ def full_table(rows: list[dict], group: str) -> str:
     """Markdown: every summarised metric (a row each, in words with its unit and its ``launch_summary.csv``
     name) against the TCUs (a column each), as ``mean / worst`` over the launches of ``group``."""
     rows = [r for r in rows if r["group"] == group]
-    lines = ["| metric (mean / worst) | " + " | ".join(r["tcu"] for r in rows) + " |",
+    lines = ["| metric (mean / worst) | " + " | ".join(_breakable(r["tcu"]) for r in rows) + " |",
              "|---|" + "--:|" * len(rows)]
     for col, (words, spec) in METRIC_WORDS.items():
         cells = [f"{_fmt(r[col + '_mean'], spec)} / {_fmt(r[col + '_worst'], spec)}" for r in rows]

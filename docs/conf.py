@@ -3,7 +3,9 @@
 Build: ``sphinx-build -W --keep-going -b html docs docs/_build/html`` (warnings are errors; MyST reports
 broken internal links as warnings). Sphinx because the command-line reference is generated from the
 argparse parser itself (sphinx-argparse), the Python reference from the numpydoc docstrings (autodoc +
-napoleon), and the pages stay Markdown (MyST), like the README.
+napoleon), and the pages stay Markdown (MyST), like the README. ``docs/_ext``: the FMU variable table and the
+``{cc}`` role (numbers computed at build time); ``docs/_static/cc.css``: wide tables and code wrap at 1280 px
+(``tests/test_site_browser.py`` checks it in headless Chromium).
 """
 from __future__ import annotations
 

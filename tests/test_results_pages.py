@@ -99,7 +99,7 @@ def test_launch_page_layout_on_a_short_run(repo):
             cells = header.strip("|").split("|")
             assert len(cells) <= 10, header[:80]
             assert not re.search(r"\b[a-z_]+_(Nm|K|degC|m_s2)\b(?!`)", header), header[:120]
-            key_rows += [line] if re.search(r"\| \d+\s of\s\d+ \|", line) else []
+            key_rows += [line] if re.search(r"\| \d+\sof\s\d+ \|", line) else []
     assert opened == closed == 2                              # one collapsed section per scenario
     assert "adaptive_<wbr>aware_<wbr>estimated" in text       # long TCU names may wrap in a narrow column
     assert len(key_rows) == 6 + 6 + 6                          # default; cooldown all + its cool-down group

@@ -1,6 +1,6 @@
-"""The documentation site as a reader sees it: the main pages rendered in headless Chromium (Debian's
-`chromium`, .ci/install) at 1280 px (and the other generated pages with wide tables). A table or code block wider than the content column, an image that does
-not load or an internal link that leads nowhere fails; every page of the site is free of the checkout's
+"""The documentation site as a reader sees it: the main pages (and the other generated pages with wide tables)
+rendered in headless Chromium (Debian's `chromium`, .ci/install) at 1280 px. A table or code block wider than
+the content column, an image that does not load or an internal link that leads nowhere fails; every page of the site is free of the checkout's
 absolute path and of ``+dirty``. Screenshots (full page, collapsed sections opened) are kept in
 ``docs/_build/screenshots/`` for review (CI artefacts, never committed).
 

@@ -35,7 +35,8 @@ CALIBRATION_SOURCES = ("cushion_clutch/benchmarks/calibrate.py", "cushion_clutch
 RECORDED = {
     "fe_vs_measured.png": ("python -m cushion_clutch.benchmarks.calibrate --png docs/fe_vs_measured.png",
                            CALIBRATION_SOURCES),
-    "fe_vs_measured_hot.png": ("python -m cushion_clutch.benchmarks.calibrate --hot --png docs/fe_vs_measured_hot.png",
+    "fe_vs_measured_hot.png": ("python -m cushion_clutch.benchmarks.calibrate --hot "
+                               "--png docs/fe_vs_measured_hot.png",
                                CALIBRATION_SOURCES),
 }
 INPUTS_FILE = Path(__file__).with_name("figure_inputs.json")

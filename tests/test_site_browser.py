@@ -1,8 +1,8 @@
 """The documentation site as a reader sees it: the main pages (and the other generated pages with wide tables)
 rendered in headless Chromium (Debian's `chromium`, .ci/install) at 1280 px. A table or code block wider than
-the content column, an image that does not load or an internal link that leads nowhere fails; every page of the site is free of the checkout's
-absolute path and of ``+dirty``. Screenshots (full page, collapsed sections opened) are kept in
-``docs/_build/screenshots/`` for review (CI artefacts, never committed).
+the content column, an image that does not load or an internal link that leads nowhere fails; every page of
+the site is free of the checkout's absolute path and of ``+dirty``. Screenshots (full page, collapsed sections
+opened) are kept in ``docs/_build/screenshots/`` for review (CI artefacts, never committed).
 
 How: the site is built into a temporary folder; each main page gets a copy beside it with a small script that
 opens every ``<details>``, measures the tables, code blocks and images after the page has loaded and writes

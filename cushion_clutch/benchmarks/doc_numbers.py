@@ -111,7 +111,8 @@ def evaluate(text: str) -> str:
 
 
 def main() -> None:
-    for text in ("closed_torque_Nm(20)", "closed_torque_Nm(195)", "closed_torque_Nm(300)", "closed_torque_Nm(20, 1)",
+    for text in ("closed_torque_Nm(20)", "closed_torque_Nm(195)", "closed_torque_Nm(300)",
+                 "closed_torque_Nm(20, 1)",
                  "kiss_shift_mm(195)", "kiss_shift_mm(300)", "kiss_shift_mm(20, 0.5)",
                  "cover_mm('diaphragm_thickness_m')", "cover_mm('installed_deflection_m')"):
         print(f"{text}: {evaluate(text)}")

@@ -169,7 +169,8 @@ def scenario_markdown(name: str, sc, results, mode_hz: float) -> str:
     rows = summary_rows(results)
     groups = [g for g in ("hot", "cool-down") if any(r["group"] == g for r in rows)]
     parts = [f"## `{name}`: {sc.description}\n\nlevels {', '.join(sc.driver.levels)}; first driveline mode "
-             f"{mode_hz:.2f} Hz; peak temperatures are the plant's over the whole run\n\n" + key_table(rows, "all")]
+             f"{mode_hz:.2f} Hz; peak temperatures are the plant's over the whole run\n\n"
+             + key_table(rows, "all")]
     for g in groups:
         parts.append(f"Launches of group `{g}` ({GROUP_WORDS[g]}):\n\n" + key_table(rows, g))
         parts.append("- " + ratio_line(results, g) + "\n- " + production_line(results, g))

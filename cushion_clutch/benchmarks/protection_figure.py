@@ -60,7 +60,8 @@ def figure(sc, results: dict, path: Path) -> list[str]:
             ax[1].step(t_min, s["protection_level"], where="post", color=COLOURS[name], label=f"{name} ({what})")
         k = peaks(res)
         lines.append(f"{name}: peak plant facing temperature {k['plant_theta_cm_peak_degC']:.0f} degC, "
-                     f"theta_cs {k['plant_theta_cs_peak_degC']:.0f} degC; {k['inhibited_launches']} inhibited launches")
+                     f"theta_cs {k['plant_theta_cs_peak_degC']:.0f} degC; "
+                     f"{k['inhibited_launches']} inhibited launches")
     damage = ClutchParameters().facing_damage_temperature_K - KELVIN
     marks = [(damage, "damage (seed paper)")]
     if prot is not None:

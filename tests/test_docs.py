@@ -133,6 +133,11 @@ def test_results_pages_say_what_made_them(page):
     text = page.read_text(encoding="utf-8")
     assert "Generated, not edited" in text and "Written by `python3 -m cushion_clutch.benchmarks." in text
     assert re.search(r"- commit: `[0-9a-f]{7,}", text) and "- machine: " in text and re.search(r"- date: \d{4}-", text)
+    # a clean tree and no machine path: page.py refuses a dirty tree unless --draft, which marks the page
+    from cushion_clutch.benchmarks.page import DRAFT_MARK
+    assert DRAFT_MARK not in text and "+dirty" not in text and "uncommitted changes" not in text, page.name
+    command = re.search(r"Written by `([^`]*)`", text).group(1)
+    assert not re.search(r"(^|[\s=])(/|~|[A-Za-z]:\\)", command), f"{page.name}: absolute path in {command!r}"
 
 
 @pytest.mark.fmu

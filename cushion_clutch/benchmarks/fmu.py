@@ -425,7 +425,7 @@ def main(argv=None) -> None:
     from cushion_clutch.data import DEFAULT_TABLES
     from cushion_clutch.model import ClutchParameters, load_table, outputs, thermal_step
 
-    from .page import results_page
+    from .page import add_draft_option, results_page
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--thermal-only", action="store_true",
@@ -438,6 +438,7 @@ def main(argv=None) -> None:
     ap.add_argument("--cold", action="store_true", help="also time builds from an empty zig cache (minutes)")
     ap.add_argument("--markdown", action="store_true", help="with --out: the results page")
     ap.add_argument("--out", type=Path, help="write the results page (e.g. docs/results/benchmarks.md)")
+    add_draft_option(ap)
     args = ap.parse_args(argv)
     if args.launches < 1:
         ap.error(f"--launches {args.launches}: must be at least 1")

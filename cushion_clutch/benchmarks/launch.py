@@ -25,6 +25,8 @@ import time
 from pathlib import Path
 from typing import Iterator
 
+from .page import add_draft_option
+
 
 def _fmu_call_us(fmu: Path, n: int = 50000) -> tuple[float, float]:
     """Microseconds per step: the cffi client and fmpy FMU2Slave (name-based set/get)."""
@@ -84,49 +86,130 @@ def production_line(results, group: str) -> str:
     return text
 
 
-def markdown(scenarios: list[str], backend: str = "native", keep: dict | None = None) -> Iterator[str]:
-    """The launch results of every scenario as Markdown (summary table, ratio, real-time factors), one
-    scenario at a time; ``keep`` (a dict) receives every scenario's results by name."""
+#: the page's words and units for the summarised metrics (launch_summary.csv's column, words, format); the
+#: full per-metric table names each column of launch_summary.csv in words
+METRIC_WORDS = {
+    "characteristic_error_rms_Nm": ("characteristic error, RMS over the launch [N·m]", ".3f"),
+    "characteristic_error_max_Nm": ("characteristic error, largest in the launch [N·m]", ".3f"),
+    "tracking_error_rms_Nm": ("torque tracking error, RMS [N·m]", ".2f"),
+    "tracking_error_max_Nm": ("torque tracking error, largest [N·m]", ".2f"),
+    "creep_error_Nm": ("creep torque error [N·m]", ".2f"),
+    "lockup_accel_step_m_s2": ("acceleration step at lock-up [m/s²]", ".3f"),
+    "shuffle_amplitude_m_s2": ("shuffle amplitude after lock-up [m/s²]", ".2f"),
+    "kiss_point_error_mm": ("kiss-point error [mm]", ".3f"),
+    "theta_cs_error_K": ("cushion-spring temperature error of the TCU [K]", ".1f"),
+    "engagement_time_s": ("engagement time [s]", ".2f"),
+    "slip_energy_kJ": ("slip energy [kJ]", ".1f"),
+    "peak_theta_cm_degC": ("peak facing temperature in the launch [°C]", ".0f"),
+    "peak_theta_cs_degC": ("peak cushion-spring temperature in the launch [°C]", ".0f"),
+    "beyond_tables_s": ("time beyond the tables' temperatures [s]", ".1f"),
+    "above_damage_s": ("time above the facing damage temperature [s]", ".1f"),
+}
+#: the key-figures table: (header in words with unit, function of a summary row giving the cell)
+KEY_HEADERS = ("TCU", "launches", "worst characteristic error [N·m]", "characteristic error RMS, mean [N·m]",
+               "worst θ_cs error [K]", "peak facing θ_cm [°C]", "peak cushion spring θ_cs [°C]", "locked up",
+               "inhibited")
+
+
+def _fmt(value: float, spec: str) -> str:
+    return "–" if value != value else format(value, spec)
+
+
+def _breakable(name: str) -> str:
+    """A TCU name that a narrow table column may wrap after its underscores (HTML ``<wbr>``, no character)."""
+    return name.replace("_", "_<wbr>")
+
+
+def key_table(rows: list[dict], group: str) -> str:
+    """Markdown: the few figures that matter per TCU in ``group`` (rows of ``report.summary_rows``): the
+    worst launch's largest characteristic error, the launches' mean RMS characteristic error, the worst
+    θ_cs estimate error, the plant's peak facing and cushion-spring temperatures over the run, the launches
+    that locked up and those the thermal protection inhibited."""
+    lines = ["| " + " | ".join(KEY_HEADERS) + " |", "|---|" + "--:|" * (len(KEY_HEADERS) - 1)]
+    for r in rows:
+        if r["group"] != group:
+            continue
+        cells = [_breakable(r["tcu"]), str(r["n"]), _fmt(r["characteristic_error_max_Nm_worst"], ".3f"),
+                 _fmt(r["characteristic_error_rms_Nm_mean"], ".3f"), _fmt(r["theta_cs_error_K_worst"], "+.1f"),
+                 _fmt(r["plant_theta_cm_peak_degC"], ".0f"), _fmt(r["plant_theta_cs_peak_degC"], ".0f"),
+                 f"{r['n'] - r['no_lockup']}\u00a0of\u00a0{r['n']}", str(r["inhibited_launches"])]
+        lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+def full_table(rows: list[dict], group: str) -> str:
+    """Markdown: every summarised metric (a row each, in words with its unit and its ``launch_summary.csv``
+    name) against the TCUs (a column each), as ``mean / worst`` over the launches of ``group``."""
+    rows = [r for r in rows if r["group"] == group]
+    lines = ["| metric (mean / worst) | " + " | ".join(_breakable(r["tcu"]) for r in rows) + " |",
+             "|---|" + "--:|" * len(rows)]
+    for col, (words, spec) in METRIC_WORDS.items():
+        cells = [f"{_fmt(r[col + '_mean'], spec)} / {_fmt(r[col + '_worst'], spec)}" for r in rows]
+        lines.append(f"| {words} (`{col}`) | " + " | ".join(cells) + " |")
+    lines.append("| engine stalls | " + " | ".join(str(r["stalls"]) for r in rows) + " |")
+    lines.append("| launches without lock-up | " + " | ".join(str(r["no_lockup"]) for r in rows) + " |")
+    return "\n".join(lines)
+
+
+def collapsible(summary: str, body: str) -> str:
+    """Markdown: ``body`` in an HTML ``<details>`` block (closed) headed by ``summary``."""
+    return (f"```{{raw}} html\n<details class=\"cc-details\"><summary>{summary}</summary>\n```\n\n{body}\n\n"
+            "```{raw} html\n</details>\n```")
+
+
+GROUP_WORDS = {"all": "all launches", "hot": "hot launches (θ_cs ≥ 100 °C at the start)",
+               "cool-down": "the cool-down launches"}
+
+
+def scenario_markdown(name: str, sc, results, mode_hz: float) -> str:
+    """One scenario's part of the page: the key figures of all launches (and of each group), the group's
+    ratio and production lines, the full per-metric tables (collapsed) and the real-time factors."""
+    from cushion_clutch.launch.report import ratio_line, summary_rows
+
+    rows = summary_rows(results)
+    groups = [g for g in ("hot", "cool-down") if any(r["group"] == g for r in rows)]
+    parts = [f"## `{name}`: {sc.description}\n\nlevels {', '.join(sc.driver.levels)}; first driveline mode "
+             f"{mode_hz:.2f} Hz; peak temperatures are the plant's over the whole run\n\n"
+             + key_table(rows, "all")]
+    for g in groups:
+        parts.append(f"Launches of group `{g}` ({GROUP_WORDS[g]}):\n\n" + key_table(rows, g))
+        parts.append("- " + ratio_line(results, g) + "\n- " + production_line(results, g))
+    stopped = [f"`{n}` {r.stopped}" for n, r in results.items() if r.stopped]
+    if stopped:                             # the plant left the model's domain: those rows hold fewer launches
+        parts.append("- **stopped early** (the rows above hold the launches up to it): " + "; ".join(stopped))
+    full = "\n\n".join(f"{GROUP_WORDS[g].capitalize()}:\n\n{full_table(rows, g)}" for g in ["all", *groups])
+    parts.append(collapsible(f"Every metric of <code>{name}</code> (mean / worst per TCU)", full))
+    sim = sc.run.duration()
+    parts.append("- real-time factor (wall / CPU time): " + ", ".join(
+        f"{n} {sim / r.wall_time_s:.0f}x / {sim / r.cpu_time_s:.0f}x" for n, r in results.items()))
+    return "\n\n".join(parts)
+
+
+def markdown(scenarios: list[str], backend: str = "native", keep: dict | None = None,
+             launches: int | None = None) -> Iterator[str]:
+    """The launch results of every scenario as Markdown (:func:`scenario_markdown`), one scenario at a time;
+    ``keep`` (a dict) receives every scenario's results by name; ``launches`` shortens every scenario's run
+    to its first launches (a quick look or a test; the page's figures come from the full runs)."""
+    import dataclasses
+
     from cushion_clutch.data import DEFAULT_TABLES
     from cushion_clutch.model import load_table
     from cushion_clutch.launch.driveline import first_mode_hz
     from cushion_clutch.launch.plant import build_plant_fmu
-    from cushion_clutch.errors import FmuCallError
-    from cushion_clutch.launch.report import ratio_line, run_all, summary_table
-    from cushion_clutch.launch.tcu import VARIANTS
+    from cushion_clutch.launch.report import run_all
     from cushion_clutch.launch.scenario import load_scenario, scenario_path
 
     with tempfile.TemporaryDirectory() as tmp:
         for name in scenarios:
-            parts = []
             sc = load_scenario(scenario_path(name))
+            if launches is not None:
+                sc = dataclasses.replace(sc, run=dataclasses.replace(
+                    sc.run, launches=launches, cool_launches=min(sc.run.cool_launches, launches)))
             fmu = build_plant_fmu(DEFAULT_TABLES, sc, Path(tmp) / name / "CushionClutch.fmu", backend=backend)
-            table = load_table(sc.tables_path("tcu") or DEFAULT_TABLES)
-            results, failed = {}, {}
-            for variant in VARIANTS:      # one at a time: a run that leaves the model's domain is reported, not hidden
-                try:
-                    results.update(run_all(fmu, sc, table, (variant,)))
-                except (ValueError, FmuCallError) as exc:
-                    failed[variant] = str(exc).splitlines()[0]
-            groups = sorted({g for r in results.values() for m in r.metrics
-                             for g in (("hot",) if m["hot"] and m["phase"] == "repeated" else ())
-                             + (("cool-down",) if m["phase"] == "cool-down" else ())})
-            sim = sc.run.duration()
+            results = run_all(fmu, sc, load_table(sc.tables_path("tcu") or DEFAULT_TABLES))
             if keep is not None:
                 keep[name] = results
-            parts.append(f"## `{name}`: {sc.description}\n\n"
-                         f"levels {', '.join(sc.driver.levels)}; first driveline mode "
-                         f"{first_mode_hz(sc):.2f} Hz\n\n" + summary_table(results, ("all",)))
-            for g in groups:
-                parts.append(f"Group `{g}`:\n\n" + summary_table(results, (g,)))
-                parts.append("- " + ratio_line(results, g))
-                parts.append("- " + production_line(results, g))
-            if failed:
-                parts.append("- stopped outside the model's domain (no row above): " + "; ".join(
-                    f"`{n}`: {msg}" for n, msg in failed.items()))
-            parts.append("- real-time factor (wall / CPU time): " + ", ".join(
-                f"{n} {sim / r.wall_time_s:.0f}x / {sim / r.cpu_time_s:.0f}x" for n, r in results.items()))
-            yield "\n\n".join(parts)
+            yield scenario_markdown(name, sc, results, first_mode_hz(sc))
 
 
 #: launches of the shipped ``default`` scenario whose per-launch figures the results page carries for the check
@@ -170,21 +253,27 @@ def check_run(backend: str = "native", launches: int = CHECK_LAUNCHES) -> str:
 
 
 CHECK_HEADING = "## Check figures"
-PAGE_INTRO = ("Every TCU on each scenario with the committed tables and the native FMU. \"worst\" is the worst "
-              "launch of the group; `hot`: θ_cs ≥ 100 °C at the launch start. Column names are those of "
-              "`launch_summary.csv`; what each metric shows and hides: [a launch study]"
+PAGE_INTRO = ("Every TCU on each scenario with the committed tables and the native FMU. Each scenario first "
+              "gives its key figures per TCU: the worst launch's largest characteristic error (the TCU's torque "
+              "characteristic against the plant's), the mean over the launches of its RMS, the worst error of "
+              "the TCU's cushion-spring temperature θ_cs, the plant's peak facing and cushion-spring "
+              "temperatures over the run, how many launches locked up and how many the thermal protection "
+              "inhibited. `hot`: θ_cs ≥ 100 °C at the launch start. Every metric (mean / worst of the group's "
+              "launches, named in words and by its `launch_summary.csv` column) is in the collapsed section "
+              "below each scenario; what each metric shows and hides: [a launch study]"
               "(../tutorials/launch_study.md). Real-time factors depend on the machine and its load.")
 
 
-def write_page(out: Path, scenarios: list[str], backend: str, argv) -> None:
+def write_page(out: Path, scenarios: list[str], backend: str, argv, launches: int | None = None) -> None:
     """The results page: every scenario's tables, then the check figures of ``default``."""
     from .page import results_page
 
     keep: dict = {}
     with results_page(out, "Launch results", "cushion_clutch.benchmarks.launch", argv, PAGE_INTRO) as page:
-        for part in markdown(scenarios, backend, keep):
+        for part in markdown(scenarios, backend, keep, launches):
             page.markdown(part)
-        check = (check_table(keep["default"]) if "default" in keep else check_run(backend))
+        full_default = "default" in keep and (launches is None or launches >= CHECK_LAUNCHES)
+        check = check_table(keep["default"]) if full_default else check_run(backend)
         page.markdown(f"{CHECK_HEADING}\n\nThe first {CHECK_LAUNCHES} launches of `default`, per launch and "
                       "TCU. `tests/test_docs.py` reruns them and fails when a figure differs, so a stale page "
                       f"fails CI.\n\n{check}")
@@ -207,12 +296,17 @@ def main(argv=None) -> None:
     ap.add_argument("--markdown", action="store_true", help="print the launch results tables")
     ap.add_argument("--scenarios", default="default,trailer,creep,cooldown,fade,wear,wear_learned,tolerance,protection", help="with --markdown")
     ap.add_argument("--out", type=Path, help="with --markdown: write the results page (e.g. docs/results/launch.md)")
+    add_draft_option(ap)
+    ap.add_argument("--launches", type=int, help="with --markdown: only each scenario's first N launches "
+                    "(a quick look at the layout; the committed page comes from the full runs)")
     args = ap.parse_args(argv)
+    if args.launches is not None and args.launches < 1:
+        ap.error(f"--launches {args.launches}: must be at least 1")
     if args.markdown and args.out:
-        write_page(args.out, args.scenarios.split(","), args.backend, argv)
+        write_page(args.out, args.scenarios.split(","), args.backend, argv, args.launches)
         return
     if args.markdown:
-        for part in markdown(args.scenarios.split(","), args.backend):
+        for part in markdown(args.scenarios.split(","), args.backend, launches=args.launches):
             print(part + "\n", flush=True)
         return
     sc = load_scenario(scenario_path(args.scenario))

@@ -95,13 +95,14 @@ def row(name: str, b: dict) -> str:
 
 
 def main(argv: list[str] | None = None) -> None:
-    from .page import results_page
+    from .page import add_draft_option, results_page
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--scenarios", default=",".join(SHIPPED), help="comma-separated shipped scenario names")
     ap.add_argument("--repeat", type=int, default=1, help="runs per TCU; the real-time factor is their median")
     ap.add_argument("--seed", type=int, help="sensor-noise seed for every scenario (default: each scenario's own)")
     ap.add_argument("--out", type=Path, help="also write the table as a results page (docs/results/production_bar.md)")
+    add_draft_option(ap)
     a = ap.parse_args(argv)
     rows = []
     with results_page(a.out, "Production TCU bar", "cushion_clutch.benchmarks.production_bar", argv,

@@ -70,7 +70,7 @@ PAGE_INTRO = ("The FE cost of the sweep with several models (element size, type,
 def main(argv=None) -> None:
     from cushion_clutch.fe.params import load_params
 
-    from .page import results_page
+    from .page import add_draft_option, results_page
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--models", nargs="*", default=["0.5e-3:S4", "1e-3:S4", "2e-3:S8R", "2e-3:S4"],
@@ -83,6 +83,7 @@ def main(argv=None) -> None:
     ap.add_argument("--sens-model", default="2e-3:S4")
     ap.add_argument("--markdown", action="store_true", help="also give the models as a Markdown table")
     ap.add_argument("--out", type=Path, help="write the results page (e.g. docs/results/fe_cost.md)")
+    add_draft_option(ap)
     args = ap.parse_args(argv)
     base = load_params()
     if args.temps:

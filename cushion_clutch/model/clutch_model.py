@@ -49,7 +49,7 @@ __all__ = ["KELVIN", "VARIABLES", "ClutchParameters", "CoverParameters", "CoverM
 VARIABLES = (
     ("x_to", "input", "m", "throwout-bearing position, 0 = open"),
     ("theta_cm", "input", "K", "clutch facing temperature"),
-    ("torque", "output", "N.m", "transmissible clutch torque n*mu*R_eq*F_pp (F_pp: clamp_force)"),
+    ("torque", "output", "N.m", "transmissible clutch torque n*mu*R_eq*clamp_force"),
     ("force", "output", "N", "cushion-spring force F(u, theta_cs); the clamp force is clamp_force"),
     ("theta_cs", "output", "K", "cushion-spring temperature"),
     ("u_f", "output", "m", "cushion compression from the kiss point, clipped at 0"),

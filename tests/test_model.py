@@ -343,3 +343,37 @@ def test_inverse_at_zero_torque_is_where_the_torque_starts(table):
             mid = 0.5 * (lo + hi)
             lo, hi = (mid, hi) if outputs(mid, th, table, P).torque == 0.0 else (lo, mid)
         assert abs(x0 - hi) < 1.5e-6, t
+
+
+@pytest.mark.parametrize("name", ["n_surfaces", "mu", "R_eq", "x_kiss_ref", "lever_ratio", "facing_wear"])
+@pytest.mark.parametrize("value", [True, False])
+def test_api_refuses_a_boolean_parameter(table, name, value):
+    """Issue 43: a bool is never a number, even where its 0/1 lies in the range (mu = True is 1.0 in Python);
+    the message names the one parameter."""
+    p = ClutchParameters(**{name: value})
+    for call in (lambda: outputs(0.006, 400.0, table, p), lambda: x_to_for_torque(100.0, 400.0, table, p)):
+        with pytest.raises(ValueError) as err:
+            call()
+        assert str(err.value).startswith(f"p.{name} = {value!r} is out of range"), str(err.value)
+
+
+@pytest.mark.parametrize("call, name", [
+    (lambda t: outputs(0.006, 400.0, t, P, omega_slip=True), "omega_slip"),
+    (lambda t: outputs(False, 400.0, t, P), "x_to"),
+    (lambda t: x_to_for_torque(True, 400.0, t, P), "torque"),
+    (lambda t: x_to_for_torque(100.0, 400.0, t, P, tol_m=True), "tol_m"),
+    (lambda t: thermal_step(300.0, 400.0, True, P), "dt"),
+])
+def test_api_refuses_a_boolean_argument(table, call, name):
+    with pytest.raises(ValueError) as err:
+        call(table)
+    assert str(err.value).startswith(f"{name} = True ") or str(err.value).startswith(f"{name} = False "), str(err.value)
+
+
+def test_thermal_step_and_system_refuse_a_boolean_parameter():
+    with pytest.raises(ValueError, match=r"^p.C = True is out of range"):
+        thermal_step(300.0, 400.0, 1.0, ClutchParameters(C=True))
+    with pytest.raises(ValueError, match=r"^p.U = False is out of range"):
+        thermal_step(300.0, 400.0, 1.0, ClutchParameters(U=False, H=0.04))
+    with pytest.raises(ValueError, match="^C = True"):
+        thermal_system(ClutchParameters(C=True))

@@ -98,6 +98,11 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, fields
 
+try:                                    # inside the pythonfmu FMU the modules are siblings
+    from .number_check import is_finite_number
+except ImportError:
+    from number_check import is_finite_number
+
 __all__ = ["range_problems", "finger_compliance", "hold_problem", "wear_limit", "wear_reserve",
            "ENGINE_TORQUE_NM", "RESERVE_FACTOR", "CoverParameters", "CoverState", "k1", "almen_laszlo_force", "almen_laszlo_slope", "CoverMap"]
 
@@ -198,8 +203,7 @@ def range_problems(params, ranges: dict) -> list[str]:
             continue
         v = getattr(params, f.name)
         lo, hi, lo_open, hi_open = ranges[f.name]
-        ok = isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) and (
-            v > lo if lo_open else v >= lo) and (v < hi if hi_open else v <= hi)
+        ok = is_finite_number(v) and (v > lo if lo_open else v >= lo) and (v < hi if hi_open else v <= hi)
         if not ok:
             out.append(f"{f.name} = {v!r} is out of range {'(' if lo_open else '['}{lo:g}, "
                        f"{hi:g}{')' if hi_open else ']'}")

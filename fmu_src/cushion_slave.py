@@ -58,6 +58,16 @@ from clutch_model import (OMEGA_SLIP_LIMIT, THETA_CM_LIMIT, VARIABLES, X_TO_LIMI
                           outputs, start_values, thermal_step)
 from clutch_model import table_problems, validity_warning  # issue 28 (validity): the shared model decides
 from table_format import table_set_x_kiss_ref
+from clutch_model import INPUT_RANGES
+from number_check import unit_hint
+
+def _hint(name: str, value) -> str:
+    """``": did you mean ...?"`` for the likely unit mistake behind input ``name`` = ``value`` (the model's
+    number_check.unit_hint over its INPUT_RANGES: the native FMU's text), or ""."""
+    unit = next(u for n, _, u, _ in VARIABLES if n == name)
+    hint = unit_hint(value, unit, *INPUT_RANGES[name][:2])
+    return f": {hint}" if hint else ""
+
 
 CAUSALITY = {"input": (Fmi2Causality.input, Fmi2Variability.continuous),
              "output": (Fmi2Causality.output, Fmi2Variability.continuous),
@@ -299,10 +309,12 @@ class CushionClutch(Fmi2Slave):
     def _input_problems(self) -> list[str]:
         out = []
         if not (isinstance(self.x_to, float) and math.isfinite(self.x_to) and abs(self.x_to) <= X_TO_LIMIT):
-            out.append(f"input x_to = {self.x_to!r} m is not finite or |x_to| > {X_TO_LIMIT:g} m")
+            out.append(f"input x_to = {self.x_to!r} m is not finite or |x_to| > {X_TO_LIMIT:g} m"
+                       + _hint("x_to", self.x_to))
         if not (isinstance(self.theta_cm, float) and math.isfinite(self.theta_cm)
                 and 0.0 < self.theta_cm < THETA_CM_LIMIT):
-            out.append(f"input theta_cm = {self.theta_cm!r} K is not finite or outside (0, {THETA_CM_LIMIT:g}) K")
+            out.append(f"input theta_cm = {self.theta_cm!r} K is not finite or outside (0, {THETA_CM_LIMIT:g}) K"
+                       + _hint("theta_cm", self.theta_cm))
         if not (isinstance(self.omega_slip, float) and math.isfinite(self.omega_slip)
                 and abs(self.omega_slip) <= OMEGA_SLIP_LIMIT):
             out.append(f"input omega_slip = {self.omega_slip!r} rad/s is not finite or |omega_slip| > "

@@ -29,13 +29,13 @@ from functools import lru_cache
 try:                                    # inside the pythonfmu FMU the modules are siblings
     from .cover import CoverMap, CoverParameters, hold_problem, range_problems
     from .friction import FrictionTable
-    from .number_check import any_bool, is_finite_number, is_number
+    from .number_check import any_bool, is_finite_number, is_number, unit_hint
     from .spring_table import KELVIN, Curve, SpringTable, pchip_slopes
     from .table_format import load_csv
 except ImportError:
     from cover import CoverMap, CoverParameters, hold_problem, range_problems
     from friction import FrictionTable
-    from number_check import any_bool, is_finite_number, is_number
+    from number_check import any_bool, is_finite_number, is_number, unit_hint
     from spring_table import KELVIN, Curve, SpringTable, pchip_slopes
     from table_format import load_csv
 
@@ -179,7 +179,7 @@ class ClutchParameters:
 
     def problems(self) -> list[str]:
         """Every parameter outside its allowed range, with the range."""
-        out = range_problems(self, self.RANGES)
+        out = range_problems(self, self.RANGES, {name: unit for name, _, unit, _ in VARIABLES})
         if not out and self.n_surfaces != int(self.n_surfaces):
             out.append(f"n_surfaces = {self.n_surfaces!r} must be a positive integer in [1, 16]")
         if not out and self.U + self.H <= 0.0:
@@ -258,14 +258,14 @@ ARGUMENT_UNITS = {"x_to": "m", "theta_cs": "K", "theta_cm": "K", "omega_slip": "
 
 
 def range_message(name: str, value, unit: str, rng: tuple) -> str:
-    """``name = value unit is outside [lo, hi] unit``, plus the kelvin hint for a temperature below its range."""
+    """``name = value unit is outside [lo, hi] unit``, plus the hint for the likely unit mistake
+    (:func:`number_check.unit_hint`: mm typed as m, degC typed as K)."""
     lo, hi, lo_open, hi_open = rng[:4]
     if isinstance(value, float):
         value = float(value)                # numpy's float64 repr would name its type
     text = f"{name} = {value!r} {unit} is outside {_range_text(lo, hi, lo_open, hi_open)} {unit}"
-    if unit == "K" and is_number(value) and value < lo:
-        text += f" (the input is in kelvin: {value!r} degC would be {value + KELVIN:g} K)"
-    return text
+    hint = unit_hint(value, unit, lo, hi)
+    return f"{text}: {hint}" if hint else text
 
 
 def _argument_error(args: dict, p: ClutchParameters | None, names: tuple[str, ...]) -> ValueError:

@@ -59,7 +59,7 @@ from clutch_model import (OMEGA_SLIP_LIMIT, THETA_CM_LIMIT, VARIABLES, X_TO_LIMI
 from clutch_model import table_problems, validity_warning  # issue 28 (validity): the shared model decides
 from table_format import table_set_x_kiss_ref
 from clutch_model import INPUT_RANGES
-from number_check import unit_hint
+from number_check import is_finite_number, unit_hint
 
 def _hint(name: str, value) -> str:
     """``": did you mean ...?"`` for the likely unit mistake behind input ``name`` = ``value`` (the model's
@@ -374,12 +374,12 @@ class CushionClutch(Fmi2Slave):
         out = []
         for name, _, _, _ in VARIABLES:
             v = state.get(name)
-            if not (isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)):
+            if not is_finite_number(v):
                 out.append(f"{name} = {v!r} is missing or not finite")
         if state.get("_phase") not in PHASES:
             out.append(f"phase {state.get('_phase')!r} is not one of {', '.join(PHASES)}")
         t = state.get("_time")
-        if t is not None and not (isinstance(t, (int, float)) and math.isfinite(t)):
+        if t is not None and not is_finite_number(t):            # a JSON true is no time
             out.append(f"time {t!r} is not finite")
         if not out and state["_phase"] in ("stepping", "terminated"):
             params = ClutchParameters.from_flat({p: float(state[p]) for p in PARAMETERS})

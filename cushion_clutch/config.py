@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import Any, Iterable
 
 from .errors import ParameterError
+from .model.number_check import is_finite_number, is_number
 
 
 def range_problem(key: str, value: Any, lo: float | None, hi: float | None,
@@ -25,7 +26,7 @@ def range_problem(key: str, value: Any, lo: float | None, hi: float | None,
     lo_s = "-inf" if lo is None else f"{lo:g}"
     hi_s = "inf" if hi is None else f"{hi:g}"
     allowed = f"{'(' if lo_open or lo is None else '['}{lo_s}, {hi_s}{')' if hi_open or hi is None else ']'}"
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+    if not is_finite_number(value):
         return f"{key} = {value!r}: must be a finite number in {allowed}"
     bad_lo = lo is not None and (value <= lo if lo_open else value < lo)
     bad_hi = hi is not None and (value >= hi if hi_open else value > hi)
@@ -54,10 +55,19 @@ class Checked:
                 yield msg
 
     def _integers(self, *names: str) -> Iterable[str]:
+        """A message for every named field that is a number but not an integer (a value that is no
+        number at all, a boolean included, is named once, by its range check)."""
         for name in names:
             value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, int):
+            if is_number(value) and not isinstance(value, int):
                 yield f"{self._key(name)} = {value!r}: must be an integer"
+
+    def _passed(self, spec: dict[str, tuple], *names: str) -> bool:
+        """True if every named field passed its own range check in ``spec`` (as :meth:`_ranges` runs it).
+
+        Cross-field checks run only then, so one bad value gives one message naming one key.
+        """
+        return all(range_problem(self._key(n), getattr(self, n), *spec[n]) is None for n in names)
 
     def _problems(self) -> Iterable[str]:  # pragma: no cover - overridden
         return ()
@@ -76,8 +86,7 @@ def _type_problems(cls: type, section: str, values: dict[str, Any]) -> Iterable[
         if isinstance(default, tuple):
             if not isinstance(v, tuple):
                 yield f"{key} = {v!r}: must be a list"
-            elif default and all(isinstance(d, (int, float)) and not isinstance(d, bool) for d in default) and \
-                    not all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in v):
+            elif default and all(is_number(d) for d in default) and not all(is_number(x) for x in v):
                 yield f"{key} = {list(v)!r}: must be a list of numbers"
         elif isinstance(default, bool):
             if not isinstance(v, bool):

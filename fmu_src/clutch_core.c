@@ -164,6 +164,20 @@ static double kiss_ref(const CcModel *m, const double *r) {
     return m->sets.n > 1 ? r[VR_X_KISS_REF] + m->sets.kiss_offset[m->set - 1] : r[VR_X_KISS_REF];
 }
 
+/* ": did you mean ...?" for the likely unit mistake behind variable k's value v out of its range (mm typed as m;
+   degC typed as K, below the range), "" if none fits: the text of the Python model's number_check.unit_hint */
+static const char *unit_hint(char *buf, size_t n, int k, double v) {
+    const double lo = CC_VARIABLES[k].range[0], hi = CC_VARIABLES[k].range[1];
+    const char *unit = CC_VARIABLES[k].unit;
+    buf[0] = '\0';
+    if (!isfinite(v) || (v >= lo && v <= hi)) return buf;
+    if (!strcmp(unit, "m") && v * 1e-3 >= lo && v * 1e-3 <= hi)
+        snprintf(buf, n, ": did you mean %g m?", v * 1e-3);
+    else if (!strcmp(unit, "K") && v < lo && v + KELVIN >= lo && v + KELVIN <= hi)
+        snprintf(buf, n, ": did you mean %g K (%g degC)?", v + KELVIN, v);
+    return buf;
+}
+
 /* the cover parameters of a variable vector (CV_* order) */
 static const double *cover_params(const double *r) { return r + VR_DIAPHRAGM_OUTER_RADIUS_M; }
 
@@ -223,9 +237,10 @@ static int check_parameters(CcModel *m, const double *r, const char *fn) {
     int k, ok = 1;
     for (k = 0; k < CC_NVARS; ++k) {
         const double *g = CC_VARIABLES[k].range;
+        char hint[96];
         if (is_parameter((unsigned int)k) && !range_ok(k, r[k])) {
-            cc_log(m, CC_ERROR, "%s: parameter %s = %g is out of range %c%g, %g%c", fn, VAR_NAME(k), r[k],
-                   g[2] ? '(' : '[', g[0], g[1], g[3] ? ')' : ']');
+            cc_log(m, CC_ERROR, "%s: parameter %s = %g is out of range %c%g, %g%c%s", fn, VAR_NAME(k), r[k],
+                   g[2] ? '(' : '[', g[0], g[1], g[3] ? ')' : ']', unit_hint(hint, sizeof hint, k, r[k]));
             ok = 0;
         }
     }
@@ -269,22 +284,18 @@ static int inputs_ok(const double *r) {
            r[VR_THETA_CM] <= THETA_MAX_K && fabs(r[VR_OMEGA_SLIP]) <= OMEGA_SLIP_LIMIT; /* false for NaN */
 }
 
-/* every input outside its range (INPUT_RANGES), named with value, range and unit; a temperature below its
-   range is said to be in kelvin */
+/* every input outside its range (INPUT_RANGES), named with value, range and unit, and the likely unit mistake
+   (unit_hint: a position in mm, a temperature in degC) */
 static void log_inputs(CcModel *m, int status, double t, const char *what) {
     int k;
     for (k = 0; k < CC_NVARS; ++k) {
         const double *g = CC_VARIABLES[k].range;
         const char *unit = CC_VARIABLES[k].unit;
         double v = m->r[k];
+        char hint[96];
         if (!is_input((unsigned int)k) || range_ok(k, v)) continue;
-        if (!strcmp(unit, "K") && v < g[0])
-            cc_log(m, status, "t = %g s: input %s = %g K is outside %c%g, %g%c K (the input is in kelvin: %g degC "
-                   "would be %g K); %s", t, VAR_NAME(k), v, g[2] ? '(' : '[', g[0], g[1], g[3] ? ')' : ']', v,
-                   v + KELVIN, what);
-        else
-            cc_log(m, status, "t = %g s: input %s = %g %s is not finite or outside %c%g, %g%c %s; %s", t, VAR_NAME(k),
-                   v, unit, g[2] ? '(' : '[', g[0], g[1], g[3] ? ')' : ']', unit, what);
+        cc_log(m, status, "t = %g s: input %s = %g %s is not finite or outside %c%g, %g%c %s%s; %s", t, VAR_NAME(k),
+               v, unit, g[2] ? '(' : '[', g[0], g[1], g[3] ? ')' : ']', unit, unit_hint(hint, sizeof hint, k, v), what);
     }
 }
 

@@ -60,6 +60,17 @@ from clutch_model import table_problems, validity_warning  # issue 28 (validity)
 from table_format import table_set_x_kiss_ref
 from slave_table_sets import more_sets  # issue 42: several table sets, the enumeration spring
 
+from clutch_model import INPUT_RANGES
+from number_check import is_finite_number, unit_hint
+
+def _hint(name: str, value) -> str:
+    """``": did you mean ...?"`` for the likely unit mistake behind input ``name`` = ``value`` (the model's
+    number_check.unit_hint over its INPUT_RANGES: the native FMU's text), or ""."""
+    unit = next(u for n, _, u, _ in VARIABLES if n == name)
+    hint = unit_hint(value, unit, *INPUT_RANGES[name][:2])
+    return f": {hint}" if hint else ""
+
+
 CAUSALITY = {"input": (Fmi2Causality.input, Fmi2Variability.continuous),
              "output": (Fmi2Causality.output, Fmi2Variability.continuous),
              "parameter": (Fmi2Causality.parameter, Fmi2Variability.fixed)}
@@ -325,10 +336,12 @@ class CushionClutch(Fmi2Slave):
     def _input_problems(self) -> list[str]:
         out = []
         if not (isinstance(self.x_to, float) and math.isfinite(self.x_to) and abs(self.x_to) <= X_TO_LIMIT):
-            out.append(f"input x_to = {self.x_to!r} m is not finite or |x_to| > {X_TO_LIMIT:g} m")
+            out.append(f"input x_to = {self.x_to!r} m is not finite or |x_to| > {X_TO_LIMIT:g} m"
+                       + _hint("x_to", self.x_to))
         if not (isinstance(self.theta_cm, float) and math.isfinite(self.theta_cm)
                 and 0.0 < self.theta_cm < THETA_CM_LIMIT):
-            out.append(f"input theta_cm = {self.theta_cm!r} K is not finite or outside (0, {THETA_CM_LIMIT:g}) K")
+            out.append(f"input theta_cm = {self.theta_cm!r} K is not finite or outside (0, {THETA_CM_LIMIT:g}) K"
+                       + _hint("theta_cm", self.theta_cm))
         if not (isinstance(self.omega_slip, float) and math.isfinite(self.omega_slip)
                 and abs(self.omega_slip) <= OMEGA_SLIP_LIMIT):
             out.append(f"input omega_slip = {self.omega_slip!r} rad/s is not finite or |omega_slip| > "
@@ -394,14 +407,14 @@ class CushionClutch(Fmi2Slave):
         out = []
         for name, _, _, _ in VARIABLES:
             v = state.get(name)
-            if not (isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)):
+            if not is_finite_number(v):
                 out.append(f"{name} = {v!r} is missing or not finite")
         if state.get("_spring") not in range(1, len(self._sets) + 1):
             out.append(f"table set spring = {state.get('_spring')!r}: this FMU carries sets 1..{len(self._sets)}")
         if state.get("_phase") not in PHASES:
             out.append(f"phase {state.get('_phase')!r} is not one of {', '.join(PHASES)}")
         t = state.get("_time")
-        if t is not None and not (isinstance(t, (int, float)) and math.isfinite(t)):
+        if t is not None and not is_finite_number(t):            # a JSON true is no time
             out.append(f"time {t!r} is not finite")
         if not out and state["_phase"] in ("stepping", "terminated"):
             params = ClutchParameters.from_flat({p: float(state[p]) for p in PARAMETERS})

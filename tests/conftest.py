@@ -54,9 +54,6 @@ def wine_env(tmp_path_factory):
     return env
 
 
-_FMPY_LOGGER = []     # fmpy's default printer behind its printf proxy, kept for the whole session
-
-
 @pytest.fixture(autouse=True)
 def _fmpy_logger_proxy():
     """Point fmpy's native printf proxy back at a logger that lives as long as the session.
@@ -67,14 +64,7 @@ def _fmpy_logger_proxy():
     freed function as soon as the FMU logs: the native FMU logs its Warnings whatever ``loggingOn``
     (issue 28), so a test of it after such a test crashed the interpreter. Our code is not involved.
     """
-    from ctypes import byref
+    from cushion_clutch.fmpy_logger import restore_fmpy_logger
 
-    from fmpy.fmi2 import fmi2CallbackFunctions, fmi2CallbackLoggerTYPE, printLogMessage
-    from fmpy.logging import addLoggerProxy
-
-    if not _FMPY_LOGGER:
-        _FMPY_LOGGER.extend([fmi2CallbackFunctions(), fmi2CallbackLoggerTYPE(printLogMessage)])
-    cb, printer = _FMPY_LOGGER
-    cb.logger = printer               # addLoggerProxy swaps in its proxy: give it the printer each time
-    addLoggerProxy(byref(cb))
+    restore_fmpy_logger()             # the package's one helper (the launch client and `simulate` call it too)
     yield

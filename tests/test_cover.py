@@ -197,3 +197,15 @@ def test_cover_toml_is_checked(tmp_path):
     assert "cover.thickness: unknown key" in text and "diaphragm_cone_height_m" in text and str(bad) in text
     with pytest.raises(ParameterError, match="out of range"):
         cover_from_dict({"fulcrum_radius_m": 2.0})
+
+
+@pytest.mark.parametrize("value", [True, False])
+def test_cover_refuses_a_boolean(tmp_path, value):
+    """Issue 43: a TOML boolean is never a number; one message naming the key, from a file and from the API."""
+    path = tmp_path / "cover.toml"
+    path.write_text(f"[cover]\ndiaphragm_thickness_m = {str(value).lower()}\n")
+    with pytest.raises(ParameterError) as exc:
+        load_cover(path)
+    assert exc.value.problems == [f"cover.diaphragm_thickness_m = {value!r}: must be a number"]
+    p = CoverParameters(diaphragm_poisson_ratio=value)         # in range as 0/1 would be, refused as a bool
+    assert p.problems() == [f"diaphragm_poisson_ratio = {value!r} is out of range [0, 0.5)"]

@@ -84,6 +84,11 @@ def test_units_are_declared(fmu):
     assert units["U"][0] == "W/K" and units["C"][0] == "J/K"
     k = {u.name: u for u in md.unitDefinitions}["K"]
     assert k.displayUnits[0].name == "degC" and k.displayUnits[0].offset == -273.15
+    # lengths are shown in mm (issue 41): x_to = 0.012 m reads 12 mm in a host; every K variable keeps degC
+    m = {u.name: u for u in md.unitDefinitions}["m"]
+    assert m.displayUnits[0].name == "mm" and m.displayUnits[0].factor == 1000.0
+    assert units["x_to"] == ("m", "mm") and units["x_kiss"] == ("m", "mm") and units["facing_wear"] == ("m", "mm")
+    assert all(d == ("degC" if u == "K" else "mm" if u == "m" else None) for u, d in units.values()), units
 
 
 @pytest.mark.parametrize("h", [1e-3, 0.1, 5.0])

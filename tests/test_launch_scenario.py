@@ -88,7 +88,8 @@ def test_cycles_and_unknown_parents_are_refused(tmp_path):
 
 
 @pytest.mark.parametrize("table, head", [
-    ("[observer]\nspring_U_W_per_K = 0.1\nspring_H_W_per_K = -1.0\n", "observer.spring_H_W_per_K:"),
+    # both in range: a rule over two keys runs only on values that passed their own checks (issue 43)
+    ("[observer]\nspring_U_W_per_K = 0.0\nspring_H_W_per_K = 0.0\n", "observer.spring_H_W_per_K:"),
     ("[tcu_thermal]\nspring_U_W_per_K = 0.0\nspring_H_W_per_K = 0.0\n", "tcu_thermal.spring_H_W_per_K:"),
     ("[engine]\ntorque_curve_rpm = [1000.0, 2000.0]\ntorque_curve_Nm = [100.0]\n", "engine.torque_curve_Nm:"),
 ])

@@ -8,7 +8,7 @@ from scipy.interpolate import PchipInterpolator
 
 from cushion_clutch.data import DEFAULT_TABLES
 from cushion_clutch.model import (KELVIN, ClutchParameters, CoverParameters, load_table, outputs, thermal_step, thermal_system,
-                                  x_to_for_torque)
+                                  VARIABLES, x_to_for_torque)
 from cushion_clutch.fe.tables import read_tables
 
 P = ClutchParameters()
@@ -177,7 +177,8 @@ def test_thermal_system_names_a_zero_heat_capacity():
     ({"n_surfaces": 0.0}, "p.n_surfaces = 0.0 is out of range [1, 16]"),
     ({"n_surfaces": 2.5}, "p.n_surfaces = 2.5 must be a positive integer in [1, 16]"),
     ({"lever_ratio": 0.0}, "p.lever_ratio = 0.0 is out of range (0, 100]"),
-    ({"x_kiss_ref": 2.0}, "p.x_kiss_ref = 2.0 is out of range [-1, 1]"),
+    ({"x_kiss_ref": 2.0}, "p.x_kiss_ref = 2.0 is out of range [-1, 1]: did you mean 0.002 m?"),
+    ({"x_kiss_ref": math.inf}, "p.x_kiss_ref = inf is out of range [-1, 1]"),
 ])
 def test_api_refuses_bad_clutch_parameters(table, bad, message):
     p = ClutchParameters(**bad)
@@ -189,11 +190,11 @@ def test_api_refuses_bad_clutch_parameters(table, bad, message):
 
 @pytest.mark.parametrize("args, message", [
     ((math.inf, 400.0), "x_to = inf m is outside [-0.002, 0.025] m"),
-    ((0.006, 100.0), "theta_cs = 100.0 K is outside [200, 800] K (the input is in kelvin: 100.0 degC would be "
-                     "373.15 K)"),
+    ((0.006, 100.0), "theta_cs = 100.0 K is outside [200, 800] K: did you mean 373.15 K (100 degC)?"),
+    ((12.0, 400.0), "x_to = 12.0 m is outside [-0.002, 0.025] m: did you mean 0.012 m?"),
     ((0.006, 800.5), "theta_cs = 800.5 K is outside [200, 800] K"),
-    ((0.1, 190.0), "x_to = 0.1 m is outside [-0.002, 0.025] m; theta_cs = 190.0 K is outside [200, 800] K "
-                   "(the input is in kelvin: 190.0 degC would be 463.15 K)"),
+    ((0.1, 190.0), "x_to = 0.1 m is outside [-0.002, 0.025] m: did you mean 0.0001 m?; theta_cs = 190.0 K is outside [200, 800] K: "
+                   "did you mean 463.15 K (190 degC)?"),
 ])
 def test_api_argument_errors_name_every_bad_argument(table, args, message):
     with pytest.raises(ValueError) as err:
@@ -284,8 +285,13 @@ def test_parameter_range_bounds_are_open_or_closed_as_documented(name):
                            "must be > 0"], got
             continue
         assert got == ([f"{name} = {v!r} is out of range {text}"] if is_open else []), (name, v, got)
+    from cushion_clutch.model.number_check import unit_hint
+    unit = next(u for n, _, u, _ in VARIABLES if n == name)
     for v in (lo - 1e-3 * (hi - lo), hi + 1e-3 * (hi - lo)):
-        assert ClutchParameters(**{name: v}).problems() == [f"{name} = {v!r} is out of range {text}"]
+        hint = unit_hint(v, unit, lo, hi)          # e.g. theta_a = 199.4: "did you mean 472.55 K (199.4 degC)?"
+        assert ClutchParameters(**{name: v}).problems() == [f"{name} = {v!r} is out of range {text}"
+                                                            + (f": {hint}" if hint else "")]
+    assert unit_hint(lo - 1e-3 * (hi - lo), unit, lo, hi) or unit not in ("K",), name   # degC below a K range
 
 
 def test_a_spring_without_a_heat_path_is_refused():
@@ -343,3 +349,37 @@ def test_inverse_at_zero_torque_is_where_the_torque_starts(table):
             mid = 0.5 * (lo + hi)
             lo, hi = (mid, hi) if outputs(mid, th, table, P).torque == 0.0 else (lo, mid)
         assert abs(x0 - hi) < 1.5e-6, t
+
+
+@pytest.mark.parametrize("name", ["n_surfaces", "mu", "R_eq", "x_kiss_ref", "lever_ratio", "facing_wear"])
+@pytest.mark.parametrize("value", [True, False])
+def test_api_refuses_a_boolean_parameter(table, name, value):
+    """Issue 43: a bool is never a number, even where its 0/1 lies in the range (mu = True is 1.0 in Python);
+    the message names the one parameter."""
+    p = ClutchParameters(**{name: value})
+    for call in (lambda: outputs(0.006, 400.0, table, p), lambda: x_to_for_torque(100.0, 400.0, table, p)):
+        with pytest.raises(ValueError) as err:
+            call()
+        assert str(err.value).startswith(f"p.{name} = {value!r} is out of range"), str(err.value)
+
+
+@pytest.mark.parametrize("call, name", [
+    (lambda t: outputs(0.006, 400.0, t, P, omega_slip=True), "omega_slip"),
+    (lambda t: outputs(False, 400.0, t, P), "x_to"),
+    (lambda t: x_to_for_torque(True, 400.0, t, P), "torque"),
+    (lambda t: x_to_for_torque(100.0, 400.0, t, P, tol_m=True), "tol_m"),
+    (lambda t: thermal_step(300.0, 400.0, True, P), "dt"),
+])
+def test_api_refuses_a_boolean_argument(table, call, name):
+    with pytest.raises(ValueError) as err:
+        call(table)
+    assert str(err.value).startswith(f"{name} = True ") or str(err.value).startswith(f"{name} = False "), str(err.value)
+
+
+def test_thermal_step_and_system_refuse_a_boolean_parameter():
+    with pytest.raises(ValueError, match=r"^p.C = True is out of range"):
+        thermal_step(300.0, 400.0, 1.0, ClutchParameters(C=True))
+    with pytest.raises(ValueError, match=r"^p.U = False is out of range"):
+        thermal_step(300.0, 400.0, 1.0, ClutchParameters(U=False, H=0.04))
+    with pytest.raises(ValueError, match="^C = True"):
+        thermal_system(ClutchParameters(C=True))

@@ -284,3 +284,38 @@ def test_malformed_table_is_an_error_not_a_crash(fmus, tmp_path, capfd):
     with pytest.raises(Exception, match="instantiate"):      # refused at instantiation, with the reason
         open_slave(fmus["native"], unzip=str(unzip), name="malformed")
     assert "force_deflection.csv line 6: expected 3 finite numbers" in capfd.readouterr().out
+
+
+def _hints(text: str) -> list[str]:
+    import re
+    return re.findall(r"did you mean [^?]*\?", text)
+
+
+@pytest.mark.parametrize("case, hint", [
+    ({"input": ("x_to", 12.0)}, "did you mean 0.012 m?"),                       # mm typed as m
+    ({"input": ("theta_cm", 20.0)}, "did you mean 293.15 K (20 degC)?"),          # degC typed as K
+    ({"start": {"theta_cs_start": 20.0}}, "did you mean 293.15 K (20 degC)?"),    # a parameter
+    ({"start": {"facing_wear": 1.0}}, "did you mean 0.001 m?"),
+])
+def test_unit_hints_native_and_python_agree(fmus, capfd, case, hint):
+    """A value refused for its range carries the likely unit mistake, with the same text from the native C FMU
+    (clutch_core.c unit_hint) and the pythonfmu FMU (number_check.unit_hint), in Co-Simulation through fmpy;
+    a refused step ends fmpy's result early (Discard + Terminated), which is how a user notices it."""
+    from fmpy import simulate_fmu
+
+    got = {}
+    for kind in ("native", "python"):
+        capfd.readouterr()
+        kw = {}
+        if "input" in case:
+            name, value = case["input"]
+            kw["input"] = np.array([(0.0, value), (1.0, value)], dtype=[("time", float), (name, float)])
+        try:
+            res = simulate_fmu(str(fmus[kind]), fmi_type="CoSimulation", stop_time=1.0, output_interval=0.1,
+                               start_values=case.get("start", {}), **kw)
+            assert res["time"][-1] < 1.0, kind          # the run stopped at the refusal
+        except Exception:                               # noqa: BLE001 - a parameter: refused at initialization
+            assert "start" in case, kind
+        got[kind] = _hints(capfd.readouterr().out)
+        assert hint in got[kind], (kind, got[kind])
+    assert set(got["native"]) == set(got["python"]), got

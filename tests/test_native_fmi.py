@@ -118,6 +118,27 @@ def test_model_descriptions_declare_both_interfaces_and_dependencies():
     assert "sources/buildDescription.xml" in zipfile.ZipFile(native_fmus()[3]).namelist()
 
 
+def test_lengths_display_in_mm_and_temperatures_in_degc():
+    """Both FMI versions: the unit m carries an mm DisplayUnit (factor 1000), K a degC one (offset -273.15), and
+    every variable in m names displayUnit mm, every variable in K degC (hosts show x_to = 0.012 as 12 mm)."""
+    from xml.etree import ElementTree as ET
+
+    for v, fmu in native_fmus().items():
+        root = ET.fromstring(zipfile.ZipFile(fmu).read("modelDescription.xml"))
+        units = {u.get("name"): u.find("DisplayUnit") for u in root.iter("Unit")}
+        assert units["m"].attrib == {"name": "mm", "factor": "1000"}, v
+        assert units["K"].attrib == {"name": "degC", "offset": "-273.15"}, v
+        typed = root.iter("Real") if v == 2 else root.find("ModelVariables")
+        seen = {}
+        for el in typed:
+            name = el.get("name") if v == 3 else None
+            seen[name or len(seen)] = (el.get("unit"), el.get("displayUnit"))
+        assert all(d == {"m": "mm", "K": "degC"}.get(u) for u, d in seen.values()), (v, seen)
+        assert sum(u == "m" for u, _ in seen.values()) >= 5 and sum(u == "K" for u, _ in seen.values()) >= 4
+        if v == 3:
+            assert seen["x_to"] == ("m", "mm") and seen["theta_cm"] == ("K", "degC")
+
+
 # ------------------------------------------------------------- FMI 2 state machine
 def _slave(fmu=None, unzip=None, name="s", guid=None):
     fmu = fmu or native_fmus()[2]

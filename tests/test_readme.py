@@ -34,6 +34,32 @@ def test_readme_keeps_the_two_commands_and_ci_runs_the_same_tests():
     assert "sphinx-build -W --keep-going -b html docs docs/_build/html" in text
 
 
+def test_ci_tests_a_fresh_environment_and_the_constraints_pin_every_dependency():
+    """.ci/run makes a virtual environment without system site packages and activates it before the README's
+    command (issue 43); constraints.txt pins every dependency of pyproject.toml (runtime, test, docs) at a
+    version its lower bound allows."""
+    import tomllib
+
+    from packaging.requirements import Requirement
+    from packaging.utils import canonicalize_name
+
+    run = (ROOT / ".ci" / "run").read_text()
+    assert run.index("python3 -m venv") < run.index("/bin/activate") < run.index("bash .ci/install && python3 -m pytest")
+    assert "--system-site-packages" not in run
+    pins = {}
+    for line in (ROOT / "constraints.txt").read_text().splitlines():
+        if line and not line.startswith("#"):
+            name, _, version = line.partition("==")
+            pins[canonicalize_name(name)] = version
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
+    extras = project["optional-dependencies"]
+    for spec in project["dependencies"] + extras["test"] + extras["docs"]:
+        req = Requirement(spec)
+        name = canonicalize_name(req.name)
+        assert name in pins, f"constraints.txt does not pin {req.name}"
+        assert req.specifier.contains(pins[name], prereleases=True), (spec, pins[name])
+
+
 @pytest.mark.fmu
 @pytest.mark.parametrize("code", BLOCKS, ids=[f"block{i}" for i in range(len(BLOCKS))])
 def test_readme_python_block_runs(code, tmp_path, monkeypatch):

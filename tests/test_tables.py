@@ -83,3 +83,18 @@ def test_tables_hold_hand_computed_values(tmp_path):
                                  (195.0, 4e-4, 400.0)], rtol=0.0, atol=1e-12)
     kiss = [line.split(",") for line in (out / "kiss_point.csv").read_text().splitlines()[1:]]
     np.testing.assert_allclose(np.array(kiss, dtype=float), [(20.0, 0.0), (195.0, 2e-4)], rtol=0.0, atol=1e-15)
+
+
+@pytest.mark.parametrize("value, ok", [(0.0041, True), (0, True), (True, False), (False, False), ("0.004", False),
+                                       (2.0, False), (float("nan"), False)])
+def test_table_set_x_kiss_ref_takes_only_a_number(tmp_path, value, ok):
+    """metadata.json's tolerance_study.x_kiss_ref_m: a JSON true was float()ed to 1 m (issue 43)."""
+    import json
+    from cushion_clutch.model.table_format import table_set_x_kiss_ref
+
+    (tmp_path / "metadata.json").write_text(json.dumps({"tolerance_study": {"x_kiss_ref_m": value}}))
+    if ok:
+        assert table_set_x_kiss_ref(tmp_path) == float(value)
+    else:
+        with pytest.raises(ValueError, match="tolerance_study.x_kiss_ref_m"):
+            table_set_x_kiss_ref(tmp_path)

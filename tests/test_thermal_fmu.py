@@ -184,6 +184,28 @@ def test_parameters_from_the_chain_and_errors(fmus, capfd):
     assert tuple(map(float, bounds["omega_engine"])) == (-limit, limit)
 
 
+def test_units_display_and_refusal_hints(fmus, capfd):
+    """The thermal FMU shares the clutch FMU's units and hints: lengths shown in mm, K in degC, and a value refused
+    for its range says what was probably meant (degC typed as K for a parameter, mm typed as m for an input)."""
+    for version, fmu in fmus.items():
+        md = read_model_description(str(fmu))
+        shown = {v.name: (v.unit, v.displayUnit) for v in md.modelVariables}
+        assert shown["x_to"] == ("m", "mm") and shown["theta_cs"] == ("K", "degC"), version
+        assert all(d == {"m": "mm", "K": "degC"}.get(u) for u, d in shown.values()), (version, shown)
+    capfd.readouterr()
+    with pytest.raises(FMICallException, match="fmi2ExitInitializationMode"):
+        Slave(fmus[2], {"theta_cs_start": 20.0})
+    assert "theta_cs_start = 20 is out of range [200, 800]: did you mean 293.15 K (20 degC)?" in capfd.readouterr().out
+    s = Slave(fmus[2])
+    try:
+        s.s.setReal([s.vr["x_to"]], [12.0])
+        with pytest.raises(FMICallException):
+            s.s.doStep(0.0, 0.01)
+    finally:
+        s.close()
+    assert "did you mean 0.012 m?" in capfd.readouterr().out
+
+
 def test_thermal_needs_the_native_backend(tmp_path, capsys):
     assert main(["build-fmu", "--thermal", "--backend", "python", "-o", str(tmp_path / "x.fmu")]) == 2
     assert "thermal = true needs backend 'native'" in capsys.readouterr().err

@@ -91,3 +91,16 @@ def test_reset_tcu_learns_at_standstill_and_a_learned_one_starts_from_its_file(f
                            load_table(), "production")
     assert r2.key_on.start == "learned: moved.json" and r2.key_on.standstill is None
     assert r2.metrics[0]["kiss_point_error_mm"] == pytest.approx(0.2, abs=0.05)
+
+
+@pytest.mark.parametrize("key", ["dx_kiss_m", "mu_scale", "loss_scale", "heat_scale", "dx_kiss_sd_m",
+                                 "starts_since_standstill"])
+def test_stored_state_refuses_a_boolean(tmp_path, key):
+    """Issue 43: a JSON true/false is no number in the stored TCU state (mu_scale = true was taken for 1)."""
+    data = {"version": 1, "dx_kiss_m": 0.5e-3, "dx_kiss_sd_m": 30e-6, "mu_scale": 1.0, "loss_scale": 1.0,
+            "heat_scale": 1.0, "touch_point_learned": True, "starts_since_standstill": 1, key: True}
+    bad = tmp_path / "b.json"
+    bad.write_text(json.dumps(data))
+    with pytest.raises(ParameterError) as err:
+        load_state(bad)
+    assert [p for p in err.value.problems if p.startswith(f"{key} = True")] == err.value.problems, err.value.problems

@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import Any, Iterable
 
 from ..config import Checked, build_checked, load_toml, range_problem
+from ..model.number_check import is_finite_number, is_number
 from ..data import DEFAULT_SPRING
 from .surface import load_surface
 
@@ -85,40 +86,51 @@ class Geometry(Checked):
 
     _section = "geometry"
 
+    _RANGES = {
+        "inner_radius_m": (0.0, 0.5, True),
+        "outer_radius_m": (0.0, 0.5, True),
+        "span_deg": (0.0, 90.0, True),
+        "thickness_m": (0.05e-3, 5e-3),
+        "wave_height_m": (0.0, 5e-3),
+        "carrier_clearance_m": (0.0, 0.2e-3),
+        "wave_start_deg": (0.0, 90.0),
+        "wave_end_deg": (0.0, 90.0),
+        "clamp_start_deg": (0.0, 90.0),
+        "clamp_end_deg": (0.0, 90.0),
+        "crest_flat_fraction": (0.0, 0.8),
+    }
+
     def _problems(self) -> Iterable[str]:
-        yield from self._ranges({
-            "inner_radius_m": (0.0, 0.5, True),
-            "outer_radius_m": (0.0, 0.5, True),
-            "span_deg": (0.0, 90.0, True),
-            "thickness_m": (0.05e-3, 5e-3),
-            "wave_height_m": (0.0, 5e-3),
-            "carrier_clearance_m": (0.0, 0.2e-3),
-            "wave_start_deg": (0.0, 90.0),
-            "wave_end_deg": (0.0, 90.0),
-            "clamp_start_deg": (0.0, 90.0),
-            "clamp_end_deg": (0.0, 90.0),
-        })
-        ok = lambda *n: all(isinstance(getattr(self, k), (int, float)) for k in n)  # noqa: E731
+        spec = self._RANGES
+        yield from self._ranges(spec)
+        # cross-field rules only on values that passed their own range check: one mistake, one message,
+        # each message led by the one key it blames
+        ok = lambda *n: self._passed(spec, *n)  # noqa: E731
         if ok("inner_radius_m", "outer_radius_m") and self.outer_radius_m <= self.inner_radius_m:
             yield (f"geometry.outer_radius_m = {self.outer_radius_m!r}: must exceed "
                    f"geometry.inner_radius_m = {self.inner_radius_m!r}")
-        if ok("clamp_start_deg", "clamp_end_deg", "wave_start_deg", "wave_end_deg", "span_deg"):
-            if not 0 <= self.clamp_start_deg < self.clamp_end_deg <= self.wave_start_deg:
-                yield ("geometry.clamp_start_deg/clamp_end_deg: need 0 <= clamp_start_deg < "
-                       f"clamp_end_deg <= wave_start_deg, got {self.clamp_start_deg!r}, "
-                       f"{self.clamp_end_deg!r}, wave_start_deg = {self.wave_start_deg!r}")
-            if not self.wave_start_deg < self.wave_end_deg <= self.span_deg:
-                yield ("geometry.wave_end_deg: need wave_start_deg < wave_end_deg <= span_deg, got "
-                       f"{self.wave_start_deg!r} < {self.wave_end_deg!r} <= {self.span_deg!r}")
+        if ok("clamp_start_deg", "clamp_end_deg") and not self.clamp_start_deg < self.clamp_end_deg:
+            yield (f"geometry.clamp_end_deg = {self.clamp_end_deg!r}: must exceed "
+                   f"geometry.clamp_start_deg = {self.clamp_start_deg!r}")
+        elif ok("clamp_end_deg", "wave_start_deg") and not self.clamp_end_deg <= self.wave_start_deg:
+            yield (f"geometry.clamp_end_deg = {self.clamp_end_deg!r}: must not exceed "
+                   f"geometry.wave_start_deg = {self.wave_start_deg!r} (the clamp ends before the wave)")
+        if ok("wave_start_deg", "wave_end_deg") and not self.wave_start_deg < self.wave_end_deg:
+            yield (f"geometry.wave_end_deg = {self.wave_end_deg!r}: must exceed "
+                   f"geometry.wave_start_deg = {self.wave_start_deg!r}")
+        elif ok("wave_end_deg", "span_deg") and not self.wave_end_deg <= self.span_deg:
+            yield (f"geometry.wave_end_deg = {self.wave_end_deg!r}: must not exceed "
+                   f"geometry.span_deg = {self.span_deg!r}")
         if self.far_end not in ("free", "locked", "elastic"):
             yield f"geometry.far_end = {self.far_end!r}: allowed 'free', 'locked' or 'elastic'"
         if self.far_zone_support not in ("slot", "carrier"):
             yield (f"geometry.far_zone_support = {self.far_zone_support!r}: allowed 'slot' or "
                    "'carrier'")
-        if isinstance(self.waves, bool) or not isinstance(self.waves, int) or not 1 <= self.waves <= 8:
+        if not (is_number(self.waves) and isinstance(self.waves, int) and 1 <= self.waves <= 8):
             yield f"geometry.waves = {self.waves!r}: must be an integer in [1, 8]"
-        yield from self._ranges({"crest_flat_fraction": (0.0, 0.8)})
-        if ok("wave_height_m", "wave_tilt_m"):
+        if not is_finite_number(self.wave_tilt_m):
+            yield f"geometry.wave_tilt_m = {self.wave_tilt_m!r}: must be a finite number"
+        elif ok("wave_height_m"):
             lim = 2.0 * self.wave_height_m
             if not abs(self.wave_tilt_m) <= lim:
                 yield (f"geometry.wave_tilt_m = {self.wave_tilt_m!r}: out of range, allowed "
@@ -262,7 +274,7 @@ class Material(Checked):
             msg = range_problem(f"material.youngs_modulus_Pa[{i}]", e, 1e6, 1e13)
             if msg:
                 yield msg
-        if all(isinstance(t, (int, float)) for t in temps) and list(temps) != sorted(set(temps)):
+        if all(is_finite_number(t) for t in temps) and list(temps) != sorted(set(temps)):
             yield "material.temperatures_degC: must be strictly increasing"
         alphas = self.expansion_coefficients_per_K
         if alphas:
@@ -449,7 +461,7 @@ class SpringParams(Checked):
     tolerances: Tolerances = field(default_factory=Tolerances)
 
     def _problems(self) -> Iterable[str]:
-        if isinstance(self.n_pairs, bool) or not isinstance(self.n_pairs, int) or not 1 <= self.n_pairs <= 64:
+        if not (is_number(self.n_pairs) and isinstance(self.n_pairs, int) and 1 <= self.n_pairs <= 64):
             yield f"n_pairs = {self.n_pairs!r}: must be an integer in [1, 64]"
         ref = self.material.reference_temperature_degC
         if not any(abs(t - ref) < 1e-9 for t in self.sweep.temperatures_degC):

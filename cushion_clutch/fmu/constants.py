@@ -20,7 +20,8 @@ MODEL_SRC = Path(clutch_model.__file__).parent
 #: and the numpy-only model (from ``MODEL_SRC``)
 SLAVE_MODULES = {"cushion_slave.py": FMU_SRC, "slave_table_sets.py": FMU_SRC, "clutch_model.py": MODEL_SRC,
                  "spring_table.py": MODEL_SRC,
-                 "friction.py": MODEL_SRC, "table_format.py": MODEL_SRC, "cover.py": MODEL_SRC}
+                 "friction.py": MODEL_SRC, "table_format.py": MODEL_SRC, "cover.py": MODEL_SRC,
+                 "number_check.py": MODEL_SRC}
 
 #: the native model core (shared) and the front end of each FMI version, as shipped in sources/
 CORE_HEADERS = ("clutch_core.h", "clutch_tables.h", "clutch_cover.h", "resource_uri.h")

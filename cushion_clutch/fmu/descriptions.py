@@ -9,6 +9,8 @@ the continuous state; torque, force, u_f and x_kiss depend directly on the input
 (ModelStructure lists the dependencies). The model is read when a description
 is written, so the descriptions follow ``VARIABLES`` as it stands.
 
+Hosts show kelvin variables in degC and lengths (unit ``m``: ``x_to``, ``x_kiss``, ``u_f``, ``facing_wear``, the
+cover's dimensions, ...) in mm (:data:`DISPLAY_UNITS`, FMI ``DisplayUnit``; the FMU's values stay SI).
 Every input and parameter carries ``min``, ``max`` and ``nominal`` from the model's one validity table
 (:func:`bounds_attributes`, from ``clutch_model.variable_bounds``); the pythonfmu backend writes the same
 attributes into its description with the same function.
@@ -24,6 +26,22 @@ UNITS = dict(BASE_UNITS, **{"K/s": {"K": "1", "s": "-1"}, "s": {"s": "1"}})
 DESCRIPTION = ("Dry-clutch torque T = n*mu*R_eq*F(u_f(x_to, theta_cs), theta_cs) with the cushion-spring "
                "thermal ODE C dtheta_cs/dt = U (theta_cm - theta_cs) + H (theta_a - theta_cs); F from "
                "CalculiX tables (native C; Co-Simulation and Model Exchange)")
+
+
+#: the display unit of a variable's unit, with its FMI DisplayUnit attributes (display = factor * value + offset)
+DISPLAY_UNITS = {"K": ("degC", {"offset": "-273.15"}), "m": ("mm", {"factor": "1000"})}
+
+
+def display_unit(unit: str) -> str | None:
+    """The display unit hosts show for ``unit`` (degC for K, mm for m), None if it is shown as it is."""
+    return DISPLAY_UNITS[unit][0] if unit in DISPLAY_UNITS else None
+
+
+def add_display_unit(unit_element: ET.Element, unit: str) -> None:
+    """Append ``unit``'s ``DisplayUnit`` (if it has one) to its ``<Unit>`` element in ``UnitDefinitions``."""
+    if unit in DISPLAY_UNITS:
+        name, attrs = DISPLAY_UNITS[unit]
+        ET.SubElement(unit_element, "DisplayUnit", dict(name=name, **attrs))
 
 
 def vr_der() -> int:
@@ -75,8 +93,7 @@ def _units(root: ET.Element) -> None:
     for name, base in UNITS.items():
         unit = ET.SubElement(units, "Unit", name=name)
         ET.SubElement(unit, "BaseUnit", base)
-        if name == "K":
-            ET.SubElement(unit, "DisplayUnit", name="degC", offset="-273.15")
+        add_display_unit(unit, name)
 
 
 def _log_categories(root: ET.Element) -> None:
@@ -102,20 +119,20 @@ def _common_attributes(vr: int, name: str, causality: str, unit: str, desc: str)
 
 def scalar_real(variables: ET.Element, vr: int, name: str, causality: str, unit: str, desc: str) -> ET.Element:
     """Append an FMI 2.0 ``ScalarVariable`` with its ``Real`` element to ``variables``; return the ``Real``
-    (a kelvin variable displayed in degC)."""
+    (with its display unit: degC for K, mm for m)."""
     real = ET.SubElement(ET.SubElement(variables, "ScalarVariable", _common_attributes(vr, name, causality, unit,
                                                                                         desc)), "Real", unit=unit)
-    if unit == "K":
-        real.set("displayUnit", "degC")
+    if display_unit(unit):
+        real.set("displayUnit", display_unit(unit))
     return real
 
 
 def float64_attributes(vr: int, name: str, causality: str, unit: str, desc: str) -> dict[str, str]:
-    """The attributes of an FMI 3.0 ``Float64`` variable (with its unit; a kelvin variable displayed in degC)."""
+    """The attributes of an FMI 3.0 ``Float64`` variable (with its unit and display unit: degC for K, mm for m)."""
     attrs = _common_attributes(vr, name, causality, unit, desc)
     attrs["unit"] = unit
-    if unit == "K":
-        attrs["displayUnit"] = "degC"
+    if display_unit(unit):
+        attrs["displayUnit"] = display_unit(unit)
     return attrs
 
 def fmi2_description(guid: str, has_friction: bool, x_kiss_ref_m: float | None = None) -> str:

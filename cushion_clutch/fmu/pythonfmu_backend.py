@@ -2,7 +2,7 @@
 
 pythonfmu writes the binaries and a bare modelDescription.xml; this module
 stages the slave, the shared model modules and the tables, then completes the
-description: SI units on every variable (temperatures in K with degC as
+description: SI units on every variable (temperatures in K with degC, lengths in m with mm as
 display unit) and the ``InitialUnknowns`` that FMI 2.0 requires for outputs.
 The guard library (:mod:`.guard`) goes in front of pythonfmu's wrapper.
 """
@@ -18,7 +18,7 @@ from xml.etree import ElementTree as ET
 from ..model import clutch_model
 from ..model.table_format import FMU_FILES
 from .constants import BASE_UNITS, FMU_SRC, SLAVE, SLAVE_MODULES
-from .descriptions import bounds_attributes
+from .descriptions import add_display_unit, bounds_attributes, display_unit
 from .guard import guard_fmu
 
 FMU_OPTIONS = dict(needsExecutionTool=False, canHandleVariableCommunicationStepSize=True,
@@ -34,8 +34,7 @@ def complete_model_description(xml_text: str) -> str:
     for name, base in BASE_UNITS.items():
         unit = ET.SubElement(units, "Unit", name=name)
         ET.SubElement(unit, "BaseUnit", base)
-        if name == "K":
-            ET.SubElement(unit, "DisplayUnit", name="degC", offset="-273.15")
+        add_display_unit(unit, name)             # degC for K, mm for m, as the native FMU's
     cosim = root.find("CoSimulation")
     root.insert(list(root).index(cosim) + 1, units)
     outputs = []
@@ -47,8 +46,8 @@ def complete_model_description(xml_text: str) -> str:
         if real is None or name not in var_units:
             raise ValueError(f"variable {name!r} has no unit in clutch_model.VARIABLES")
         real.set("unit", var_units[name])
-        if var_units[name] == "K":
-            real.set("displayUnit", "degC")
+        if display_unit(var_units[name]):
+            real.set("displayUnit", display_unit(var_units[name]))
         for key, value in bounds_attributes(name).items():     # min, max, nominal (issue 28)
             real.set(key, value)
         if var.get("causality") == "output":

@@ -273,7 +273,7 @@ class EkfParams(Checked):
     _section = "ekf"
 
     def _problems(self) -> Iterable[str]:
-        yield from self._ranges({
+        yield from self._ranges(spec := {
             "period_s": (1e-3, 10.0), "theta0_sd_K": (0.0, 500.0), "heat_share_sd": (0.0, 10.0),
             "theta_walk_K2_per_s": (0.0, 1e4), "kiss_sd_m": (0.0, 0.01), "kiss_walk_m2_per_s": (0.0, 1e-3),
             "mu_sd": (0.0, 1.0), "mu_walk_per_s": (0.0, 1.0),
@@ -290,7 +290,8 @@ class EkfParams(Checked):
             "heat_scale_sd": (0.0, 2.0), "heat_walk_per_s": (0.0, 1.0), "loss_excitation_K": (0.0, 500.0), "theta_torque_min_Nm": (0.0, 1e4),
             "scale_min": (0.0, 1.0, True), "scale_max": (1.0, 100.0)})
         yield from self._integers("evidence_confirm")
-        if self.touch_torque_max_Nm <= self.touch_torque_min_Nm:
+        if self._passed(spec, "touch_torque_max_Nm", "touch_torque_min_Nm") and \
+                self.touch_torque_max_Nm <= self.touch_torque_min_Nm:
             yield "ekf.touch_torque_max_Nm: must exceed ekf.touch_torque_min_Nm"
 
 

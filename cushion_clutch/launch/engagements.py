@@ -96,12 +96,15 @@ def simulate(fmu: Path, cycle: EngagementCycle = EngagementCycle(), n_engagement
     """
     from fmpy import simulate_fmu
 
+    from ..fmpy_logger import restore_fmpy_logger
+
     stop = n_engagements * cycle.period_s
     t = np.arange(0.0, stop + step_s / 2, step_s)
     # every input given (omega_slip at its start value), so fmpy does not warn about a missing one
     inputs = np.zeros(len(t), dtype=[("time", float), ("x_to", float), ("theta_cm", float), ("omega_slip", float)])
     inputs["time"], inputs["x_to"], inputs["theta_cm"] = t, cycle.bearing_position(t), cycle.facing_temperature(t)
     inputs["omega_slip"] = OMEGA_SLIP_START
+    restore_fmpy_logger()       # fmpy's default logger: never one freed by an earlier run in this process
     res = simulate_fmu(str(fmu), start_time=0.0, stop_time=stop, output_interval=step_s,
                        input=inputs, start_values=start_values or {},
                        output=["x_to", "theta_cm", "torque", "force", "theta_cs", "u_f", "x_kiss"])

@@ -43,6 +43,8 @@ class ClutchFmu:
         from fmpy import extract, read_model_description
         from fmpy.fmi2 import FMU2Slave
 
+        from ..fmpy_logger import restore_fmpy_logger
+
         md = read_model_description(str(fmu))
         vr = {v.name: v.valueReference for v in md.modelVariables}
         missing = [n for n in INPUTS + OUTPUTS + EXTRA_OUTPUTS if n not in vr]
@@ -52,6 +54,7 @@ class ClutchFmu:
         self.slave = FMU2Slave(guid=md.guid, unzipDirectory=self.unzip,
                                modelIdentifier=md.coSimulation.modelIdentifier, instanceName="clutch")
         s = self.slave
+        restore_fmpy_logger()               # fmpy's default callbacks: never a logger freed by an earlier run
         s.instantiate()
         try:
             s.setupExperiment(startTime=0.0)

@@ -77,10 +77,12 @@ class Protection(Checked):
     def _problems(self) -> Iterable[str]:
         if not isinstance(self.enabled, bool):
             yield f"protection.enabled = {self.enabled!r}: must be true or false"
-        yield from self._ranges({
+        yield from self._ranges(spec := {
             "warn_degC": (20.0, 600.0), "limit_degC": (20.0, 600.0), "inhibit_degC": (20.0, 600.0),
             "resume_degC": (20.0, 600.0), "damage_degC": (20.0, 800.0), "hysteresis_K": (0.0, 100.0),
             "limit_engine_speed_rpm": (500.0, 8000.0)})
+        if not self._passed(spec, "warn_degC", "limit_degC", "inhibit_degC", "damage_degC", "resume_degC"):
+            return
         if not self.warn_degC <= self.limit_degC <= self.inhibit_degC < self.damage_degC:
             yield "protection: need warn_degC <= limit_degC <= inhibit_degC < damage_degC"
         if self.resume_degC >= self.inhibit_degC:

@@ -174,7 +174,7 @@ class Tcu(Checked):
     _section = "tcu"
 
     def _problems(self) -> Iterable[str]:
-        yield from self._ranges({
+        yield from self._ranges(spec := {
             "period_s": (1e-4, 1.0), "torque_ramp_Nm_per_s": (1.0, 1e5),
             "engine_speed_full_pedal_rpm": (500.0, 8000.0), "engine_speed_time_constant_s": (1e-3, 10.0),
             "speed_kp_Nm_per_rad_s": (0.0, 100.0), "speed_ki_Nm_per_rad": (0.0, 1e4),
@@ -184,7 +184,7 @@ class Tcu(Checked):
             "drive_time_s": (0.5, 100.0), "prefill_s": (0.0, 5.0),
             "facing_mu_slope_per_100_rad_s": (-0.2, 0.2), "facing_mu_reference_slip_rad_s": (0.0, 1000.0)})
         k, w_ref = self.facing_mu_slope_per_100_rad_s, self.facing_mu_reference_slip_rad_s
-        if not all(isinstance(v, (int, float)) for v in (k, w_ref)):
+        if not self._passed(spec, "facing_mu_slope_per_100_rad_s", "facing_mu_reference_slip_rad_s"):
             return
         low = min(1.0 + k * (w - w_ref) / 100.0 for w in (0.0, 1000.0))
         if low < 0.5:

@@ -55,7 +55,7 @@ class ProductionSensors(Checked):
     _section = "tcu_sensors"
 
     def _problems(self) -> Iterable[str]:
-        yield from self._ranges({
+        yield from self._ranges(spec := {
             "crank_teeth": (4, 1000), "crank_missing_teeth": (0, 10), "input_teeth": (1, 1000),
             "tooth_pitch_error_rad": (0.0, 0.05), "timer_s": (0.0, 1e-3), "timeout_s": (1e-3, 10.0),
             "torque_gain_error": (-0.2, 0.2), "torque_offset_Nm": (-100.0, 100.0), "torque_noise_Nm": (0.0, 100.0),
@@ -63,7 +63,8 @@ class ProductionSensors(Checked):
             "position_resolution_m": (0.0, 1e-3), "ambient_offset_K": (-20.0, 20.0),
             "ambient_resolution_K": (0.0, 10.0), "seed": (0, 2 ** 31 - 1)})
         yield from self._integers("crank_teeth", "crank_missing_teeth", "input_teeth", "seed")
-        if isinstance(self.crank_teeth, int) and isinstance(self.crank_missing_teeth, int) and \
+        if self._passed(spec, "crank_teeth", "crank_missing_teeth") and \
+                isinstance(self.crank_teeth, int) and isinstance(self.crank_missing_teeth, int) and \
                 self.crank_missing_teeth >= self.crank_teeth - 2:
             yield "tcu_sensors.crank_missing_teeth: must leave at least 2 teeth on the wheel"
 

@@ -16,6 +16,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from ..errors import ParameterError
+from ..model.number_check import is_finite_number, is_number
 
 #: format version of the file
 VERSION = 1
@@ -43,14 +44,14 @@ class AdaptedState:
         for key, lo, hi in (("dx_kiss_m", -0.005, 0.005), ("mu_scale", 0.3, 3.0), ("loss_scale", 0.0, 100.0),
                             ("heat_scale", 0.0, 100.0)):
             v = getattr(self, key)
-            if not isinstance(v, (int, float)) or not lo <= v <= hi:
+            if not is_finite_number(v) or not lo <= v <= hi:
                 out.append(f"{key} = {v!r}: allowed [{lo}, {hi}]")
-        if not (isinstance(self.dx_kiss_sd_m, (int, float)) and (math.isnan(self.dx_kiss_sd_m)
+        if not (is_number(self.dx_kiss_sd_m) and (math.isnan(self.dx_kiss_sd_m)
                                                                    or 0.0 < self.dx_kiss_sd_m < 0.01)):
             out.append(f"dx_kiss_sd_m = {self.dx_kiss_sd_m!r}: allowed (0, 0.01) or NaN")
         if not isinstance(self.touch_point_learned, bool):
             out.append(f"touch_point_learned = {self.touch_point_learned!r}: must be true or false")
-        if isinstance(self.starts_since_standstill, bool) or not isinstance(self.starts_since_standstill, int) \
+        if not (is_number(self.starts_since_standstill) and isinstance(self.starts_since_standstill, int)) \
                 or self.starts_since_standstill < 0:
             out.append(f"starts_since_standstill = {self.starts_since_standstill!r}: must be an integer >= 0")
         return out

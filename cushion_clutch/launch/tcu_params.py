@@ -38,10 +38,11 @@ class Observer(TcuNetworkBase):
 
     def _problems(self) -> Iterable[str]:
         yield from super()._problems()
-        yield from self._ranges({
+        yield from self._ranges(spec := {
             "capacity_J_per_K": (1.0, 1e6), "loss_W_per_K": (0.0, 1e4), "heat_share": (0.0, 1.0),
             "spring_U_W_per_K": (0.0, 1e4), "spring_H_W_per_K": (0.0, 1e4), "spring_C_J_per_K": (0.0, 1e6, True)})
-        if self.spring_U_W_per_K + self.spring_H_W_per_K <= 0.0:
+        if self._passed(spec, "spring_U_W_per_K", "spring_H_W_per_K") and \
+                self.spring_U_W_per_K + self.spring_H_W_per_K <= 0.0:
             yield (f"observer.spring_H_W_per_K: spring_U_W_per_K + spring_H_W_per_K = "
                    f"{self.spring_U_W_per_K + self.spring_H_W_per_K:g} W/K; must be > 0 (the spring exchanges heat)")
 
@@ -127,13 +128,13 @@ class Standstill(Checked):
     def _problems(self) -> Iterable[str]:
         if self.learn not in STANDSTILL_LEARN:
             yield f"standstill.learn = {self.learn!r}: allowed " + ", ".join(STANDSTILL_LEARN)
-        yield from self._ranges({
+        yield from self._ranges(spec := {
             "interval_starts": (1, 100000), "ramp_rate_m_per_s": (1e-6, 0.01), "start_margin_m": (0.0, 0.005),
             "settle_s": (0.0, 10.0), "detect_speed_rad_s": (0.5, 200.0), "fit_speed_rad_s": (1.0, 200.0),
             "min_torque_Nm": (0.0, 100.0), "timeout_s": (0.5, 600.0), "accuracy_m": (1e-7, 1e-3), "disc_inertia_kg_m2": (1e-4, 10.0),
             "plant_drag_Nm": (0.0, 100.0), "plant_drag_Nm_per_rad_s": (0.0, 10.0)})
         yield from self._integers("interval_starts")
-        if self.fit_speed_rad_s <= self.detect_speed_rad_s:
+        if self._passed(spec, "fit_speed_rad_s", "detect_speed_rad_s") and self.fit_speed_rad_s <= self.detect_speed_rad_s:
             yield "standstill.fit_speed_rad_s: must exceed standstill.detect_speed_rad_s"
 
 

@@ -8,7 +8,8 @@
 - :mod:`.table_format`: the table-set format (file names, columns, units, metadata keys), its CSV reader;
 - :mod:`.api`: loading a table set, torque, the thermal model as a python-control system.
 
-The pythonfmu FMU carries ``clutch_model``, ``spring_table``, ``cover``, ``friction`` and ``table_format`` as
+The pythonfmu FMU carries ``clutch_model``, ``spring_table``, ``cover``, ``friction``, ``table_format`` and
+``number_check`` (the one "is this a number, never a bool" predicate) as
 sibling modules (its build copies them), so they import each other relatively with a
 fallback to plain sibling imports. The FE pipeline, the FMU build, the launch
 simulation and the pythonfmu slave all use these modules; nothing here imports

@@ -9,10 +9,10 @@ Examples
 """
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 from .clutch_model import ClutchParameters, SpringTable, outputs
+from .number_check import is_finite_number
 
 __all__ = ["load_table", "torque", "thermal_system"]
 
@@ -40,7 +40,7 @@ def thermal_system(p: ClutchParameters | None = None):
     import control
 
     p = p or ClutchParameters()
-    if not (isinstance(p.C, (int, float)) and math.isfinite(p.C) and p.C > 0.0):
+    if not (is_finite_number(p.C) and p.C > 0.0):
         raise ValueError(f"C = {p.C!r}: the cushion-spring heat capacity (J/K) must be a finite number > 0")
     g = p.U + p.H
     return control.ss([[-g / p.C]], [[p.U / p.C, p.H / p.C]], [[1.0]], [[0.0, 0.0]],

@@ -29,11 +29,13 @@ from functools import lru_cache
 try:                                    # inside the pythonfmu FMU the modules are siblings
     from .cover import CoverMap, CoverParameters, hold_problem, range_problems
     from .friction import FrictionTable
+    from .number_check import any_bool, is_finite_number, is_number, unit_hint
     from .spring_table import KELVIN, Curve, SpringTable, pchip_slopes
     from .table_format import load_csv
 except ImportError:
     from cover import CoverMap, CoverParameters, hold_problem, range_problems
     from friction import FrictionTable
+    from number_check import any_bool, is_finite_number, is_number, unit_hint
     from spring_table import KELVIN, Curve, SpringTable, pchip_slopes
     from table_format import load_csv
 
@@ -189,7 +191,7 @@ class ClutchParameters:
 
     def problems(self) -> list[str]:
         """Every parameter outside its allowed range, with the range."""
-        out = range_problems(self, self.RANGES)
+        out = range_problems(self, self.RANGES, {name: unit for name, _, unit, _ in VARIABLES})
         if not out and self.n_surfaces != int(self.n_surfaces):
             out.append(f"n_surfaces = {self.n_surfaces!r} must be a positive integer in [1, 16]")
         if not out and self.U + self.H <= 0.0:
@@ -268,14 +270,14 @@ ARGUMENT_UNITS = {"x_to": "m", "theta_cs": "K", "theta_cm": "K", "omega_slip": "
 
 
 def range_message(name: str, value, unit: str, rng: tuple) -> str:
-    """``name = value unit is outside [lo, hi] unit``, plus the kelvin hint for a temperature below its range."""
+    """``name = value unit is outside [lo, hi] unit``, plus the hint for the likely unit mistake
+    (:func:`number_check.unit_hint`: mm typed as m, degC typed as K)."""
     lo, hi, lo_open, hi_open = rng[:4]
     if isinstance(value, float):
         value = float(value)                # numpy's float64 repr would name its type
     text = f"{name} = {value!r} {unit} is outside {_range_text(lo, hi, lo_open, hi_open)} {unit}"
-    if unit == "K" and isinstance(value, (int, float)) and value < lo:
-        text += f" (the input is in kelvin: {value!r} degC would be {value + KELVIN:g} K)"
-    return text
+    hint = unit_hint(value, unit, lo, hi)
+    return f"{text}: {hint}" if hint else text
 
 
 def _argument_error(args: dict, p: ClutchParameters | None, names: tuple[str, ...]) -> ValueError:
@@ -283,8 +285,7 @@ def _argument_error(args: dict, p: ClutchParameters | None, names: tuple[str, ..
     problems = []
     for name, v in args.items():
         lo, hi, lo_open, hi_open = ARGUMENT_RANGES[name]
-        ok = isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) and (
-            v > lo if lo_open else v >= lo) and (v < hi if hi_open else v <= hi)
+        ok = is_finite_number(v) and (v > lo if lo_open else v >= lo) and (v < hi if hi_open else v <= hi)
         if not ok:
             problems.append(range_message(name, v, ARGUMENT_UNITS.get(name, ""), (lo, hi, lo_open, hi_open)))
     if p is not None:
@@ -312,7 +313,7 @@ def thermal_step(theta_cs: float, theta_cm: float, dt: float, p: ClutchParameter
     """
     if not (THETA_MIN_K <= theta_cs <= THETA_MAX_K and THETA_MIN_K <= theta_cm <= THETA_MAX_K and 0.0 <= dt <= 1e9
             and 0.0 <= p.U <= 1e4 and 0.0 <= p.H <= 1e4 and 0.0 < p.C <= 1e6
-            and THETA_MIN_K <= p.theta_a <= THETA_MAX_K and p.U + p.H > 0.0):
+            and THETA_MIN_K <= p.theta_a <= THETA_MAX_K and p.U + p.H > 0.0 and not any_bool(dt, p.U, p.H, p.C)):
         raise _argument_error({"theta_cs": theta_cs, "theta_cm": theta_cm, "dt": dt}, p,
                               ("U", "H", "C", "theta_a"))
     g = p.U + p.H
@@ -396,7 +397,8 @@ def _clutch_ok(p: ClutchParameters) -> bool:
     """Cheap range check of the parameters in CLUTCH_PARAMETERS (False for NaN)."""
     return (1.0 <= p.n_surfaces <= 16.0 and p.n_surfaces == int(p.n_surfaces) and 0.0 <= p.mu <= 2.0
             and 0.0 < p.R_eq <= 1.0 and -1.0 <= p.x_kiss_ref <= 1.0 and 0.0 < p.lever_ratio <= 100.0
-            and 0.0 <= p.facing_wear <= 0.004 and not _cover_problems(p.cover, p.lever_ratio))
+            and 0.0 <= p.facing_wear <= 0.004 and not any_bool(*(getattr(p, n) for n in CLUTCH_PARAMETERS))
+            and not _cover_problems(p.cover, p.lever_ratio))
 
 
 _LAST_HOLD: list = [None, None, None, None]     # table, cover, (lever, x_kiss_ref, wear), problem
@@ -510,7 +512,7 @@ def outputs(x_to: float, theta_cs: float, table: SpringTable, p: ClutchParameter
     """
     key = _parameters_checked(table, p)
     if not (X_TO_MIN <= x_to <= X_TO_MAX and THETA_MIN_K <= theta_cs <= THETA_MAX_K
-            and -OMEGA_SLIP_LIMIT <= omega_slip <= OMEGA_SLIP_LIMIT
+            and -OMEGA_SLIP_LIMIT <= omega_slip <= OMEGA_SLIP_LIMIT and not any_bool(x_to, omega_slip)
             and (theta_cm is None or THETA_MIN_K <= theta_cm <= THETA_MAX_K) and (key is None or _clutch_ok(p))):
         raise _argument_error({"x_to": x_to, "theta_cs": theta_cs, "omega_slip": omega_slip,
                                **({} if theta_cm is None else {"theta_cm": theta_cm})}, p, CLUTCH_PARAMETERS)
@@ -566,7 +568,7 @@ def x_to_for_torque(torque: float, theta_cs: float, table: SpringTable, p: Clutc
     """
     key = _parameters_checked(table, p)
     if not (-1e9 <= torque <= 1e9 and THETA_MIN_K <= theta_cs <= THETA_MAX_K and 0.0 < tol_m <= 1.0
-            and -OMEGA_SLIP_LIMIT <= omega_slip <= OMEGA_SLIP_LIMIT
+            and -OMEGA_SLIP_LIMIT <= omega_slip <= OMEGA_SLIP_LIMIT and not any_bool(torque, tol_m, omega_slip)
             and (theta_cm is None or THETA_MIN_K <= theta_cm <= THETA_MAX_K) and (key is None or _clutch_ok(p))):
         raise _argument_error({"torque": torque, "theta_cs": theta_cs, "tol_m": tol_m, "omega_slip": omega_slip,
                                **({} if theta_cm is None else {"theta_cm": theta_cm})}, p, CLUTCH_PARAMETERS)

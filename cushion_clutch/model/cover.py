@@ -98,6 +98,11 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, fields
 
+try:                                    # inside the pythonfmu FMU the modules are siblings
+    from .number_check import is_finite_number, unit_hint
+except ImportError:
+    from number_check import is_finite_number, unit_hint
+
 __all__ = ["range_problems", "finger_compliance", "hold_problem", "wear_limit", "wear_reserve",
            "ENGINE_TORQUE_NM", "RESERVE_FACTOR", "CoverParameters", "CoverState", "k1", "almen_laszlo_force", "almen_laszlo_slope", "CoverMap"]
 
@@ -187,10 +192,12 @@ class CoverParameters:
         return out
 
 
-def range_problems(params, ranges: dict) -> list[str]:
+def range_problems(params, ranges: dict, units: dict | None = None) -> list[str]:
     """Every field of the dataclass ``params`` named in ``ranges`` that is not a finite number in its range.
 
-    ``ranges`` maps a field name to ``(low, high, low_open, high_open)``.
+    ``ranges`` maps a field name to ``(low, high, low_open, high_open)``; ``units`` a field name to its unit
+    (the message then ends with the hint for the likely unit mistake, :func:`number_check.unit_hint`; default:
+    a name ending in ``_m`` is in m, one ending in ``_K`` in K).
     """
     out = []
     for f in fields(params):
@@ -198,11 +205,12 @@ def range_problems(params, ranges: dict) -> list[str]:
             continue
         v = getattr(params, f.name)
         lo, hi, lo_open, hi_open = ranges[f.name]
-        ok = isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) and (
-            v > lo if lo_open else v >= lo) and (v < hi if hi_open else v <= hi)
+        ok = is_finite_number(v) and (v > lo if lo_open else v >= lo) and (v < hi if hi_open else v <= hi)
         if not ok:
+            unit = (units or {}).get(f.name) or ("m" if f.name.endswith("_m") else "K" if f.name.endswith("_K") else "")
+            hint = unit_hint(v, unit, lo, hi)
             out.append(f"{f.name} = {v!r} is out of range {'(' if lo_open else '['}{lo:g}, "
-                       f"{hi:g}{')' if hi_open else ']'}")
+                       f"{hi:g}{')' if hi_open else ']'}" + (f": {hint}" if hint else ""))
     return out
 
 

@@ -17,6 +17,7 @@ from dataclasses import fields
 from pathlib import Path
 
 from .cover import CoverParameters
+from .number_check import is_number
 
 __all__ = ["load_cover", "cover_from_dict"]
 
@@ -38,7 +39,7 @@ def cover_from_dict(section: dict, lever_ratio: float = 3.0, source: str | None 
     for k, v in section.items():
         if k not in allowed:
             continue
-        if isinstance(v, bool) or not isinstance(v, (int, float)):
+        if not is_number(v):
             problems.append(f"cover.{k} = {v!r}: must be a number")
         else:
             values[k] = float(v)

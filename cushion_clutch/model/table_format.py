@@ -85,10 +85,13 @@ def table_set_x_kiss_ref(folder: str | Path) -> float | None:
     path = Path(folder) / METADATA
     if not path.exists():
         return None
+    try:                            # imported here: number_check imports spring_table, which imports this module
+        from .number_check import is_finite_number
+    except ImportError:
+        from number_check import is_finite_number
     value = json.loads(path.read_text()).get("tolerance_study", {}).get("x_kiss_ref_m")
     if value is None:
         return None
-    value = float(value)
-    if not (math.isfinite(value) and -1.0 <= value <= 1.0):
+    if not (is_finite_number(value) and -1.0 <= value <= 1.0):      # a JSON true is no 1 m
         raise ValueError(f"{path}: tolerance_study.x_kiss_ref_m = {value!r}: allowed -1..1 m")
-    return value
+    return float(value)

@@ -135,7 +135,7 @@ class NetworkParams(Checked):
     _section = "plant_thermal"
 
     def _problems(self) -> Iterable[str]:
-        yield from self._ranges({
+        yield from self._ranges(spec := {
             "friction_outer_radius_m": (0.03, 0.5), "friction_inner_radius_m": (0.01, 0.4),
             "metal_conductivity_W_per_m_K": (1.0, 500.0), "metal_density_kg_m3": (1000.0, 20000.0),
             "metal_heat_J_per_kg_K": (100.0, 2000.0), "facing_conductivity_W_per_m_K": (0.05, 50.0),
@@ -147,6 +147,8 @@ class NetworkParams(Checked):
             "still_air_W_per_m2_K": (0.0, 1e3), "rotating_W_per_m2_K": (0.0, 1e4),
             "convection_reference_rad_s": (1.0, 2000.0), "flywheel_cooled_area_m2": (0.0, 1.0),
             "pressure_plate_cooled_area_m2": (0.0, 1.0), "facing_cooled_area_m2": (0.0, 1.0)})
+        if not self._passed(spec, *spec):
+            return                                  # the rules below combine them all
         if self.friction_inner_radius_m >= self.friction_outer_radius_m:
             yield f"{self._key('friction_inner_radius_m')}: must be below friction_outer_radius_m"
             return

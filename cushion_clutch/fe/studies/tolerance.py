@@ -21,6 +21,7 @@ import numpy as np
 from scipy.stats import norm, qmc
 
 from ...errors import ParameterError, StudyError
+from ...model.number_check import is_number
 from ..cases import DEFAULT_CACHE, Case, CaseOutcome, run_cases
 from ..params import TOLERANCE_KEYS, SpringParams, Tolerances
 
@@ -63,7 +64,7 @@ def draw(tolerances: Tolerances, n: int, method: str = "lhs", seed: int = 0) -> 
     problems = []
     if method not in METHODS:
         problems.append(f"--method {method!r}: allowed {', '.join(METHODS)}")
-    if isinstance(n, bool) or not isinstance(n, int) or not 2 <= n <= 100000:
+    if not (is_number(n) and isinstance(n, int) and 2 <= n <= 100000):
         problems.append(f"--samples {n!r}: must be an integer in [2, 100000]")
     sds = tolerances.declared()
     if not sds:

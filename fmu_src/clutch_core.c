@@ -393,11 +393,17 @@ static int get_real_checked(CcModel *m, const unsigned int vr[], size_t n, doubl
             cc_log(m, CC_ERROR, "%s: unknown value reference %u", fn, vr[k]);
             return CC_ERROR;
         }
-    if (m->dirty && refresh(m, fn) != CC_OK && m->me) {
-        /* Model Exchange: outputs of invalid inputs are refused, as the derivative is */
-        for (k = 0; k < n; ++k)
+    if (m->dirty && refresh(m, fn) != CC_OK) {
+        /* outputs of invalid inputs (or of a state the cover cannot hold) are refused, in Co-Simulation as in Model
+           Exchange (docs/reference/statuses.md): Discard, the values are the last ones computed; the state theta_cs
+           and the parameters read OK */
+        int status = CC_OK;
+        for (k = 0; k < n; ++k) {
+            v[k] = m->r[vr[k]];
             if ((CC_VARIABLES[vr[k]].causality == CC_OUTPUT && vr[k] != VR_THETA_CS) || vr[k] == CC_VR_DER_THETA_CS)
-                return CC_DISCARD;
+                status = CC_DISCARD;
+        }
+        return status;
     }
     for (k = 0; k < n; ++k) v[k] = m->r[vr[k]];
     return CC_OK;
@@ -431,25 +437,52 @@ int cc_exit_init(CcModel *m, const char *fn) {
     return CC_OK;
 }
 
+#if CC_THERMAL
+/* the model before a thermal step: a refused step restores all of it (every node, theta_cs, theta_cm, the outputs,
+   the time, the cover's warm start) */
+typedef struct {
+    double r[CC_NVARS];
+    double time;
+    CcWarm warm;
+    int range_warned;
+} CcStepStart;
+
+static void step_start_save(const CcModel *m, CcStepStart *s) {
+    memcpy(s->r, m->r, sizeof s->r);
+    s->time = m->time;
+    s->warm = m->warm;
+    s->range_warned = m->range_warned;
+}
+
+static int step_refused(CcModel *m, const CcStepStart *s) {
+    memcpy(m->r, s->r, sizeof m->r);
+    m->time = s->time;
+    m->warm = s->warm;
+    m->range_warned = s->range_warned;
+    m->dirty = 1; /* the outputs of the current inputs at the step's start, at the next read */
+    cc_net_restore(m);
+    return CC_DISCARD;
+}
+#endif
+
 int cc_do_step(CcModel *m, double t, double h, const char *fn) {
     double g, theta_inf, theta_old, *r = m->r;
     int status = CC_OK;
+#if CC_THERMAL
+    CcStepStart start;
+#endif
     if (!cc_allowed(m, PH_STEP, fn)) return CC_ERROR;
     if (!(h >= 0.0 && h <= DBL_MAX && fabs(t) <= DBL_MAX)) { /* finite, h >= 0 (false for NaN): three compares */
-        cc_log(m, CC_DISCARD, "%s: t = %g s: step size %g s must be finite and >= 0; step refused", fn, t, h);
-        m->terminated = 1;
+        cc_log(m, CC_DISCARD, "%s: t = %.17g s: step size %.17g s must be finite and >= 0; step refused", fn, t, h);
         return CC_DISCARD;
     }
     if (!inputs_ok(r)) {
         log_inputs(m, CC_DISCARD, t, "step refused");
-        m->terminated = 1;
         return CC_DISCARD;
     }
 #if CC_THERMAL
-    if (!cc_net_begin_step(m, t, "step refused")) {
-        m->terminated = 1;
-        return CC_DISCARD;
-    }
+    if (!cc_net_begin_step(m, t, "step refused")) return CC_DISCARD;
+    step_start_save(m, &start);
 #endif
     if (fabs(t - m->time) > 1e-9 * (1.0 + fabs(t))) {
         cc_log(m, CC_WARNING, "%s: currentCommunicationPoint = %.17g s does not follow the previous step "
@@ -467,21 +500,22 @@ int cc_do_step(CcModel *m, double t, double h, const char *fn) {
         r[VR_THETA_CS] = theta_inf + (r[VR_THETA_CS] - theta_inf) * m->decay;
     }
     if (update_outputs(m) != CC_OK) { /* a discarded step leaves state and time where they were */
+#if CC_THERMAL
+        return step_refused(m, &start);
+#else
         r[VR_THETA_CS] = theta_old;
         r[CC_VR_DER_THETA_CS] = (r[VR_U] * r[VR_THETA_CM] + r[VR_H] * r[VR_THETA_A] - g * theta_old) / r[VR_C];
-        m->terminated = 1;
         return CC_DISCARD;
+#endif
     }
-    m->time = t + h;
-    m->terminated = 0;
 #if CC_THERMAL
     /* the launch plant's order: the torque just computed (new theta_cs, held theta_cm) heats the network, then
-       the outputs at the step's end (clutch_thermal.c) */
-    if (cc_net_step(m, h, fn, update_outputs) != CC_OK) {
-        m->terminated = 1;
-        return CC_DISCARD;
-    }
+       the outputs at the step's end (clutch_thermal.c); a refused network step rolls everything back */
+    (void)theta_old;
+    m->time = t;
+    if (cc_net_step(m, h, fn, update_outputs) != CC_OK) return step_refused(m, &start);
 #endif
+    m->time = t + h;
     return status;
 }
 
@@ -539,7 +573,8 @@ int cc_get_state_value(CcModel *m, double *theta_cs, const char *fn) {
 int cc_set_states(CcModel *m, const double *x, const char *fn) {
     int status;
 #if CC_THERMAL
-    if (!cc_allowed(m, PH_CONT, fn) || !cc_net_states_ok(m, x + 1, fn)) return CC_ERROR;
+    if (!cc_allowed(m, PH_CONT, fn)) return CC_ERROR;
+    if (!cc_net_states_ok(m, x + 1, CC_DISCARD, fn, "states not set")) return CC_DISCARD; /* as a refused CS step */
 #endif
     status = cc_set_state_value(m, x[0], fn);
 #if CC_THERMAL
@@ -618,6 +653,10 @@ int cc_state_check(CcModel *m, const void *bytes, size_t size, const char *fn) {
     }
     if (s.phase != PH_INSTANTIATED && s.phase != PH_INIT && s.phase != PH_ERROR && !check_parameters(m, s.r, fn))
         return 0;
+#if CC_THERMAL
+    if (s.phase != PH_INSTANTIATED && s.phase != PH_INIT && s.phase != PH_ERROR && !cc_net_saved_ok(m, s.r, fn))
+        return 0; /* the nodes in their declared ranges, as every step and ME state */
+#endif
     return 1;
 }
 
@@ -631,4 +670,7 @@ void cc_state_load(CcModel *m, const CcState *s) {
     m->decay_h = NAN;
     m->dirty = 1;
     m->cover_ok = 0;
+#if CC_THERMAL
+    if (m->phase != PH_INSTANTIATED && m->phase != PH_INIT && m->phase != PH_ERROR) cc_net_restore(m);
+#endif
 }

@@ -70,7 +70,8 @@ def thermal_dependencies(chain: Chain, has_friction: bool) -> tuple[dict[int, li
 
 
 def _bounds(chain: Chain, name: str) -> dict[str, str]:
-    """FMI ``min``/``max`` of a variant's input or parameter: its closed range bounds (an open bound is left out)."""
+    """FMI ``min``/``max`` of a variant's input, parameter or bounded output: its closed range bounds (an open bound
+    is left out)."""
     rng = thermal_ranges(chain).get(name)
     if rng is None:
         return {}
@@ -135,8 +136,8 @@ def thermal_fmi2_description(guid: str, has_friction: bool, chain: Chain, x_kiss
         real = scalar_real(variables, vr, name, causality, unit, desc)
         if causality in ("input", "parameter"):
             real.set("start", repr(starts[name]))
-            for k, v in _bounds(chain, name).items():
-                real.set(k, v)
+        for k, v in _bounds(chain, name).items():   # inputs, parameters and the nodes (thermal_ranges)
+            real.set(k, v)
         if name.startswith("der("):
             real.set("derivative", str(index[name[4:-1]]))
     variables.append(der_cs)
@@ -185,7 +186,7 @@ def thermal_fmi3_description(token: str, has_friction: bool, chain: Chain, x_kis
             attrs["derivative"] = str(vrs[name[4:-1]])
         if causality in ("input", "parameter"):
             attrs["start"] = repr(starts[name])
-            attrs.update(_bounds(chain, name))
+        attrs.update(_bounds(chain, name))          # inputs, parameters and the nodes (thermal_ranges)
         ET.SubElement(variables, "Float64", attrs)
     variables.append(der_cs)
     deps, ders = thermal_dependencies(chain, has_friction)

@@ -120,6 +120,11 @@ INPUT_RANGES = {
     "theta_cm": (THETA_MIN_K, THETA_MAX_K, False, False),
     "omega_slip": (-OMEGA_SLIP_LIMIT, OMEGA_SLIP_LIMIT, False, False),
 }
+#: the bounded outputs' ranges (the modelDescription's min/max): theta_cs lies between theta_cm and theta_a
+#: (the exact solution of eq. 3), both in [THETA_MIN_K, THETA_MAX_K]
+OUTPUT_RANGES = {
+    "theta_cs": (THETA_MIN_K, THETA_MAX_K, False, False),
+}
 #: nominal values (FMI ``nominal``) where the default is 0 or not a scale: the rest use |default|
 NOMINAL_OVERRIDES = {"x_to": 0.01, "theta_cm": 373.15, "omega_slip": 100.0, "facing_wear": 0.001,
                      "x_kiss_ref": 0.004, "diaphragm_modulus_drop_per_K": 1e-4}
@@ -199,9 +204,10 @@ def variable_bounds() -> dict[str, tuple[float, float, float]]:
     defaults = start_values()
     out = {}
     for name, causality, _, _ in VARIABLES:
-        if causality not in ("input", "parameter"):
+        if causality not in ("input", "parameter") and name not in OUTPUT_RANGES:
             continue
-        lo, hi = (INPUT_RANGES if causality == "input" else ClutchParameters.RANGES)[name][:2]
+        table = {"input": INPUT_RANGES, "parameter": ClutchParameters.RANGES}.get(causality, OUTPUT_RANGES)
+        lo, hi = table[name][:2]
         nominal = NOMINAL_OVERRIDES.get(name, abs(defaults[name]) or 1.0)
         out[name] = (float(lo), float(hi), float(nominal))
     return out

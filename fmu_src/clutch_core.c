@@ -109,17 +109,17 @@ static int cover_consistent(CcModel *m, const double *r, const char *fn) {
     int ok = 1;
     if (!(c[CV_B] < c[CV_RF] && c[CV_RF] < c[CV_RPP] && c[CV_RPP] <= c[CV_A])) {
         if (m) cc_log(m, CC_ERROR, "%s: radii must satisfy diaphragm_inner_radius_m < fulcrum_radius_m < "
-                      "pressure_plate_radius_m <= diaphragm_outer_radius_m (got %g < %g < %g <= %g)", fn, c[CV_B],
+                      "pressure_plate_radius_m <= diaphragm_outer_radius_m (got %.17g < %.17g < %.17g <= %.17g)", fn, c[CV_B],
                       c[CV_RF], c[CV_RPP], c[CV_A]);
         ok = 0;
     }
     if (!(c[CV_H] < 2.0 * sqrt(2.0) * c[CV_T])) {
-        if (m) cc_log(m, CC_ERROR, "%s: diaphragm_cone_height_m / diaphragm_thickness_m = %g must be < 2 sqrt(2) "
+        if (m) cc_log(m, CC_ERROR, "%s: diaphragm_cone_height_m / diaphragm_thickness_m = %.17g must be < 2 sqrt(2) "
                       "(above, the diaphragm's valley force is negative: it snaps through)", fn, c[CV_H] / c[CV_T]);
         ok = 0;
     }
     if (!(c[CV_SINST] <= 2.0 * c[CV_H])) {
-        if (m) cc_log(m, CC_ERROR, "%s: installed_deflection_m = %g must be <= 2 diaphragm_cone_height_m = %g m (past "
+        if (m) cc_log(m, CC_ERROR, "%s: installed_deflection_m = %.17g must be <= 2 diaphragm_cone_height_m = %.17g m (past "
                       "that the diaphragm is turned inside out)", fn, c[CV_SINST], 2.0 * c[CV_H]);
         ok = 0;
     }
@@ -128,7 +128,7 @@ static int cover_consistent(CcModel *m, const double *r, const char *fn) {
         ok = 0;
     }
     if (ok && !(lever * (c[CV_RPP] - c[CV_RF]) < c[CV_RF])) {
-        if (m) cc_log(m, CC_ERROR, "%s: lever_ratio = %g puts the bearing at r_b = r_f - i (r_pp - r_f) = %g m; "
+        if (m) cc_log(m, CC_ERROR, "%s: lever_ratio = %.17g puts the bearing at r_b = r_f - i (r_pp - r_f) = %g m; "
                       "must be > 0", fn, lever, c[CV_RF] - lever * (c[CV_RPP] - c[CV_RF]));
         ok = 0;
     }
@@ -136,7 +136,7 @@ static int cover_consistent(CcModel *m, const double *r, const char *fn) {
         CcCover cv;
         cc_cover_prepare(&cv, c, lever, r[VR_X_KISS_REF], &m->table);
         if (!(cc_cover_slope_bound(&cv) > 0.0)) {
-            cc_log(m, CC_ERROR, "%s: release_compliance_m_per_N = %g: the release snaps through (x_to(s) not "
+            cc_log(m, CC_ERROR, "%s: release_compliance_m_per_N = %.17g: the release snaps through (x_to(s) not "
                    "monotone on the diaphragm's falling branch); reduce it", fn, c[CV_C]);
             ok = 0;
         }
@@ -158,13 +158,13 @@ static int check_parameters(CcModel *m, const double *r, const char *fn) {
     for (k = 0; k < CC_NVARS; ++k) {
         const double *g = CC_VARIABLES[k].range;
         if (is_parameter((unsigned int)k) && !range_ok(k, r[k])) {
-            cc_log(m, CC_ERROR, "%s: parameter %s = %g is out of range %c%g, %g%c", fn, VAR_NAME(k), r[k],
+            cc_log(m, CC_ERROR, "%s: parameter %s = %.17g is out of range %c%g, %g%c", fn, VAR_NAME(k), r[k],
                    g[2] ? '(' : '[', g[0], g[1], g[3] ? ')' : ']');
             ok = 0;
         }
     }
     if (range_ok(VR_N_SURFACES, r[VR_N_SURFACES]) && r[VR_N_SURFACES] != floor(r[VR_N_SURFACES])) {
-        cc_log(m, CC_ERROR, "%s: parameter n_surfaces = %g must be a whole number in [1, 16]", fn, r[VR_N_SURFACES]);
+        cc_log(m, CC_ERROR, "%s: parameter n_surfaces = %.17g must be a whole number in [1, 16]", fn, r[VR_N_SURFACES]);
         ok = 0;
     }
 #if CC_THERMAL
@@ -186,7 +186,7 @@ static int check_parameters(CcModel *m, const double *r, const char *fn) {
             char where[120];
             if (limit >= 0.0) snprintf(where, sizeof where, "the wear limit of this cover is %.6g m", limit);
             else snprintf(where, sizeof where, "this cover cannot hold the cushion even with new facings");
-            cc_log(m, CC_ERROR, "%s: parameter facing_wear = %g m: the diaphragm cannot hold the fully compressed "
+            cc_log(m, CC_ERROR, "%s: parameter facing_wear = %.17g m: the diaphragm cannot hold the fully compressed "
                    "cushion (bearing force %.4g N < 0 at theta_cs = %g K, theta_cm = %g K); %s over theta in "
                    "[%g, %g] K", fn, r[VR_FACING_WEAR], fto, t_cs, t_cm, where, THETA_MIN_K, THETA_MAX_K);
             ok = 0;
@@ -213,11 +213,11 @@ static void log_inputs(CcModel *m, int status, double t, const char *what) {
         double v = m->r[k];
         if (!is_input((unsigned int)k) || range_ok(k, v)) continue;
         if (!strcmp(unit, "K") && v < g[0])
-            cc_log(m, status, "t = %g s: input %s = %g K is outside %c%g, %g%c K (the input is in kelvin: %g degC "
-                   "would be %g K); %s", t, VAR_NAME(k), v, g[2] ? '(' : '[', g[0], g[1], g[3] ? ')' : ']', v,
+            cc_log(m, status, "t = %g s: input %s = %.17g K is outside %c%g, %g%c K (the input is in kelvin: %.17g "
+                   "degC would be %g K); %s", t, VAR_NAME(k), v, g[2] ? '(' : '[', g[0], g[1], g[3] ? ')' : ']', v,
                    v + KELVIN, what);
         else
-            cc_log(m, status, "t = %g s: input %s = %g %s is not finite or outside %c%g, %g%c %s; %s", t, VAR_NAME(k),
+            cc_log(m, status, "t = %g s: input %s = %.17g %s is not finite or outside %c%g, %g%c %s; %s", t, VAR_NAME(k),
                    v, unit, g[2] ? '(' : '[', g[0], g[1], g[3] ? ')' : ']', unit, what);
     }
 }
@@ -473,7 +473,7 @@ int cc_do_step(CcModel *m, double t, double h, const char *fn) {
 #endif
     if (!cc_allowed(m, PH_STEP, fn)) return CC_ERROR;
     if (!(h >= 0.0 && h <= DBL_MAX && fabs(t) <= DBL_MAX)) { /* finite, h >= 0 (false for NaN): three compares */
-        cc_log(m, CC_DISCARD, "%s: t = %.17g s: step size %.17g s must be finite and >= 0; step refused", fn, t, h);
+        cc_log(m, CC_DISCARD, "%s: t = %g s: step size %.17g s must be finite and >= 0; step refused", fn, t, h);
         return CC_DISCARD;
     }
     if (!inputs_ok(r)) {
@@ -545,7 +545,7 @@ int cc_derivative(CcModel *m, double *der, const char *fn) {
 int cc_set_time(CcModel *m, double t, const char *fn) {
     if (!cc_allowed(m, PH_EVENT | PH_CONT, fn)) return CC_ERROR;
     if (!isfinite(t)) {
-        cc_log(m, CC_ERROR, "%s: time = %g s is not finite; refused", fn, t);
+        cc_log(m, CC_ERROR, "%s: time = %.17g s is not finite; refused", fn, t);
         return CC_ERROR;
     }
     m->time = t;
@@ -555,7 +555,7 @@ int cc_set_time(CcModel *m, double t, const char *fn) {
 int cc_set_state_value(CcModel *m, double theta_cs, const char *fn) {
     if (!cc_allowed(m, PH_CONT, fn)) return CC_ERROR;
     if (!(theta_cs >= THETA_MIN_K && theta_cs <= THETA_MAX_K)) {
-        cc_log(m, CC_ERROR, "%s: theta_cs = %g K is not finite or outside [%g, %g] K", fn, theta_cs, THETA_MIN_K,
+        cc_log(m, CC_ERROR, "%s: theta_cs = %.17g K is not finite or outside [%g, %g] K", fn, theta_cs, THETA_MIN_K,
                THETA_MAX_K);
         return CC_ERROR;
     }
@@ -640,7 +640,7 @@ int cc_state_check(CcModel *m, const void *bytes, size_t size, const char *fn) {
     }
     for (k = 0; k < CC_NVARS; ++k)
         if (!isfinite(s.r[k])) {
-            cc_log(m, CC_ERROR, "%s: the state's %s = %g is not finite", fn, VAR_NAME(k), s.r[k]);
+            cc_log(m, CC_ERROR, "%s: the state's %s = %.17g is not finite", fn, VAR_NAME(k), s.r[k]);
             return 0;
         }
     if (!isfinite(s.time) || !(s.r[VR_THETA_CS] >= THETA_MIN_K && s.r[VR_THETA_CS] <= THETA_MAX_K) ||

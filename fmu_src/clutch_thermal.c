@@ -86,7 +86,7 @@ int cc_net_parameters_ok(CcModel *m, const double *r, const char *fn) {
 static int inputs_ok(CcModel *m, double t, const char *what) {
     double w = m->r[VR_OMEGA_ENGINE];
     if (isfinite(w) && fabs(w) <= OMEGA_SLIP_LIMIT) return 1;
-    cc_log(m, CC_DISCARD, "t = %.17g s: input omega_engine = %.17g rad/s is not finite or outside [%.15g, %.15g] "
+    cc_log(m, CC_DISCARD, "t = %g s: input omega_engine = %.17g rad/s is not finite or outside [%.15g, %.15g] "
            "rad/s; %s", t, w, -OMEGA_SLIP_LIMIT, OMEGA_SLIP_LIMIT, what);
     return 0;
 }
@@ -101,13 +101,13 @@ static int nodes_ok(CcModel *m, const double *th, int status, const char *fn, co
     for (k = 0; k < TN_N; ++k) {
         mean += TN_WEIGHT[k] * th[k];
         if (!(th[k] >= TN_THETA_MIN_K && th[k] <= TN_THETA_MAX_K)) { /* false for NaN */
-            cc_log(m, status, "%s: t = %.17g s: %s = %.17g K is not finite or outside [%.15g, %.15g] K; %s", fn,
+            cc_log(m, status, "%s: t = %g s: %s = %.17g K is not finite or outside [%.15g, %.15g] K; %s", fn,
                    m->time, TN_NAME[k], th[k], TN_THETA_MIN_K, TN_THETA_MAX_K, what);
             ok = 0;
         }
     }
     if (ok && !(mean >= THETA_MIN_K && mean <= THETA_MAX_K)) {
-        cc_log(m, status, "%s: t = %.17g s: the facing temperature theta_cm = %.17g K (the facing nodes' mean) is "
+        cc_log(m, status, "%s: t = %g s: the facing temperature theta_cm = %.17g K (the facing nodes' mean) is "
                "outside [%.15g, %.15g] K; %s", fn, m->time, mean, THETA_MIN_K, THETA_MAX_K, what);
         ok = 0;
     }

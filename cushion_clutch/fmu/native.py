@@ -19,6 +19,7 @@ import zipfile
 from pathlib import Path
 
 from ..model import clutch_model
+from ..model.api import load_table
 from ..model.table_format import FMU_FILES, FRICTION, table_set_x_kiss_ref
 from .constants import (CORE_HEADERS, CORE_SOURCES, FMI_HEADERS, FMU_SRC, FRONT_ENDS, SLAVE,  # noqa: F401
                         fmi2_header_dir, fmi_header_dir, sources)
@@ -83,6 +84,7 @@ def build_native_fmu(tables: Path, output: Path, fmi_version: int = 2,
     guid = model_guid(tables, fmi_version, chain)
     has_friction = (tables / FRICTION).exists()
     x_kiss_ref = table_set_x_kiss_ref(tables)
+    table = load_table(tables)                          # facing_wear's declared max: the cover's wear limit with it
     thermal = chain is not None
     with tempfile.TemporaryDirectory(prefix="cushion_native_") as tmp:
         src = Path(tmp) / "sources"
@@ -92,8 +94,8 @@ def build_native_fmu(tables: Path, output: Path, fmi_version: int = 2,
         tmp_out = output.with_suffix(".fmu.tmp")
         try:                                            # no half-written .fmu.tmp left behind
             with zipfile.ZipFile(tmp_out, "w", zipfile.ZIP_DEFLATED) as z:
-                z.writestr("modelDescription.xml", fmi2_description(guid, has_friction, x_kiss_ref)
-                           if fmi_version == 2 else fmi3_description(guid, has_friction, x_kiss_ref))
+                z.writestr("modelDescription.xml", fmi2_description(guid, has_friction, x_kiss_ref, table)
+                           if fmi_version == 2 else fmi3_description(guid, has_friction, x_kiss_ref, table))
                 for platform, lib in sorted(libs.items()):
                     z.write(lib, f"binaries/{platform}/{lib.name}")
                 for name in staged:
@@ -109,7 +111,7 @@ def build_native_fmu(tables: Path, output: Path, fmi_version: int = 2,
             raise
     log.info("built native FMI %d.0 %s (%s) from tables %s", fmi_version, output, ", ".join(sorted(libs)), tables)
     if thermal:                         # the thermal variant's descriptions replace the clutch FMU's
-        thermal_descriptions_into(output, guid, has_friction, chain, x_kiss_ref, fmi_version)
+        thermal_descriptions_into(output, guid, has_friction, chain, x_kiss_ref, fmi_version, table)
     return output
 
 

@@ -16,6 +16,7 @@ from pathlib import Path
 from xml.etree import ElementTree as ET
 
 from ..model import clutch_model
+from ..model.api import load_table
 from ..model.table_format import FMU_FILES
 from .constants import BASE_UNITS, FMU_SRC, SLAVE, SLAVE_MODULES
 from .descriptions import bounds_attributes
@@ -26,9 +27,11 @@ FMU_OPTIONS = dict(needsExecutionTool=False, canHandleVariableCommunicationStepS
                    canGetAndSetFMUstate=True, canSerializeFMUstate=True)
 
 
-def complete_model_description(xml_text: str) -> str:
-    """Add unit definitions, variable units and InitialUnknowns to pythonfmu's XML."""
+def complete_model_description(xml_text: str, table=None) -> str:
+    """Add unit definitions, variable units, min/max/nominal (``table``: the FMU's SpringTable, for facing_wear's
+    declared max) and InitialUnknowns to pythonfmu's XML."""
     root = ET.fromstring(xml_text)
+    bounds = clutch_model.variable_bounds(table)
     var_units = {name: unit for name, _, unit, _ in clutch_model.VARIABLES}   # temperatures: degC displayed
     units = ET.Element("UnitDefinitions")
     for name, base in BASE_UNITS.items():
@@ -47,7 +50,7 @@ def complete_model_description(xml_text: str) -> str:
         real.set("unit", var_units[name])
         if var_units[name] == "K":
             real.set("displayUnit", "degC")
-        for key, value in bounds_attributes(name).items():     # min, max, nominal (issue 28)
+        for key, value in bounds_attributes(name, bounds).items():     # min, max, nominal (issue 28)
             real.set(key, value)
         if var.get("causality") == "output":
             outputs.append(index)
@@ -94,5 +97,6 @@ def build_python_fmu(tables: Path, output: Path) -> Path:
             built = FmuBuilder.build_FMU(stage / f"{SLAVE}.py", dest=stage / "out",
                                          project_files=[*(stage / m for m in SLAVE_MODULES), stage / "tables"],
                                          **FMU_OPTIONS)
-        guard_fmu(Path(built), output, complete_model_description)
+        table = load_table(tables)
+        guard_fmu(Path(built), output, lambda xml: complete_model_description(xml, table))
     return output

@@ -110,9 +110,10 @@ def _theta_cm_description(chain: Chain) -> str:
     return next(d for _, n, _, u, d in _all(chain) if n == "theta_cm") + " [K]"
 
 
-def thermal_fmi2_description(guid: str, has_friction: bool, chain: Chain, x_kiss_ref_m: float | None = None) -> str:
-    """FMI 2.0 modelDescription.xml of the thermal FMU (ME and CS)."""
-    root = ET.fromstring(fmi2_description(guid, has_friction, x_kiss_ref_m))
+def thermal_fmi2_description(guid: str, has_friction: bool, chain: Chain, x_kiss_ref_m: float | None = None,
+                             table=None) -> str:
+    """FMI 2.0 modelDescription.xml of the thermal FMU (ME and CS; ``table``: its SpringTable)."""
+    root = ET.fromstring(fmi2_description(guid, has_friction, x_kiss_ref_m, table))
     _head(root, 2)
     p = None if x_kiss_ref_m is None else clutch_model.ClutchParameters(x_kiss_ref=x_kiss_ref_m)
     starts = thermal_starts(chain, p)
@@ -157,9 +158,11 @@ def thermal_fmi2_description(guid: str, has_friction: bool, chain: Chain, x_kiss
     return _finish(root)
 
 
-def thermal_fmi3_description(token: str, has_friction: bool, chain: Chain, x_kiss_ref_m: float | None = None) -> str:
-    """FMI 3.0 modelDescription.xml of the thermal FMU (ME and CS, independent variable time)."""
-    root = ET.fromstring(fmi3_description(token, has_friction, x_kiss_ref_m))
+def thermal_fmi3_description(token: str, has_friction: bool, chain: Chain, x_kiss_ref_m: float | None = None,
+                             table=None) -> str:
+    """FMI 3.0 modelDescription.xml of the thermal FMU (ME and CS, independent variable time; ``table``: its
+    SpringTable)."""
+    root = ET.fromstring(fmi3_description(token, has_friction, x_kiss_ref_m, table))
     _head(root, 3)
     p = None if x_kiss_ref_m is None else clutch_model.ClutchParameters(x_kiss_ref=x_kiss_ref_m)
     starts = thermal_starts(chain, p)
@@ -208,12 +211,12 @@ def thermal_fmi3_build_description() -> str:
 
 
 def thermal_descriptions_into(fmu: Path, guid: str, has_friction: bool, chain: Chain, x_kiss_ref_m: float | None,
-                              fmi_version: int) -> None:
+                              fmi_version: int, table=None) -> None:
     """Replace ``modelDescription.xml`` (and, FMI 3.0, ``sources/buildDescription.xml``) in the built ``fmu``
     with the thermal variant's (the native build writes the clutch FMU's; binaries and sources are the variant's)."""
     fmu = Path(fmu)
-    replace = {"modelDescription.xml": thermal_fmi2_description(guid, has_friction, chain, x_kiss_ref_m)
-               if fmi_version == 2 else thermal_fmi3_description(guid, has_friction, chain, x_kiss_ref_m)}
+    replace = {"modelDescription.xml": thermal_fmi2_description(guid, has_friction, chain, x_kiss_ref_m, table)
+               if fmi_version == 2 else thermal_fmi3_description(guid, has_friction, chain, x_kiss_ref_m, table)}
     if fmi_version == 3:
         replace["sources/buildDescription.xml"] = thermal_fmi3_build_description()
     tmp = fmu.with_suffix(".fmu.tmp")

@@ -20,7 +20,7 @@ HEADER = "cushion_variables.h"
 #: C causality codes (the header's enum)
 CAUSALITIES = {"input": "CC_INPUT", "output": "CC_OUTPUT", "parameter": "CC_PARAMETER", "local": "CC_LOCAL"}
 #: input limits of the model written as C macros
-LIMITS = ("X_TO_MIN", "X_TO_MAX", "THETA_MIN_K", "THETA_MAX_K", "THETA_CM_LIMIT", "OMEGA_SLIP_LIMIT")
+LIMITS = ("X_TO_MIN", "X_TO_MAX", "THETA_MIN_K", "THETA_MAX_K", "OMEGA_SLIP_LIMIT")
 
 
 def enum_name(name: str) -> str:

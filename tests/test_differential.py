@@ -83,7 +83,8 @@ def test_model_exchange_answers_every_call_as_co_simulation(fmus):
 @pytest.mark.parametrize("which", [0, 1, 2])
 def test_a_read_after_a_refused_input_is_never_a_stale_value_with_ok(fmus, which):
     """After a step, x_to = 1 m is set (accepted: fmi2OK, it is only an input) and torque read: Discard, in the
-    native FMI 2.0 and 3.0 and the pythonfmu FMU alike; the state theta_cs reads OK; a valid input recovers."""
+    native FMI 2.0 and 3.0 and the pythonfmu FMU alike; the state theta_cs reads OK; the refused step leaves
+    fmi2Terminated false (the pythonfmu wrapper's own answer is true: the guard answers); a valid input recovers."""
     fmu = fmus[which]
     fmu.instantiate()
     try:
@@ -96,7 +97,11 @@ def test_a_read_after_a_refused_input_is_never_a_stale_value_with_ok(fmus, which
         assert fmu.get(["theta_cs"])[0] == 0, fmu.label
         assert any("x_to = 1" in m and "[-0.002, 0.025] m" in m for m in fmu.log.lines), fmu.log.lines
         assert fmu.step(0.1, 0.1) == 2
+        if fmu.fmi == 2:                                           # a recoverable Discard: not Terminated
+            assert fmu.slave.getBooleanStatus(3) is False, fmu.label
+            assert fmu.slave.getRealStatus(2) == pytest.approx(0.1), fmu.label
         assert fmu.set({"x_to": 0.008}) == 0 and fmu.get(["torque"]) == (0, [torque])
+        assert fmu.step(0.1, 0.1) == 0, fmu.label                  # and the next step proceeds
     finally:
         fmu.free()
 

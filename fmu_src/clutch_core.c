@@ -395,12 +395,16 @@ static int get_real_checked(CcModel *m, const unsigned int vr[], size_t n, doubl
         }
     if (m->dirty && refresh(m, fn) != CC_OK) {
         /* outputs of invalid inputs (or of a state the cover cannot hold) are refused, in Co-Simulation as in Model
-           Exchange (docs/reference/statuses.md): Discard, the values are the last ones computed; the state theta_cs
-           and the parameters read OK */
+           Exchange (docs/reference/statuses.md): Discard, the values are the last ones computed; the states
+           (theta_cs, the thermal variant's nodes and theta_cm) and the parameters read OK */
         int status = CC_OK;
         for (k = 0; k < n; ++k) {
             v[k] = m->r[vr[k]];
-            if ((CC_VARIABLES[vr[k]].causality == CC_OUTPUT && vr[k] != VR_THETA_CS) || vr[k] == CC_VR_DER_THETA_CS)
+            if ((CC_VARIABLES[vr[k]].causality == CC_OUTPUT && vr[k] != VR_THETA_CS
+#if CC_THERMAL
+                 && !cc_net_state_output(vr[k]) /* the nodes and their facing mean are states too */
+#endif
+                 ) || vr[k] == CC_VR_DER_THETA_CS)
                 status = CC_DISCARD;
         }
         return status;

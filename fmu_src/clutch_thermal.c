@@ -168,6 +168,14 @@ int cc_net_saved_ok(CcModel *m, const double *r, const char *fn) {
     return nodes_ok(m, th, CC_ERROR, fn, "state refused");
 }
 
+int cc_net_state_output(unsigned int vr) {
+    int k;
+    if (vr == VR_THETA_CM) return 1;
+    for (k = 0; k < TN_N; ++k)
+        if (vr == (unsigned int)TN_VR_THETA[k]) return 1;
+    return 0;
+}
+
 void cc_net_restore(CcModel *m) {
     double th[TN_N];
     int k;

@@ -165,3 +165,21 @@ def test_error_and_warning_statuses_are_the_native_ones(fmus):
             assert fmu.step(0.15, 0.1) == 0, fmu.label
         finally:
             fmu.free()
+
+
+def test_messages_print_the_offending_value_exactly_and_the_same_range(fmus):
+    """x_to = 0.025000001 m (just past the range): every front end's message prints a number that is exactly that
+    value (native %.17g, pythonfmu repr; "%g" printed the limit itself) and the range [-0.002, 0.025] m."""
+    import re
+    value = 0.025000001
+    for fmu in fmus:
+        fmu.instantiate()
+        try:
+            assert fmu.init(0.0, {})[-1] == 0
+            fmu.set({"x_to": value})
+            assert fmu.step(0.0, 0.1) == 2, fmu.label
+            line = next(m for m in fmu.log.lines if "x_to = " in m)
+            printed = float(re.search(r"x_to = ([-+0-9.e]+) m", line).group(1))
+            assert printed == value and "[-0.002, 0.025] m" in line, (fmu.label, line)
+        finally:
+            fmu.free()

@@ -442,28 +442,30 @@ int cc_exit_init(CcModel *m, const char *fn) {
 }
 
 #if CC_THERMAL
-/* the model before a thermal step: a refused step restores all of it (every node, theta_cs, theta_cm, the outputs,
-   the time, the cover's warm start) */
+/* the model's state before a thermal step: a refused step restores it (theta_cs, every node and so theta_cm, the
+   time, the cover's warm start, the validity last warned); the outputs and derivatives, computed from it, are
+   recomputed at the next read */
 typedef struct {
-    double r[CC_NVARS];
-    double time;
+    double theta_cs, time;
+    double nodes[CC_NSTATES - 1];
     CcWarm warm;
     int range_warned;
 } CcStepStart;
 
-static void step_start_save(const CcModel *m, CcStepStart *s) {
-    memcpy(s->r, m->r, sizeof s->r);
+static void step_start_save(CcModel *m, CcStepStart *s) {
+    s->theta_cs = m->r[VR_THETA_CS];
     s->time = m->time;
+    cc_net_get_states(m, s->nodes);
     s->warm = m->warm;
     s->range_warned = m->range_warned;
 }
 
 static int step_refused(CcModel *m, const CcStepStart *s) {
-    memcpy(m->r, s->r, sizeof m->r);
+    m->r[VR_THETA_CS] = s->theta_cs;
     m->time = s->time;
+    cc_net_set_states(m, s->nodes); /* the nodes and theta_cm; dirty: outputs and derivatives at the next read */
     m->warm = s->warm;
     m->range_warned = s->range_warned;
-    m->dirty = 1; /* the outputs of the current inputs at the step's start, at the next read */
     cc_net_restore(m);
     return CC_DISCARD;
 }

@@ -189,17 +189,17 @@ static int cover_consistent(CcModel *m, const double *r, const char *fn) {
     int ok = 1;
     if (!(c[CV_B] < c[CV_RF] && c[CV_RF] < c[CV_RPP] && c[CV_RPP] <= c[CV_A])) {
         if (m) cc_log(m, CC_ERROR, "%s: radii must satisfy diaphragm_inner_radius_m < fulcrum_radius_m < "
-                      "pressure_plate_radius_m <= diaphragm_outer_radius_m (got %g < %g < %g <= %g)", fn, c[CV_B],
+                      "pressure_plate_radius_m <= diaphragm_outer_radius_m (got %.17g < %.17g < %.17g <= %.17g)", fn, c[CV_B],
                       c[CV_RF], c[CV_RPP], c[CV_A]);
         ok = 0;
     }
     if (!(c[CV_H] < 2.0 * sqrt(2.0) * c[CV_T])) {
-        if (m) cc_log(m, CC_ERROR, "%s: diaphragm_cone_height_m / diaphragm_thickness_m = %g must be < 2 sqrt(2) "
+        if (m) cc_log(m, CC_ERROR, "%s: diaphragm_cone_height_m / diaphragm_thickness_m = %.17g must be < 2 sqrt(2) "
                       "(above, the diaphragm's valley force is negative: it snaps through)", fn, c[CV_H] / c[CV_T]);
         ok = 0;
     }
     if (!(c[CV_SINST] <= 2.0 * c[CV_H])) {
-        if (m) cc_log(m, CC_ERROR, "%s: installed_deflection_m = %g must be <= 2 diaphragm_cone_height_m = %g m (past "
+        if (m) cc_log(m, CC_ERROR, "%s: installed_deflection_m = %.17g must be <= 2 diaphragm_cone_height_m = %.17g m (past "
                       "that the diaphragm is turned inside out)", fn, c[CV_SINST], 2.0 * c[CV_H]);
         ok = 0;
     }
@@ -208,7 +208,7 @@ static int cover_consistent(CcModel *m, const double *r, const char *fn) {
         ok = 0;
     }
     if (ok && !(lever * (c[CV_RPP] - c[CV_RF]) < c[CV_RF])) {
-        if (m) cc_log(m, CC_ERROR, "%s: lever_ratio = %g puts the bearing at r_b = r_f - i (r_pp - r_f) = %g m; "
+        if (m) cc_log(m, CC_ERROR, "%s: lever_ratio = %.17g puts the bearing at r_b = r_f - i (r_pp - r_f) = %g m; "
                       "must be > 0", fn, lever, c[CV_RF] - lever * (c[CV_RPP] - c[CV_RF]));
         ok = 0;
     }
@@ -216,7 +216,7 @@ static int cover_consistent(CcModel *m, const double *r, const char *fn) {
         CcCover cv;
         cc_cover_prepare(&cv, c, lever, kiss_ref(m, r), &m->table);
         if (!(cc_cover_slope_bound(&cv) > 0.0)) {
-            cc_log(m, CC_ERROR, "%s: release_compliance_m_per_N = %g: the release snaps through (x_to(s) not "
+            cc_log(m, CC_ERROR, "%s: release_compliance_m_per_N = %.17g: the release snaps through (x_to(s) not "
                    "monotone on the diaphragm's falling branch); reduce it", fn, c[CV_C]);
             ok = 0;
         }
@@ -239,13 +239,13 @@ static int check_parameters(CcModel *m, const double *r, const char *fn) {
         const double *g = CC_VARIABLES[k].range;
         char hint[96];
         if (is_parameter((unsigned int)k) && !range_ok(k, r[k])) {
-            cc_log(m, CC_ERROR, "%s: parameter %s = %g is out of range %c%g, %g%c%s", fn, VAR_NAME(k), r[k],
+            cc_log(m, CC_ERROR, "%s: parameter %s = %.17g is out of range %c%g, %g%c%s", fn, VAR_NAME(k), r[k],
                    g[2] ? '(' : '[', g[0], g[1], g[3] ? ')' : ']', unit_hint(hint, sizeof hint, k, r[k]));
             ok = 0;
         }
     }
     if (range_ok(VR_N_SURFACES, r[VR_N_SURFACES]) && r[VR_N_SURFACES] != floor(r[VR_N_SURFACES])) {
-        cc_log(m, CC_ERROR, "%s: parameter n_surfaces = %g must be a whole number in [1, 16]", fn, r[VR_N_SURFACES]);
+        cc_log(m, CC_ERROR, "%s: parameter n_surfaces = %.17g must be a whole number in [1, 16]", fn, r[VR_N_SURFACES]);
         ok = 0;
     }
 #if CC_THERMAL
@@ -267,7 +267,7 @@ static int check_parameters(CcModel *m, const double *r, const char *fn) {
             char where[120];
             if (limit >= 0.0) snprintf(where, sizeof where, "the wear limit of this cover is %.6g m", limit);
             else snprintf(where, sizeof where, "this cover cannot hold the cushion even with new facings");
-            cc_log(m, CC_ERROR, "%s: parameter facing_wear = %g m: the diaphragm cannot hold the fully compressed "
+            cc_log(m, CC_ERROR, "%s: parameter facing_wear = %.17g m: the diaphragm cannot hold the fully compressed "
                    "cushion (bearing force %.4g N < 0 at theta_cs = %g K, theta_cm = %g K); %s over theta in "
                    "[%g, %g] K", fn, r[VR_FACING_WEAR], fto, t_cs, t_cm, where, THETA_MIN_K, THETA_MAX_K);
             ok = 0;
@@ -294,7 +294,7 @@ static void log_inputs(CcModel *m, int status, double t, const char *what) {
         double v = m->r[k];
         char hint[96];
         if (!is_input((unsigned int)k) || range_ok(k, v)) continue;
-        cc_log(m, status, "t = %g s: input %s = %g %s is not finite or outside %c%g, %g%c %s%s; %s", t, VAR_NAME(k),
+        cc_log(m, status, "t = %g s: input %s = %.17g %s is not finite or outside %c%g, %g%c %s%s; %s", t, VAR_NAME(k),
                v, unit, g[2] ? '(' : '[', g[0], g[1], g[3] ? ')' : ']', unit, unit_hint(hint, sizeof hint, k, v), what);
     }
 }
@@ -470,11 +470,21 @@ static int get_real_checked(CcModel *m, const unsigned int vr[], size_t n, doubl
             cc_log(m, CC_ERROR, "%s: unknown value reference %u", fn, vr[k]);
             return CC_ERROR;
         }
-    if (m->dirty && refresh(m, fn) != CC_OK && m->me) {
-        /* Model Exchange: outputs of invalid inputs are refused, as the derivative is */
-        for (k = 0; k < n; ++k)
-            if ((CC_VARIABLES[vr[k]].causality == CC_OUTPUT && vr[k] != VR_THETA_CS) || vr[k] == CC_VR_DER_THETA_CS)
-                return CC_DISCARD;
+    if (m->dirty && refresh(m, fn) != CC_OK) {
+        /* outputs of invalid inputs (or of a state the cover cannot hold) are refused, in Co-Simulation as in Model
+           Exchange (docs/reference/statuses.md): Discard, the values are the last ones computed; the states
+           (theta_cs, the thermal variant's nodes and theta_cm) and the parameters read OK */
+        int status = CC_OK;
+        for (k = 0; k < n; ++k) {
+            v[k] = m->r[vr[k]];
+            if ((CC_VARIABLES[vr[k]].causality == CC_OUTPUT && vr[k] != VR_THETA_CS
+#if CC_THERMAL
+                 && !cc_net_state_output(vr[k]) /* the nodes and their facing mean are states too */
+#endif
+                 ) || vr[k] == CC_VR_DER_THETA_CS)
+                status = CC_DISCARD;
+        }
+        return status;
     }
     for (k = 0; k < n; ++k) v[k] = m->r[vr[k]];
     return CC_OK;
@@ -511,25 +521,54 @@ int cc_exit_init(CcModel *m, const char *fn) {
     return CC_OK;
 }
 
+#if CC_THERMAL
+/* the model's state before a thermal step: a refused step restores it (theta_cs, every node and so theta_cm, the
+   time, the cover's warm start, the validity last warned); the outputs and derivatives, computed from it, are
+   recomputed at the next read */
+typedef struct {
+    double theta_cs, time;
+    double nodes[CC_NSTATES - 1];
+    CcWarm warm;
+    int range_warned;
+} CcStepStart;
+
+static void step_start_save(CcModel *m, CcStepStart *s) {
+    s->theta_cs = m->r[VR_THETA_CS];
+    s->time = m->time;
+    cc_net_get_states(m, s->nodes);
+    s->warm = m->warm;
+    s->range_warned = m->range_warned;
+}
+
+static int step_refused(CcModel *m, const CcStepStart *s) {
+    m->r[VR_THETA_CS] = s->theta_cs;
+    m->time = s->time;
+    cc_net_set_states(m, s->nodes); /* the nodes and theta_cm; dirty: outputs and derivatives at the next read */
+    m->warm = s->warm;
+    m->range_warned = s->range_warned;
+    cc_net_restore(m);
+    return CC_DISCARD;
+}
+#endif
+
 int cc_do_step(CcModel *m, double t, double h, const char *fn) {
     double g, theta_inf, theta_old, *r = m->r;
     int status = CC_OK;
+#if CC_THERMAL
+    CcStepStart start;
+#endif
     if (!cc_allowed(m, PH_STEP, fn)) return CC_ERROR;
     if (!(h >= 0.0 && h <= DBL_MAX && fabs(t) <= DBL_MAX)) { /* finite, h >= 0 (false for NaN): three compares */
-        cc_log(m, CC_DISCARD, "%s: t = %g s: step size %g s must be finite and >= 0; step refused", fn, t, h);
-        m->terminated = 1;
+        cc_log(m, CC_DISCARD, "%s: t = %g s: step size %.17g s must be finite and >= 0; step refused", fn, t, h);
         return CC_DISCARD;
     }
     if (!inputs_ok(r)) {
         log_inputs(m, CC_DISCARD, t, "step refused");
-        m->terminated = 1;
         return CC_DISCARD;
     }
 #if CC_THERMAL
-    if (!cc_net_begin_step(m, t, "step refused")) {
-        m->terminated = 1;
-        return CC_DISCARD;
-    }
+    if (!cc_net_begin_step(m, t, "step refused")) return CC_DISCARD;
+    step_start_save(m, &start);
 #endif
     if (fabs(t - m->time) > 1e-9 * (1.0 + fabs(t))) {
         cc_log(m, CC_WARNING, "%s: currentCommunicationPoint = %.17g s does not follow the previous step "
@@ -547,21 +586,22 @@ int cc_do_step(CcModel *m, double t, double h, const char *fn) {
         r[VR_THETA_CS] = theta_inf + (r[VR_THETA_CS] - theta_inf) * m->decay;
     }
     if (update_outputs(m) != CC_OK) { /* a discarded step leaves state and time where they were */
+#if CC_THERMAL
+        return step_refused(m, &start);
+#else
         r[VR_THETA_CS] = theta_old;
         r[CC_VR_DER_THETA_CS] = (r[VR_U] * r[VR_THETA_CM] + r[VR_H] * r[VR_THETA_A] - g * theta_old) / r[VR_C];
-        m->terminated = 1;
         return CC_DISCARD;
+#endif
     }
-    m->time = t + h;
-    m->terminated = 0;
 #if CC_THERMAL
     /* the launch plant's order: the torque just computed (new theta_cs, held theta_cm) heats the network, then
-       the outputs at the step's end (clutch_thermal.c) */
-    if (cc_net_step(m, h, fn, update_outputs) != CC_OK) {
-        m->terminated = 1;
-        return CC_DISCARD;
-    }
+       the outputs at the step's end (clutch_thermal.c); a refused network step rolls everything back */
+    (void)theta_old;
+    m->time = t;
+    if (cc_net_step(m, h, fn, update_outputs) != CC_OK) return step_refused(m, &start);
 #endif
+    m->time = t + h;
     return status;
 }
 
@@ -591,7 +631,7 @@ int cc_derivative(CcModel *m, double *der, const char *fn) {
 int cc_set_time(CcModel *m, double t, const char *fn) {
     if (!cc_allowed(m, PH_EVENT | PH_CONT, fn)) return CC_ERROR;
     if (!isfinite(t)) {
-        cc_log(m, CC_ERROR, "%s: time = %g s is not finite; refused", fn, t);
+        cc_log(m, CC_ERROR, "%s: time = %.17g s is not finite; refused", fn, t);
         return CC_ERROR;
     }
     m->time = t;
@@ -601,7 +641,7 @@ int cc_set_time(CcModel *m, double t, const char *fn) {
 int cc_set_state_value(CcModel *m, double theta_cs, const char *fn) {
     if (!cc_allowed(m, PH_CONT, fn)) return CC_ERROR;
     if (!(theta_cs >= THETA_MIN_K && theta_cs <= THETA_MAX_K)) {
-        cc_log(m, CC_ERROR, "%s: theta_cs = %g K is not finite or outside [%g, %g] K", fn, theta_cs, THETA_MIN_K,
+        cc_log(m, CC_ERROR, "%s: theta_cs = %.17g K is not finite or outside [%g, %g] K", fn, theta_cs, THETA_MIN_K,
                THETA_MAX_K);
         return CC_ERROR;
     }
@@ -619,7 +659,8 @@ int cc_get_state_value(CcModel *m, double *theta_cs, const char *fn) {
 int cc_set_states(CcModel *m, const double *x, const char *fn) {
     int status;
 #if CC_THERMAL
-    if (!cc_allowed(m, PH_CONT, fn) || !cc_net_states_ok(m, x + 1, fn)) return CC_ERROR;
+    if (!cc_allowed(m, PH_CONT, fn)) return CC_ERROR;
+    if (!cc_net_states_ok(m, x + 1, CC_DISCARD, fn, "states not set")) return CC_DISCARD; /* as a refused CS step */
 #endif
     status = cc_set_state_value(m, x[0], fn);
 #if CC_THERMAL
@@ -686,7 +727,7 @@ int cc_state_check(CcModel *m, const void *bytes, size_t size, const char *fn) {
     }
     for (k = 0; k < CC_NVARS; ++k)
         if (!isfinite(s.r[k])) {
-            cc_log(m, CC_ERROR, "%s: the state's %s = %g is not finite", fn, VAR_NAME(k), s.r[k]);
+            cc_log(m, CC_ERROR, "%s: the state's %s = %.17g is not finite", fn, VAR_NAME(k), s.r[k]);
             return 0;
         }
     if (!isfinite(s.time) || !(s.r[VR_THETA_CS] >= THETA_MIN_K && s.r[VR_THETA_CS] <= THETA_MAX_K) ||
@@ -704,6 +745,10 @@ int cc_state_check(CcModel *m, const void *bytes, size_t size, const char *fn) {
     }
     if (s.phase != PH_INSTANTIATED && s.phase != PH_INIT && s.phase != PH_ERROR && !check_parameters(m, s.r, fn))
         return 0;
+#if CC_THERMAL
+    if (s.phase != PH_INSTANTIATED && s.phase != PH_INIT && s.phase != PH_ERROR && !cc_net_saved_ok(m, s.r, fn))
+        return 0; /* the nodes in their declared ranges, as every step and ME state */
+#endif
     return 1;
 }
 
@@ -718,4 +763,7 @@ void cc_state_load(CcModel *m, const CcState *s) {
     m->decay_h = NAN;
     m->dirty = 1;
     m->cover_ok = 0;
+#if CC_THERMAL
+    if (m->phase != PH_INSTANTIATED && m->phase != PH_INIT && m->phase != PH_ERROR) cc_net_restore(m);
+#endif
 }

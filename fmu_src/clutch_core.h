@@ -62,7 +62,8 @@ typedef struct {
     int me;           /* 1: Model Exchange instance, 0: Co-Simulation */
     int dirty;        /* outputs and derivative need recomputing */
     int range_warned; /* the validity of the last outputs (0, 1, 2): a warning is logged on each change to 1 or 2 */
-    int terminated;   /* CS: the last step was refused (fmi2Terminated / terminateSimulation) */
+    int terminated;   /* fmi2Terminated / terminateSimulation: 0; every Discard of this model is recoverable (a refused
+                         step leaves the state at its start, the next acceptable step proceeds); kept in the state */
     int logging_on;
     double decay_h, decay; /* the Co-Simulation step's exp(-h (U + H) / C) of step h (decay_h NaN: none yet; set
                               NaN by every change of the parameters: set, reset, state load) */
@@ -138,7 +139,14 @@ int cc_net_parameters_ok(CcModel *m, const double *r, const char *fn);
 int cc_net_begin_step(CcModel *m, double t, const char *what);
 int cc_net_outputs(CcModel *m);
 int cc_net_step(CcModel *m, double h, const char *fn, int (*outputs)(CcModel *));
-int cc_net_states_ok(CcModel *m, const double *x, const char *fn);
+/* the nodes x (ME states) in their declared ranges, or every problem logged with status and 0 */
+int cc_net_states_ok(CcModel *m, const double *x, int status, const char *fn, const char *what);
+/* the nodes of a saved variable vector r in their declared ranges, or logged (Error) and 0 */
+int cc_net_saved_ok(CcModel *m, const double *r, const char *fn);
+/* after a rollback or a state load: theta_cm from the nodes, the next output update computes the derivatives */
+void cc_net_restore(CcModel *m);
+/* 1 if vr is a node temperature or theta_cm (states, not computed from the inputs) */
+int cc_net_state_output(unsigned int vr);
 void cc_net_set_states(CcModel *m, const double *x);
 void cc_net_get_states(CcModel *m, double *x);
 void cc_net_get_derivatives(CcModel *m, double *der);

@@ -89,9 +89,38 @@ int cc_net_parameters_ok(CcModel *m, const double *r, const char *fn) {
 static int inputs_ok(CcModel *m, double t, const char *what) {
     double w = m->r[VR_OMEGA_ENGINE];
     if (isfinite(w) && fabs(w) <= OMEGA_SLIP_LIMIT) return 1;
-    cc_log(m, CC_DISCARD, "t = %g s: input omega_engine = %g rad/s is not finite or |omega_engine| > %g rad/s; %s", t,
-           w, OMEGA_SLIP_LIMIT, what);
+    cc_log(m, CC_DISCARD, "t = %g s: input omega_engine = %.17g rad/s is not finite or outside [%.15g, %.15g] "
+           "rad/s; %s", t, w, -OMEGA_SLIP_LIMIT, OMEGA_SLIP_LIMIT, what);
     return 0;
+}
+
+/* 1 if every node temperature th (K) is finite and in the nodes' one declared range [TN_THETA_MIN_K,
+   TN_THETA_MAX_K] (thermal_chain.NODE_RANGE, the modelDescription's min/max of every theta_<node>) and their facing
+   mean theta_cm and the friction surface theta_friction in their declared range [THETA_MIN_K, THETA_MAX_K]; otherwise logs every problem with the status
+   (fn: the call, what: what happens) and returns 0. The one check of the nodes: CS step, ME states, saved states */
+static int nodes_ok(CcModel *m, const double *th, int status, const char *fn, const char *what) {
+    double mean = 0.0, surface = 0.0;
+    int k, ok = 1;
+    for (k = 0; k < TN_N; ++k) {
+        mean += TN_WEIGHT[k] * th[k];
+        surface += TN_FRICTION_WEIGHT[k] * th[k];
+        if (!(th[k] >= TN_THETA_MIN_K && th[k] <= TN_THETA_MAX_K)) { /* false for NaN */
+            cc_log(m, status, "%s: t = %g s: %s = %.17g K is not finite or outside [%.15g, %.15g] K; %s", fn,
+                   m->time, TN_NAME[k], th[k], TN_THETA_MIN_K, TN_THETA_MAX_K, what);
+            ok = 0;
+        }
+    }
+    if (ok && !(mean >= THETA_MIN_K && mean <= THETA_MAX_K)) {
+        cc_log(m, status, "%s: t = %g s: the facing temperature theta_cm = %.17g K (the facing nodes' mean) is "
+               "outside [%.15g, %.15g] K; %s", fn, m->time, mean, THETA_MIN_K, THETA_MAX_K, what);
+        ok = 0;
+    }
+    if (ok && !(surface >= THETA_MIN_K && surface <= THETA_MAX_K)) { /* mu is read there (theta_friction) */
+        cc_log(m, status, "%s: t = %g s: the friction-surface temperature theta_friction = %.17g K is outside "
+               "[%.15g, %.15g] K; %s", fn, m->time, surface, THETA_MIN_K, THETA_MAX_K, what);
+        ok = 0;
+    }
+    return ok;
 }
 
 int cc_net_begin_step(CcModel *m, double t, const char *what) {
@@ -125,17 +154,8 @@ int cc_net_step(CcModel *m, double h, const char *fn, int (*outputs)(CcModel *))
     operating(m, &p, &op);
     for (i = 0; i < TN_N; ++i) th[i] = r[TN_VR_THETA[i]];
     tn_step(&p, &op, th, h, r[VR_SLIP_POWER], &m->tn_memo);
+    if (!nodes_ok(m, th, CC_DISCARD, fn, "step refused (the state stays at the step's start)")) return CC_DISCARD;
     store(r, th);
-    if (!(r[VR_THETA_CM] > 0.0 && r[VR_THETA_CM] < THETA_CM_LIMIT)) {
-        cc_log(m, CC_DISCARD, "%s: t = %g s: the facing temperature theta_cm = %g K left (0, %g) K; step refused", fn,
-               m->time, r[VR_THETA_CM], THETA_CM_LIMIT);
-        return CC_DISCARD;
-    }
-    if (!(r[CC_VR_THETA_MU] >= THETA_MIN_K && r[CC_VR_THETA_MU] <= THETA_MAX_K)) {
-        cc_log(m, CC_DISCARD, "%s: t = %g s: the friction-surface temperature theta_friction = %g K left [%g, %g] K; "
-               "step refused", fn, m->time, r[CC_VR_THETA_MU], THETA_MIN_K, THETA_MAX_K);
-        return CC_DISCARD;
-    }
     m->net_skip = 1;   /* the outputs at the step's end; the derivatives here, at the step's speeds */
     if (outputs(m) != CC_OK) {
         m->net_skip = 0;
@@ -146,15 +166,31 @@ int cc_net_step(CcModel *m, double h, const char *fn, int (*outputs)(CcModel *))
     return CC_OK;
 }
 
-int cc_net_states_ok(CcModel *m, const double *x, const char *fn) {
+int cc_net_states_ok(CcModel *m, const double *x, int status, const char *fn, const char *what) {
+    return nodes_ok(m, x, status, fn, what);
+}
+
+int cc_net_saved_ok(CcModel *m, const double *r, const char *fn) {
+    double th[TN_N];
     int k;
+    for (k = 0; k < TN_N; ++k) th[k] = r[TN_VR_THETA[k]];
+    return nodes_ok(m, th, CC_ERROR, fn, "state refused");
+}
+
+int cc_net_state_output(unsigned int vr) {
+    int k;
+    if (vr == VR_THETA_CM) return 1;
     for (k = 0; k < TN_N; ++k)
-        if (!(isfinite(x[k]) && x[k] > 0.0 && x[k] < THETA_CM_LIMIT)) {
-            cc_log(m, CC_ERROR, "%s: state %d (%s) = %g K is not finite or outside (0, %g) K", fn, k + 1,
-                   TN_NAME[k], x[k], THETA_CM_LIMIT);
-            return 0;
-        }
-    return 1;
+        if (vr == (unsigned int)TN_VR_THETA[k]) return 1;
+    return 0;
+}
+
+void cc_net_restore(CcModel *m) {
+    double th[TN_N];
+    int k;
+    for (k = 0; k < TN_N; ++k) th[k] = m->r[TN_VR_THETA[k]];
+    store(m->r, th); /* theta_cm from the nodes, as every step computes it */
+    m->net_skip = 0;
 }
 
 void cc_net_set_states(CcModel *m, const double *x) {

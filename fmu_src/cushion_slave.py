@@ -34,9 +34,9 @@ by call against it by ``tests/test_differential.py``):
   ``fmi2GetReal`` recomputes them from the current inputs and state first
   (in Initialization Mode with ``theta_cs = theta_cs_start``). Inputs that are
   not finite or out of range, or a cover that cannot hold the cushion, leave
-  the outputs at their last values (a Discard message is logged; the get
-  itself is fmi2OK, as in the native CS FMU) and they stay stale, so the next
-  valid input recovers them.
+  the outputs at their last values and they stay stale, so the next valid
+  input recovers them; a get of such an output (not theta_cs) returns
+  fmi2Discard with a message, as the native FMU (docs/reference/statuses.md).
 - ``fmi2DoStep`` refuses (fmi2Discard) bad step sizes, bad inputs and a step
   after which the cover cannot hold the cushion, with the state, the time and
   the outputs unchanged (as the native FMU; fmi2LastSuccessfulTime is the
@@ -54,27 +54,20 @@ from pathlib import Path
 from pythonfmu import Fmi2Causality, Fmi2Slave, Fmi2Variability, Integer, Real
 from pythonfmu.enums import Fmi2Status
 
-from clutch_model import (OMEGA_SLIP_LIMIT, THETA_CM_LIMIT, VARIABLES, X_TO_LIMIT, ClutchParameters, SpringTable,
-                          outputs, start_values, thermal_step)
+from clutch_model import (INPUT_RANGES, OUTPUT_RANGES, VARIABLES, ClutchParameters, SpringTable, outputs,
+                          range_message, start_values, thermal_step)
 from clutch_model import table_problems, validity_warning  # issue 28 (validity): the shared model decides
 from table_format import table_set_x_kiss_ref
 from slave_table_sets import more_sets  # issue 42: several table sets, the enumeration spring
 
-from clutch_model import INPUT_RANGES
-from number_check import is_finite_number, unit_hint
-
-def _hint(name: str, value) -> str:
-    """``": did you mean ...?"`` for the likely unit mistake behind input ``name`` = ``value`` (the model's
-    number_check.unit_hint over its INPUT_RANGES: the native FMU's text), or ""."""
-    unit = next(u for n, _, u, _ in VARIABLES if n == name)
-    hint = unit_hint(value, unit, *INPUT_RANGES[name][:2])
-    return f": {hint}" if hint else ""
+from number_check import is_finite_number
 
 
 CAUSALITY = {"input": (Fmi2Causality.input, Fmi2Variability.continuous),
              "output": (Fmi2Causality.output, Fmi2Variability.continuous),
              "parameter": (Fmi2Causality.parameter, Fmi2Variability.fixed)}
 PARAMETERS = [name for name, causality, _, _ in VARIABLES if causality == "parameter"]
+UNITS = {name: unit for name, _, unit, _ in VARIABLES}
 #: the outputs that clutch_model.outputs() returns (fields of Outputs): every output but the state theta_cs
 OUTPUTS = [name for name, causality, _, _ in VARIABLES if causality == "output" and name != "theta_cs"]
 #: tag of a serialized state; bump when the state's content changes
@@ -283,8 +276,9 @@ class CushionClutch(Fmi2Slave):
         if problems:
             self._refuse("fmi2GetReal", problems)
             return [math.nan] * len(vrs)
-        if self._dirty and self._phase in COMPUTED_PHASES:
-            self._refresh()
+        if self._dirty and self._phase != "instantiated" and not self._refresh() and any(
+                self._kinds[vr] == "output" and self._names[vr] != "theta_cs" for vr in vrs):
+            self._answer(Fmi2Status.discard)       # stale outputs are never read with fmi2OK
         return [float(getattr(self, self._names[vr])) for vr in vrs]
 
     def _no_such_type(self, call: str, vrs) -> None:
@@ -334,18 +328,13 @@ class CushionClutch(Fmi2Slave):
 
     # -- helpers -------------------------------------------------------------
     def _input_problems(self) -> list[str]:
+        """Every input outside its range (``clutch_model.INPUT_RANGES``, the native FMU's), its value exactly."""
         out = []
-        if not (isinstance(self.x_to, float) and math.isfinite(self.x_to) and abs(self.x_to) <= X_TO_LIMIT):
-            out.append(f"input x_to = {self.x_to!r} m is not finite or |x_to| > {X_TO_LIMIT:g} m"
-                       + _hint("x_to", self.x_to))
-        if not (isinstance(self.theta_cm, float) and math.isfinite(self.theta_cm)
-                and 0.0 < self.theta_cm < THETA_CM_LIMIT):
-            out.append(f"input theta_cm = {self.theta_cm!r} K is not finite or outside (0, {THETA_CM_LIMIT:g}) K"
-                       + _hint("theta_cm", self.theta_cm))
-        if not (isinstance(self.omega_slip, float) and math.isfinite(self.omega_slip)
-                and abs(self.omega_slip) <= OMEGA_SLIP_LIMIT):
-            out.append(f"input omega_slip = {self.omega_slip!r} rad/s is not finite or |omega_slip| > "
-                       f"{OMEGA_SLIP_LIMIT:g} rad/s")
+        for name, (lo, hi, lo_open, hi_open) in INPUT_RANGES.items():
+            v = getattr(self, name)
+            if not (isinstance(v, float) and math.isfinite(v) and (v > lo if lo_open else v >= lo)
+                    and (v < hi if hi_open else v <= hi)):
+                out.append("input " + range_message(name, v, UNITS[name], INPUT_RANGES[name]))
         return out
 
     def _current_parameters(self) -> ClutchParameters:
@@ -357,20 +346,23 @@ class CushionClutch(Fmi2Slave):
             flat["x_kiss_ref"] = flat["x_kiss_ref"] + offset
         return ClutchParameters.from_flat(flat)
 
-    def _refresh(self) -> None:
-        """Outputs of the current inputs and state, computed on read (stale outputs only)."""
+    def _refresh(self) -> bool:
+        """Outputs of the current inputs and state, computed on read (stale outputs only); False (logged) if they
+        cannot be: the outputs keep their last values and stay stale."""
         problems = self._input_problems()
-        if problems:                       # the outputs keep their last values and stay stale
+        if problems:
             for p in problems:
                 self.log(f"fmi2GetReal: {p}; outputs not updated", Fmi2Status.discard)
-            return
+            return False
+        if self._phase not in COMPUTED_PHASES:
+            return True
         if self._phase == "initialization":
             params = self._current_parameters()
             if self._table is None or params.problems():
-                return                     # reported at fmi2ExitInitializationMode
+                return True                # reported at fmi2ExitInitializationMode
             self._params = params
             self.theta_cs = params.theta_cs_start
-        self._update_outputs("fmi2GetReal")
+        return self._update_outputs("fmi2GetReal")
 
     def _update_outputs(self, where: str = "") -> bool:
         """Outputs from the current inputs and state; False (logged, outputs kept) if the cover cannot hold."""
@@ -419,8 +411,9 @@ class CushionClutch(Fmi2Slave):
         if not out and state["_phase"] in ("stepping", "terminated"):
             params = ClutchParameters.from_flat({p: float(state[p]) for p in PARAMETERS})
             out += [f"parameter {p}" for p in params.problems()]
-            if not 0.0 < state["theta_cs"] < THETA_CM_LIMIT:
-                out.append(f"theta_cs = {state['theta_cs']!r} K is outside (0, {THETA_CM_LIMIT:g}) K")
+            lo, hi = OUTPUT_RANGES["theta_cs"][:2]
+            if not lo <= state["theta_cs"] <= hi:
+                out.append(range_message("theta_cs", state["theta_cs"], "K", OUTPUT_RANGES["theta_cs"]))
         return out
 
     def _set_fmu_state(self, state):

@@ -367,5 +367,19 @@ FORWARD_C(fmi2CancelStep, (fmi2Component c), (in))
 FORWARD_C(fmi2GetStatus, (fmi2Component c, const fmi2StatusKind k, fmi2Status *v), (in, k, v))
 FORWARD_C(fmi2GetRealStatus, (fmi2Component c, const fmi2StatusKind k, fmi2Real *v), (in, k, v))
 FORWARD_C(fmi2GetIntegerStatus, (fmi2Component c, const fmi2StatusKind k, fmi2Integer *v), (in, k, v))
-FORWARD_C(fmi2GetBooleanStatus, (fmi2Component c, const fmi2StatusKind k, fmi2Boolean *v), (in, k, v))
+/* fmi2Terminated: false. pythonfmu's wrapper answers true after any doStep that returned fmi2Discard, but every
+   Discard of the slave is recoverable (a refused step changes nothing; the next valid step proceeds), as in the
+   native FMU (issue 39); fmpy's simulate_fmu would otherwise end the run quietly at the first refused step */
+fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind k, fmi2Boolean *v) {
+    if (c && k == fmi2Terminated && v) {
+        *v = fmi2False;
+        return fmi2OK;
+    }
+    {
+        fmi2GetBooleanStatusTYPE *f = (fmi2GetBooleanStatusTYPE *)sym("fmi2GetBooleanStatus");
+        Guard *g = (Guard *)c;
+        if (!g || !f) return fmi2Error;
+        return f(g->inner, k, v);
+    }
+}
 FORWARD_C(fmi2GetStringStatus, (fmi2Component c, const fmi2StatusKind k, fmi2String *v), (in, k, v))

@@ -64,6 +64,48 @@ def test_native_fmi3_answers_every_call_as_fmi2(fmus):
     assert diffs == [], "\n".join(diffs[:3])
 
 
+def test_model_exchange_answers_every_call_as_co_simulation(fmus):
+    """The native FMI 2.0 FMU's Model Exchange interface against its Co-Simulation one on the same sequences
+    without their steps: the same status at every call (a read of an output after a refused input is Discard in
+    both, never a stale value with OK) and the same values."""
+    native = fmus[0]
+    me = D.Fmi2ME(native.path, "native2me")
+    try:
+        outcomes = D.run(native, me, range(SEQUENCES), calls=60, steps=False)
+    finally:
+        me.close()
+    diffs = [str(o.difference) for o in outcomes if o.difference is not None]
+    assert diffs == [], f"{len(diffs)} of {SEQUENCES} sequences differ:\n" + "\n".join(diffs[:3])
+    assert sum(o.discards for o in outcomes) >= 20                   # stale reads refused in both
+    assert sum(o.gets_after_set for o in outcomes) >= 100
+
+
+@pytest.mark.parametrize("which", [0, 1, 2])
+def test_a_read_after_a_refused_input_is_never_a_stale_value_with_ok(fmus, which):
+    """After a step, x_to = 1 m is set (accepted: fmi2OK, it is only an input) and torque read: Discard, in the
+    native FMI 2.0 and 3.0 and the pythonfmu FMU alike; the state theta_cs reads OK; the refused step leaves
+    fmi2Terminated false (the pythonfmu wrapper's own answer is true: the guard answers); a valid input recovers."""
+    fmu = fmus[which]
+    fmu.instantiate()
+    try:
+        assert fmu.init(0.0, {})[-1] == 0
+        assert fmu.set({"x_to": 0.008}) == 0 and fmu.step(0.0, 0.1) == 0
+        status, (torque,) = fmu.get(["torque"])
+        assert status == 0 and torque > 100.0
+        assert fmu.set({"x_to": 1.0}) == 0
+        assert fmu.get(["torque"])[0] == 2, fmu.label
+        assert fmu.get(["theta_cs"])[0] == 0, fmu.label
+        assert any("x_to = 1" in m and "[-0.002, 0.025] m" in m for m in fmu.log.lines), fmu.log.lines
+        assert fmu.step(0.1, 0.1) == 2
+        if fmu.fmi == 2:                                           # a recoverable Discard: not Terminated
+            assert fmu.slave.getBooleanStatus(3) is False, fmu.label
+            assert fmu.slave.getRealStatus(2) == pytest.approx(0.1), fmu.label
+        assert fmu.set({"x_to": 0.008}) == 0 and fmu.get(["torque"]) == (0, [torque])
+        assert fmu.step(0.1, 0.1) == 0, fmu.label                  # and the next step proceeds
+    finally:
+        fmu.free()
+
+
 def test_an_output_read_right_after_set_follows_the_input(fmus):
     """Issue 31's example: at x_to = 0 and 20 degC, set x_to = 8 mm and read the torque with no step in
     between, then 4 mm: both FMUs answer the new input's torque (the Python model's), not the previous one."""
@@ -121,5 +163,24 @@ def test_error_and_warning_statuses_are_the_native_ones(fmus):
             assert fmu.step(0.0, 0.1) == 0, fmu.label                  # not faulty afterwards
             assert fmu.step(0.05, 0.1) == 1, fmu.label                 # not where the last step ended: warned
             assert fmu.step(0.15, 0.1) == 0, fmu.label
+        finally:
+            fmu.free()
+
+
+def test_messages_print_the_offending_value_exactly_and_the_same_range(fmus):
+    """x_to = 0.025000001 m (just past the range): every front end's message prints a number that is exactly that
+    value (native %.17g, pythonfmu repr; "%g" printed the limit itself) and the range [-0.002, 0.025] m."""
+    import re
+    value = 0.025000001
+    for fmu in fmus:
+        fmu.instantiate()
+        try:
+            assert fmu.init(0.0, {})[-1] == 0
+            fmu.set({"x_to": value})
+            fmu.log.lines = []                                     # this step's messages only
+            assert fmu.step(0.0, 0.1) == 2, fmu.label
+            line = next(m for m in fmu.log.lines if "x_to = " in m)
+            printed = float(re.search(r"x_to = ([-+0-9.e]+) m", line).group(1))
+            assert printed == value and "[-0.002, 0.025] m" in line, (fmu.label, line)
         finally:
             fmu.free()

@@ -184,8 +184,11 @@ def test_state_machine_refusals_are_errors_with_messages(capfd):
     s.setReal([vr["x_to"]], [math.inf])
     assert _status(lambda: s.doStep(6.0, 1.0)) == "discard"
     assert "input x_to = inf" in capfd.readouterr().out
-    assert s.getBooleanStatus(fmi2Terminated) is True or s.getBooleanStatus(fmi2Terminated) == 1
+    assert s.getBooleanStatus(fmi2Terminated) is False    # a recoverable Discard never terminates (issue 39)
     assert s.getRealStatus(fmi2LastSuccessfulTime) == 6.0
+    s.setReal([vr["x_to"]], [0.006])
+    s.doStep(6.0, 1.0)                                    # acceptable inputs: the next step proceeds
+    assert s.getRealStatus(fmi2LastSuccessfulTime) == 7.0
     s.terminate()
     assert _status(lambda: s.doStep(6.0, 1.0)) == "error"
     s.freeInstance()
@@ -214,12 +217,21 @@ def test_parameters_guid_and_format_characters(tmp_path, capfd):
     assert "fmu %s%n%d/resources/tables/kiss_point.csv line 2: expected 2 finite numbers" in out
 
 
-def test_simulate_fmu_ends_a_refused_run_with_a_message(capfd):
-    sig = np.array([(0.0, 0.005), (1.0, 0.005), (1.0, math.nan), (2.0, math.nan)],
+def test_simulate_fmu_raises_at_a_mid_run_nan(capfd):
+    """What fmpy's simulate_fmu does with 0.1 s of NaN in x_to mid-run (issue 39): the step is refused (Discard,
+    not Terminated, so fmpy does not end the run quietly with a short result), fmpy reads the outputs and the read
+    of stale outputs is Discard too: simulate_fmu raises FMICallException (status 2) naming fmi2GetReal, and the
+    FMU's message names the input and its range. docs/reference/statuses.md tells fmpy users so."""
+    from fmpy.fmi1 import FMICallException
+    sig = np.array([(0.0, 0.005), (0.5, 0.005), (0.5, math.nan), (0.6, math.nan), (0.6, 0.005), (2.0, 0.005)],
                    dtype=[("time", float), ("x_to", float)])
-    res = simulate_fmu(str(native_fmus()[2]), input=sig, stop_time=2.0, output_interval=0.1)
-    assert res["time"][-1] == pytest.approx(1.0)          # Discard + Terminated: fmpy stops there
-    assert "input x_to = nan m is not finite" in capfd.readouterr().out
+    with pytest.raises(FMICallException) as e:
+        simulate_fmu(str(native_fmus()[2]), input=sig, stop_time=2.0, output_interval=0.1, timeout=60.0)
+    assert e.value.status == 2 and "fmi2GetReal" in str(e.value)
+    out = capfd.readouterr().out
+    assert "input x_to = nan m is not finite or outside [-0.002, 0.025] m; step refused" in out
+    full = simulate_fmu(str(native_fmus()[2]), input=sig[[0, 1, 4, 5]], stop_time=2.0, output_interval=0.1)
+    assert full["time"][-1] == pytest.approx(2.0)         # the same run without the NaN goes to the end
 
 
 # ------------------------------------------------------------------ saved states
@@ -511,7 +523,9 @@ def test_der_theta_cs_output_is_the_heat_balance_in_both_versions():
 
 
 def test_fmi3_refused_step_asks_to_terminate():
-    """fmi3DoStep's terminateSimulation: true after a discarded step, false after a good one."""
+    """fmi3DoStep's terminateSimulation: false after a good step and after a recoverable Discard (issue 39: only
+    what cannot be recovered would set it; every Discard of this FMU is recoverable), and the next step with
+    acceptable inputs proceeds."""
     import ctypes
     s, vr = _stepping(3, "t3", logging=False)
     do_step = s.dll.fmi3DoStep
@@ -526,7 +540,9 @@ def test_fmi3_refused_step_asks_to_terminate():
     s.setFloat64([vr["x_to"], vr["theta_cm"]], [0.006, 500.0])
     assert step(0.0) == (0, [False, False, False], 1.0)          # OK, no event, go on, early return false
     s.setFloat64([vr["theta_cm"]], [-1.0])
-    assert step(1.0) == (2, [False, True, False], 1.0)           # Discard: terminate, last good time 1 s
+    assert step(1.0) == (2, [False, False, False], 1.0)          # Discard: go on, last good time 1 s
+    s.setFloat64([vr["theta_cm"]], [500.0])
+    assert step(1.0) == (0, [False, False, False], 2.0)
     s.terminate()
     s.freeInstance()
 

@@ -306,3 +306,194 @@ def test_mu_is_read_at_the_friction_surface(tmp_path):
     finally:
         s.close()
     assert tf_k - cm > 5.0 and apart > 0.005        # 3 s at ~10 kW: the surface 9 K ahead, mu 0.0077 apart
+
+# ------------------------------------------------------------ refusals (issue 39)
+class Logged:
+    """An FMI 2.0 instance of the thermal FMU (CS, or ME with ``me``) whose log messages are kept in ``messages``
+    ((status, text)), initialised with ``start``; calls raise fmpy's FMICallException on Discard and worse."""
+
+    def __init__(self, fmu: Path, start: dict[str, float] | None = None, me: bool = False):
+        from ctypes import byref
+
+        from fmpy import extract
+        from fmpy.fmi2 import (FMU2Model, FMU2Slave, defaultCallbacks, fmi2CallbackFunctions,
+                               fmi2CallbackLoggerTYPE)
+        from fmpy.logging import addLoggerProxy
+        md = read_model_description(str(fmu))
+        self.md = md
+        self.vr = {v.name: v.valueReference for v in md.modelVariables}
+        self.messages: list[tuple[int, str]] = []
+        self.cb = fmi2CallbackFunctions()
+        self.cb.logger = fmi2CallbackLoggerTYPE(lambda c, n, st, cat, msg: self.messages.append((st, msg.decode())))
+        self.cb.allocateMemory, self.cb.freeMemory = defaultCallbacks.allocateMemory, defaultCallbacks.freeMemory
+        addLoggerProxy(byref(self.cb))                     # formats the FMU's "%s" messages
+        self.unzip = extract(str(fmu))
+        cls = FMU2Model if me else FMU2Slave
+        self.s = cls(guid=md.guid, unzipDirectory=self.unzip, modelIdentifier="CushionClutchThermal",
+                     instanceName="refusals")
+        self.s.instantiate(callbacks=self.cb)
+        self.s.setupExperiment(startTime=0.0)
+        if start:
+            self.s.setReal([self.vr[k] for k in start], list(start.values()))
+        self.s.enterInitializationMode()
+
+    def get(self, names):
+        return self.s.getReal([self.vr[k] for k in names])
+
+    def close(self):
+        self.s.freeInstance()
+        shutil.rmtree(self.unzip, ignore_errors=True)
+
+
+def _kelvin_outputs(md) -> dict[str, float]:
+    return {v.name: float(v.max) for v in md.modelVariables if v.unit == "K" and v.causality == "output"}
+
+
+def test_every_kelvin_output_and_node_declares_one_range_at_most_1000_degC(fmus):
+    from cushion_clutch.fmu.thermal_chain import NODE_RANGE
+    for version, fmu in fmus.items():
+        md = read_model_description(str(fmu))
+        maxima = _kelvin_outputs(md)                      # float(None) would fail: every one declares a max
+        assert set(NODE_OUTPUTS) | {"theta_cm", "theta_cs"} <= set(maxima)
+        assert max(maxima.values()) <= 1273.15, maxima
+        bounds = {v.name: (v.min, v.max) for v in md.modelVariables}
+        for name in NODE_OUTPUTS:
+            assert tuple(map(float, bounds[name])) == NODE_RANGE[:2], (version, name)
+        assert tuple(map(float, bounds["theta_network_start"])) == (clutch_model.THETA_MIN_K, clutch_model.THETA_MAX_K)
+        for k in NODES:                                   # capacities: a declared min > 0
+            assert float(bounds[f"C_{k}"][0]) > 0.0 and bounds[f"C_{k}"][1] is not None, k
+
+
+@pytest.mark.parametrize("theta0", [150.0, 900.0])
+def test_theta_network_start_outside_its_range_is_refused_at_initialisation(fmus, theta0):
+    s = Logged(fmus[2], {"theta_network_start": theta0})
+    try:
+        with pytest.raises(FMICallException):
+            s.s.exitInitializationMode()
+    finally:
+        s.close()
+    assert any(st == 3 and f"theta_network_start = {theta0:.17g}" in m and "[200, 800]" in m
+               for st, m in s.messages), s.messages
+
+
+def test_huge_slip_refused_steps_roll_back_and_the_instance_recovers(fmus):
+    """The bar: 470 kW of slip (x_to 12 mm, omega_slip = omega_engine = 1500 rad/s) for 10 s of the host's clock in
+    10 ms steps, then the clutch open for 600 s. A refused step returns Discard with one message, leaves every node,
+    theta_cs, theta_cm, the outputs and LastSuccessfulTime at the step's start, does not set Terminated, and the
+    next acceptable step proceeds; no output in K is ever reported above its declared maximum with OK."""
+    s = Logged(fmus[2])
+    s.s.exitInitializationMode()
+    maxima = _kelvin_outputs(s.md)
+    names = list(maxima)
+    t, h, refused, taken, before = 0.0, 0.01, 0, 0, None
+    try:
+        def attempt(x_to, w, step):
+            nonlocal t, refused, taken, before
+            s.s.setReal([s.vr["x_to"], s.vr["omega_slip"], s.vr["omega_engine"]], [x_to, w, w or 100.0])
+            n = len(s.messages)
+            try:
+                s.s.doStep(t, step)
+            except FMICallException as e:
+                assert e.status == 2                      # Discard, never Error
+                refused += 1
+                new = [m for st, m in s.messages[n:] if st == 2]
+                assert len(new) == 1 and "K is not finite or outside [200, 1273.15] K; step refused" in new[0], new
+                assert s.get(names) == before             # the whole state stays at the step's start
+                assert s.s.getRealStatus(2) == last_ok_time and s.s.getBooleanStatus(3) is False
+            else:
+                taken += 1
+                before = s.get(names)
+                for name, v in zip(names, before):
+                    assert v <= maxima[name], (t, name, v)
+                globals_["last"] = t + step
+            t += step                                     # the host's clock goes on
+        globals_ = {"last": 0.0}
+        last_ok_time = 0.0
+        while t < 10.0 - 1e-9:
+            last_ok_time = globals_["last"]
+            attempt(0.012, 1500.0, h)
+        hot = dict(zip(names, before))
+        assert refused > 100 and taken > 100, (refused, taken)
+        refused_hot, taken_hot = refused, taken
+        while t < 610.0 - 1e-9:
+            last_ok_time = globals_["last"]
+            attempt(0.0, 0.0, 0.1)
+        assert refused == refused_hot and taken - taken_hot == 6000      # every open step is taken
+        cold = dict(zip(names, s.get(names)))
+    finally:
+        s.close()
+    print("hottest node at the first refusal:", max((v, k) for k, v in hot.items() if k in NODE_OUTPUTS),
+          f"; {refused} refused steps; after 600 s open:", {k: round(v, 1) for k, v in cold.items()})
+    assert all(cold[k] < hot[k] - 100.0 for k in ("theta_flywheel_surface", "theta_pressure_plate_surface"))
+
+
+def test_model_exchange_checks_the_nodes_as_co_simulation(fmus):
+    """fmi2SetContinuousStates with a node past its declared maximum: Discard with the same message as a refused
+    CS step, and the states stay as they were; at the maximum itself: accepted."""
+    s = Logged(fmus[2], me=True)
+    try:
+        s.s.exitInitializationMode()
+        s.s.enterContinuousTimeMode()
+        import ctypes
+        n = 1 + len(NODES)
+        buf = (ctypes.c_double * n)()
+        s.s.getContinuousStates(buf, n)
+        x = list(buf)
+        hot = list(x)
+        hot[1 + NODES.index("flywheel_surface")] = 1273.16
+        with pytest.raises(FMICallException) as e:
+            s.s.setContinuousStates((ctypes.c_double * n)(*hot), n)
+        assert e.value.status == 2
+        assert "theta_flywheel_surface = 1273.1600000000001 K is not finite or outside [200, 1273.15] K; states " \
+               "not set" in s.messages[-1][1]
+        s.s.getContinuousStates(buf, n)
+        assert list(buf) == x
+        hot[1 + NODES.index("flywheel_surface")] = 1273.15
+        s.s.setContinuousStates((ctypes.c_double * n)(*hot), n)
+        s.s.getContinuousStates(buf, n)
+        assert list(buf) == hot
+    finally:
+        s.close()
+
+
+def _seal(blob: bytearray) -> bytes:
+    """The native state with its FNV-1a 64 checksum recomputed (clutch_core.c fnv1a)."""
+    import struct
+    h = 1469598103934665603
+    for b in blob[:-8]:
+        h = ((h ^ b) * 1099511628211) & 0xFFFFFFFFFFFFFFFF
+    blob[-8:] = struct.pack("<Q", h)
+    return bytes(blob)
+
+
+@pytest.mark.parametrize("node, value", [("theta_facing_flywheel_side", -5.0), ("theta_flywheel_bulk", 1e6)])
+def test_crafted_states_with_nodes_out_of_range_are_refused(fmus, node, value):
+    import struct
+    s = Logged(fmus[2])
+    try:
+        s.s.exitInitializationMode()
+        s.s.setReal([s.vr["x_to"], s.vr["omega_slip"], s.vr["omega_engine"]], [0.007, 100.0, 100.0])
+        s.s.doStep(0.0, 0.01)
+        before = s.get(["theta_cm", *NODE_OUTPUTS])
+        blob = bytearray(s.s.serializeFMUstate(s.s.getFMUstate()))
+        at = 40 + 8 * s.vr[node]                          # header, then r[] by value reference
+        blob[at:at + 8] = struct.pack("<d", value)
+        with pytest.raises(FMICallException):
+            s.s.deSerializeFMUstate(_seal(blob))
+        assert f"{node} = {value:.17g} K is not finite or outside [200, 1273.15] K; state refused" in s.messages[-1][1]
+        assert s.get(["theta_cm", *NODE_OUTPUTS]) == before
+        s.s.doStep(0.01, 0.01)                            # still stepping
+    finally:
+        s.close()
+
+
+def test_the_docs_state_the_enforced_ranges():
+    """docs/reference/thermal_fmu.md states the ranges the code declares and enforces."""
+    from cushion_clutch.fmu.thermal_chain import CAPACITY_RANGE, GLOBALS, NODE_RANGE
+    text = (Path(__file__).parents[1] / "docs" / "reference" / "thermal_fmu.md").read_text()
+    lo, hi = GLOBALS["theta_network_start"][2][:2]
+    for statement in (f"**[{NODE_RANGE[0]:g}, {NODE_RANGE[1]:g}] K**", f"`theta_network_start` must lie in [{lo:g}, "
+                      f"{hi:g}] K", f"in [{CAPACITY_RANGE[0]:g}, {CAPACITY_RANGE[1]:g}] J/K",
+                      f"**[{clutch_model.THETA_MIN_K:g}, {clutch_model.THETA_MAX_K:g}] K**"):
+        assert statement in text, statement
+    assert "(0, 2000) K" not in text

@@ -142,3 +142,71 @@ def test_native_description_puts_the_derivative_after_the_appended_parameter(ext
     der = {v.name: v for v in md.modelVariables}["der(theta_cs)"]
     assert der.valueReference == len(clutch_model.VARIABLES) + 1
     assert [d.variable.name for d in md.derivatives] == ["der(theta_cs)"]
+
+
+# ---------------------------------------------------------------- one range table (issue 44 item 2, issue 39)
+def _docs_rows():
+    from pathlib import Path
+    sys.path.insert(0, str(Path(__file__).parents[1] / "docs" / "_ext"))
+    try:
+        import fmu_variables
+    finally:
+        sys.path.pop(0)
+    return {row[0]: row for row in fmu_variables._rows()}
+
+
+def _numbers(text: str) -> list[float]:
+    return [float(x) for x in re.findall(r"-?\d+(?:\.\d+)?(?:e[+-]?\d+)?", text)]
+
+
+@pytest.mark.fmu
+def test_the_docs_allowed_column_states_every_declared_min_and_max():
+    """The FMU-variables page's "allowed" cell of every variable that the built default FMU declares with a min and
+    a max holds both numbers (the page and the modelDescription read the same range table), and no legacy limit
+    constant is left."""
+    from native_builds import native_fmus
+    rows = _docs_rows()
+    md = read_model_description(str(native_fmus()[2]))
+    declared = [v for v in md.modelVariables if v.min is not None and v.max is not None]
+    assert len(declared) >= 30
+    for v in declared:
+        cell = rows[v.name][4]
+        assert float(v.min) in _numbers(cell) and float(v.max) in _numbers(cell), (v.name, cell, v.min, v.max)
+    assert not hasattr(clutch_model, "X_TO_LIMIT") and not hasattr(clutch_model, "THETA_CM_LIMIT")
+    assert rows["x_to"][4] == "[-0.002, 0.025]" and rows["theta_cm"][4] == "[200, 800]"
+
+
+@pytest.mark.fmu
+def test_facing_wear_declares_what_initialisation_accepts():
+    """facing_wear's declared max is the default cover's wear limit (at most 2.4 mm): the native FMU initialises
+    with it and refuses 2 um more with the wear-limit message."""
+    import math
+
+    from fmpy import extract
+    from fmpy.fmi1 import FMICallException
+    from fmpy.fmi2 import FMU2Slave
+
+    from native_builds import native_fmus
+    fmu = native_fmus()[2]
+    md = read_model_description(str(fmu))
+    wear = next(v for v in md.modelVariables if v.name == "facing_wear")
+    top = float(wear.max)
+    assert 0.002 < top <= 0.0024 and "wear limit" in wear.description
+    unzip = extract(str(fmu))
+    try:
+        for value, ok in ((top, True), (top + 2e-6, False)):
+            s = FMU2Slave(guid=md.guid, unzipDirectory=unzip, modelIdentifier=md.coSimulation.modelIdentifier,
+                          instanceName="wear")
+            s.instantiate()
+            s.setupExperiment(startTime=0.0)
+            s.setReal([wear.valueReference], [value])
+            s.enterInitializationMode()
+            if ok:
+                s.exitInitializationMode()
+            else:
+                with pytest.raises(FMICallException):
+                    s.exitInitializationMode()
+            s.freeInstance()
+    finally:
+        shutil.rmtree(unzip, ignore_errors=True)
+    assert math.isclose(top, clutch_model.facing_wear_max(clutch_model.SpringTable.from_dir(DEFAULT_TABLES)))

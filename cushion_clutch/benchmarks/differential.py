@@ -231,6 +231,22 @@ class Fmi2CS:
         return _status(self.slave.fmi2Reset, self.slave.component)
 
 
+class Fmi2ME(Fmi2CS):
+    """The same FMU's FMI 2.0 Model Exchange interface with the same calls but steps (a CS step has no ME
+    counterpart the FMU answers by itself; :func:`compare` with ``steps=False`` leaves them out)."""
+
+    def instantiate(self) -> None:
+        from fmpy.fmi2 import FMU2Model
+        self.slave = FMU2Model(guid=self.md.guid, unzipDirectory=self.unzip,
+                               modelIdentifier=self.md.modelExchange.modelIdentifier, instanceName=self.label)
+        self._cb = self._callbacks()
+        self.slave.instantiate(callbacks=self._cb, loggingOn=True)
+        self.state = None
+
+    def step(self, t: float, h: float) -> int:
+        raise TypeError("Model Exchange has no doStep: compare(..., steps=False)")
+
+
 class Fmi3CS(Fmi2CS):
     """The native FMI 3.0 Co-Simulation FMU with the same calls (FMI 3.0 has no setupExperiment)."""
 
@@ -354,11 +370,12 @@ class Outcome:
     gets_after_set: int = 0       #: reads right after an fmi2SetReal of an input
 
 
-def compare(reference: Fmi2CS, other: Fmi2CS, seed: int, calls: int) -> Outcome:
-    """Run sequence ``seed`` through both FMUs, call by call."""
+def compare(reference: Fmi2CS, other: Fmi2CS, seed: int, calls: int, steps: bool = True) -> Outcome:
+    """Run sequence ``seed`` through both FMUs, call by call (``steps=False``: without its steps, for a Model
+    Exchange instance)."""
     from cushion_clutch.model.clutch_model import VARIABLES
     names = [n for n, *_ in VARIABLES]          # in every backend: the same sequences in every comparison
-    ops = sequence(seed, calls, names)
+    ops = [op for op in sequence(seed, calls, names) if steps or op[0] != "step"]
     reference.instantiate()
     other.instantiate()
     clock, saved_clock = [0.0], None
@@ -400,9 +417,9 @@ def compare(reference: Fmi2CS, other: Fmi2CS, seed: int, calls: int) -> Outcome:
         other.free()
 
 
-def run(reference: Fmi2CS, other: Fmi2CS, seeds, calls: int) -> list[Outcome]:
-    """Every sequence of ``seeds`` through both FMUs."""
-    return [compare(reference, other, seed, calls) for seed in seeds]
+def run(reference: Fmi2CS, other: Fmi2CS, seeds, calls: int, steps: bool = True) -> list[Outcome]:
+    """Every sequence of ``seeds`` through both FMUs (``steps=False``: without their steps)."""
+    return [compare(reference, other, seed, calls, steps) for seed in seeds]
 
 
 def build_fmus(folder: Path, fmi3: bool = False) -> dict[str, Path]:

@@ -82,10 +82,20 @@ def _variables(x_kiss_ref_m: float | None = None):
     yield vr_der(), "der(theta_cs)", "local", "K/s", "rate of change of theta_cs (paper eq. 3)", None
 
 
-def bounds_attributes(name: str) -> dict[str, str]:
-    """``min``, ``max`` and ``nominal`` (XML attribute text) of an input or parameter; {} for other variables."""
-    b = clutch_model.variable_bounds().get(name)
+def bounds_attributes(name: str, bounds: dict | None = None) -> dict[str, str]:
+    """``min``, ``max`` and ``nominal`` (XML attribute text) of an input, parameter or bounded output; {} for other
+    variables. ``bounds``: :func:`clutch_model.variable_bounds` of the FMU's table set (default: without a table,
+    ``facing_wear`` then has its absolute range)."""
+    b = (clutch_model.variable_bounds() if bounds is None else bounds).get(name)
     return {} if b is None else {"min": repr(b[0]), "max": repr(b[1]), "nominal": repr(b[2])}
+
+
+def _wear_note(desc: str, name: str, bounds: dict) -> str:
+    """A variable's description, for ``facing_wear`` with where its declared maximum comes from."""
+    if name != "facing_wear":
+        return desc
+    return (f"{desc}; max {bounds[name][1]!r} m is the default cover's wear limit with this FMU's tables "
+            "(initialisation refuses more; another cover is checked at initialisation)")
 
 
 def _units(root: ET.Element) -> None:
@@ -135,7 +145,7 @@ def float64_attributes(vr: int, name: str, causality: str, unit: str, desc: str)
         attrs["displayUnit"] = display_unit(unit)
     return attrs
 
-def fmi2_description(guid: str, has_friction: bool, x_kiss_ref_m: float | None = None) -> str:
+def fmi2_description(guid: str, has_friction: bool, x_kiss_ref_m: float | None = None, table=None) -> str:
     """FMI 2.0 modelDescription.xml: ME and CS, SourceFiles, ModelStructure with dependencies."""
     root = ET.Element("fmiModelDescription", fmiVersion="2.0", modelName=SLAVE, guid=guid, description=DESCRIPTION,
                       generationTool="cushion_clutch (native C)", variableNamingConvention="flat",
@@ -153,11 +163,12 @@ def fmi2_description(guid: str, has_friction: bool, x_kiss_ref_m: float | None =
     _units(root)
     _log_categories(root)
     variables = ET.SubElement(root, "ModelVariables")
+    bounds = clutch_model.variable_bounds(table)   # table: the FMU's SpringTable (facing_wear's declared max)
     for vr, name, causality, unit, desc, start in _variables(x_kiss_ref_m):
-        real = scalar_real(variables, vr, name, causality, unit, desc)
+        real = scalar_real(variables, vr, name, causality, unit, _wear_note(desc, name, bounds))
         if vr == vr_der():
             real.set("derivative", str(_vr("theta_cs") + 1))
-        for key, value in bounds_attributes(name).items():
+        for key, value in bounds_attributes(name, bounds).items():
             real.set(key, value)
         if start is not None:
             real.set("start", repr(start))
@@ -176,7 +187,7 @@ def fmi2_description(guid: str, has_friction: bool, x_kiss_ref_m: float | None =
     return _finish(root)
 
 
-def fmi3_description(token: str, has_friction: bool, x_kiss_ref_m: float | None = None) -> str:
+def fmi3_description(token: str, has_friction: bool, x_kiss_ref_m: float | None = None, table=None) -> str:
     """FMI 3.0 modelDescription.xml: ME and CS, independent variable time, ModelStructure."""
     root = ET.Element("fmiModelDescription", fmiVersion="3.0", modelName=SLAVE, instantiationToken=token,
                       description=DESCRIPTION, generationTool="cushion_clutch (native C)",
@@ -190,11 +201,12 @@ def fmi3_description(token: str, has_friction: bool, x_kiss_ref_m: float | None 
     variables = ET.SubElement(root, "ModelVariables")
     ET.SubElement(variables, "Float64", name="time", valueReference=str(vr_time()), causality="independent",
                   variability="continuous", unit="s", description="simulation time [s]")
+    bounds = clutch_model.variable_bounds(table)   # table: the FMU's SpringTable (facing_wear's declared max)
     for vr, name, causality, unit, desc, start in _variables(x_kiss_ref_m):
-        attrs = float64_attributes(vr, name, causality, unit, desc)
+        attrs = float64_attributes(vr, name, causality, unit, _wear_note(desc, name, bounds))
         if vr == vr_der():
             attrs["derivative"] = str(_vr("theta_cs"))
-        attrs.update(bounds_attributes(name))
+        attrs.update(bounds_attributes(name, bounds))
         if start is not None:
             attrs["start"] = repr(start)
         ET.SubElement(variables, "Float64", attrs)

@@ -28,7 +28,7 @@ from .variable_table import HEADER as VARIABLE_HEADER
 from .variable_table import variable_header
 from .thermal_chain import NETWORK_HEADERS, NETWORK_SOURCES, THERMAL_SLAVE, Chain, thermal_header  # noqa: F401
 from .thermal_descriptions import thermal_descriptions_into, thermal_sources
-from .table_sets import carried_sets, hash_sets, with_table_sets, write_resources
+from .table_sets import carried_sets, hash_sets, wear_limiting_table, with_table_sets, write_resources
 
 log = logging.getLogger(__name__)
 
@@ -90,6 +90,7 @@ def build_native_fmu(tables: Path, output: Path, fmi_version: int = 2,
     guid = model_guid(tables, fmi_version, chain, sets)
     has_friction = any((folder / FRICTION).exists() for folder in (tables, *more_tables))
     x_kiss_ref = table_set_x_kiss_ref(tables)
+    table = wear_limiting_table([tables, *more_tables])  # facing_wear's declared max: the cover's wear limit with it
     thermal = chain is not None
     with tempfile.TemporaryDirectory(prefix="cushion_native_") as tmp:
         src = Path(tmp) / "sources"
@@ -100,8 +101,8 @@ def build_native_fmu(tables: Path, output: Path, fmi_version: int = 2,
         try:                                            # no half-written .fmu.tmp left behind
             with zipfile.ZipFile(tmp_out, "w", zipfile.ZIP_DEFLATED) as z:
                 z.writestr("modelDescription.xml", with_table_sets(
-                    fmi2_description(guid, has_friction, x_kiss_ref) if fmi_version == 2
-                    else fmi3_description(guid, has_friction, x_kiss_ref), sets, fmi_version))
+                    fmi2_description(guid, has_friction, x_kiss_ref, table) if fmi_version == 2
+                    else fmi3_description(guid, has_friction, x_kiss_ref, table), sets, fmi_version))
                 for platform, lib in sorted(libs.items()):
                     z.write(lib, f"binaries/{platform}/{lib.name}")
                 for name in staged:
@@ -119,7 +120,7 @@ def build_native_fmu(tables: Path, output: Path, fmi_version: int = 2,
             raise
     log.info("built native FMI %d.0 %s (%s) from tables %s", fmi_version, output, ", ".join(sorted(libs)), tables)
     if thermal:                         # the thermal variant's descriptions replace the clutch FMU's
-        thermal_descriptions_into(output, guid, has_friction, chain, x_kiss_ref, fmi_version)
+        thermal_descriptions_into(output, guid, has_friction, chain, x_kiss_ref, fmi_version, table)
     return output
 
 

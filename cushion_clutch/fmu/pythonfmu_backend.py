@@ -26,9 +26,11 @@ FMU_OPTIONS = dict(needsExecutionTool=False, canHandleVariableCommunicationStepS
                    canGetAndSetFMUstate=True, canSerializeFMUstate=True)
 
 
-def complete_model_description(xml_text: str) -> str:
-    """Add unit definitions, variable units and InitialUnknowns to pythonfmu's XML."""
+def complete_model_description(xml_text: str, table=None) -> str:
+    """Add unit definitions, variable units, min/max/nominal (``table``: the FMU's SpringTable, for facing_wear's
+    declared max) and InitialUnknowns to pythonfmu's XML."""
     root = ET.fromstring(xml_text)
+    bounds = clutch_model.variable_bounds(table)
     var_units = {name: unit for name, _, unit, _ in clutch_model.VARIABLES}   # temperatures: degC displayed
     units = ET.Element("UnitDefinitions")
     for name, base in BASE_UNITS.items():
@@ -48,7 +50,7 @@ def complete_model_description(xml_text: str) -> str:
         real.set("unit", var_units[name])
         if display_unit(var_units[name]):
             real.set("displayUnit", display_unit(var_units[name]))
-        for key, value in bounds_attributes(name).items():     # min, max, nominal (issue 28)
+        for key, value in bounds_attributes(name, bounds).items():     # min, max, nominal (issue 28)
             real.set(key, value)
         if var.get("causality") == "output":
             outputs.append(index)
@@ -84,7 +86,7 @@ def build_python_fmu(tables: Path, output: Path, more_tables: tuple = ()) -> Pat
     FMU then carries every set and its enumeration ``spring`` picks one, :mod:`.table_sets`)."""
     from pythonfmu.builder import FmuBuilder
 
-    from .table_sets import carried_sets, enumeration_from_integer, stage_sets
+    from .table_sets import carried_sets, enumeration_from_integer, stage_sets, wear_limiting_table
     sets = carried_sets([tables, *more_tables]) if more_tables else ()
     with tempfile.TemporaryDirectory(prefix="cushion_fmu_") as tmp:
         stage = Path(tmp)
@@ -100,5 +102,7 @@ def build_python_fmu(tables: Path, output: Path, more_tables: tuple = ()) -> Pat
             built = FmuBuilder.build_FMU(stage / f"{SLAVE}.py", dest=stage / "out",
                                          project_files=[*(stage / m for m in SLAVE_MODULES), stage / "tables",
                                                         *extra], **FMU_OPTIONS)
-        guard_fmu(Path(built), output, lambda xml: enumeration_from_integer(complete_model_description(xml), sets))
+        table = wear_limiting_table([tables, *more_tables])
+        guard_fmu(Path(built), output,
+                  lambda xml: enumeration_from_integer(complete_model_description(xml, table), sets))
     return output

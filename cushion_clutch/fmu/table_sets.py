@@ -229,3 +229,14 @@ def enumeration_from_integer(xml_text: str, sets) -> str:
     root.insert(list(root).index(root.find("UnitDefinitions")) + 1, types)
     ET.indent(root)
     return '<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
+
+
+def wear_limiting_table(folders) -> clutch_model.SpringTable:
+    """The table of the carried set whose default-cover wear limit is the smallest
+    (:func:`~cushion_clutch.model.clutch_model.facing_wear_max`): ``facing_wear``'s declared maximum must hold
+    whichever set a host chooses, so an FMU carrying several sets declares the tightest one."""
+    from ..model.api import load_table
+    from ..model.clutch_model import facing_wear_max
+
+    tables = [load_table(folder) for folder in folders]
+    return tables[0] if len(tables) == 1 else min(tables, key=facing_wear_max)

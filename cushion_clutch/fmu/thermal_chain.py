@@ -46,6 +46,14 @@ TN_MAX = 32
 #: the output of the friction-surface temperature (K), at which mu of a friction table is read
 FRICTION_OUTPUT = "theta_friction"
 
+#: highest temperature of any network node, K: 1000 degC. No part of a dry clutch survives it (grey iron melts near
+#: 1150 degC, organic facings char by about 530 degC); a step or a state beyond it is refused
+NODE_MAX_K = 1273.15
+#: the one range of every node temperature ``theta_<node>`` (low, high, low open, high open): the modelDescription's
+#: min/max, the C checks of the CS step, the ME states and restored states (TN_THETA_MIN_K, TN_THETA_MAX_K), the docs.
+#: The low end is the model's: no sink is colder (theta_a, theta_engine) and every node starts at theta_network_start
+NODE_RANGE = (clutch_model.THETA_MIN_K, NODE_MAX_K, False, False)
+
 
 @dataclass(frozen=True)
 class Chain:
@@ -142,6 +150,10 @@ def _link_params(a: str, b: str) -> dict[str, str]:
     return {"always": f"G_{a}__{b}", "clamped": f"G_{a}__{b}_clamped"}
 
 
+#: range of every node's heat capacity C_<node>, J/K: at least 1 J/K (about 2 g of steel; the default's smallest node,
+#: a 1 mm surface layer, holds 122 J/K), so that min > 0 is declared and the ME derivative stays finite
+CAPACITY_RANGE = (1.0, 1e6, False, False)
+
 #: the network's global parameters: name -> (unit, description, range)
 GLOBALS = {
     "theta_engine": ("K", "engine block temperature (the sink of G_engine_*)", (223.15, 423.15, False, False)),
@@ -151,7 +163,8 @@ GLOBALS = {
                    (0.0, 1e4, False, False)),
     "convection_reference_omega": ("rad/s", "speed w_ref of the convection law A (h_still_air + h_rotating "
                                             "(|w| / w_ref)^0.8)", (1.0, 2000.0, False, False)),
-    "theta_network_start": ("K", "initial temperature of every network node", (0.0, 2000.0, True, True)),
+    "theta_network_start": ("K", "initial temperature of every network node (the facings' mean is theta_cm: the "
+                                 "range of theta_cm)", clutch_model.INPUT_RANGES["theta_cm"]),
 }
 
 
@@ -209,11 +222,16 @@ def thermal_starts(chain: Chain, p: "clutch_model.ClutchParameters | None" = Non
 
 
 def thermal_ranges(chain: Chain) -> dict[str, tuple]:
-    """Allowed range (low, high, low open, high open) of every parameter of the variant (and its input)."""
+    """Allowed range (low, high, low open, high open) of every parameter of the variant, its input ``omega_engine``
+    and its bounded outputs (``theta_cm``: the facing nodes' mean, in the clutch's theta_cm range; ``theta_cs``;
+    every node: :data:`NODE_RANGE`)."""
     ranges = dict(clutch_model.ClutchParameters.RANGES)
+    ranges.update(clutch_model.OUTPUT_RANGES)
+    ranges["theta_cm"] = clutch_model.INPUT_RANGES["theta_cm"]
     for k in chain.nodes:
         q = _node_params(k)
-        ranges.update({q["cap"]: (0.0, 1e6, True, False), q["share"]: (0.0, 1.0, False, False),
+        ranges[node_output(k)] = NODE_RANGE
+        ranges.update({q["cap"]: CAPACITY_RANGE, q["share"]: (0.0, 1.0, False, False),
                        q["area"]: (0.0, 10.0, False, False), q["engine"]: (0.0, 1e4, False, False)})
     for a, b in chain.links():
         ranges.update({v: (0.0, 1e6, False, False) for v in _link_params(a, b).values()})
@@ -261,6 +279,10 @@ def _block(chain: Chain) -> str:
 #define TN_VR_WREF {enum_name("convection_reference_omega")}
 #define TN_VR_THETA0 {enum_name("theta_network_start")}
 #define CC_VR_THETA_MU {enum_name(FRICTION_OUTPUT)} /* mu is read at the friction surface (clutch_core.c) */
+
+/* the one range of every node temperature, K (thermal_chain.NODE_RANGE) */
+#define TN_THETA_MIN_K {float(NODE_RANGE[0])!r}
+#define TN_THETA_MAX_K {float(NODE_RANGE[1])!r}
 #ifdef CC_DEFINE_THERMAL_TABLE /* clutch_thermal.c */
 {chr(10).join(arrays)}
 #endif

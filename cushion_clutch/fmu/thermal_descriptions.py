@@ -75,7 +75,8 @@ def thermal_dependencies(chain: Chain, has_friction: bool) -> tuple[dict[int, li
 
 
 def _bounds(chain: Chain, name: str) -> dict[str, str]:
-    """FMI ``min``/``max`` of a variant's input or parameter: its closed range bounds (an open bound is left out)."""
+    """FMI ``min``/``max`` of a variant's input, parameter or bounded output: its closed range bounds (an open bound
+    is left out)."""
     rng = thermal_ranges(chain).get(name)
     if rng is None:
         return {}
@@ -114,9 +115,10 @@ def _theta_cm_description(chain: Chain) -> str:
     return next(d for _, n, _, u, d in _all(chain) if n == "theta_cm") + " [K]"
 
 
-def thermal_fmi2_description(guid: str, has_friction: bool, chain: Chain, x_kiss_ref_m: float | None = None) -> str:
-    """FMI 2.0 modelDescription.xml of the thermal FMU (ME and CS)."""
-    root = ET.fromstring(fmi2_description(guid, has_friction, x_kiss_ref_m))
+def thermal_fmi2_description(guid: str, has_friction: bool, chain: Chain, x_kiss_ref_m: float | None = None,
+                             table=None) -> str:
+    """FMI 2.0 modelDescription.xml of the thermal FMU (ME and CS; ``table``: its SpringTable)."""
+    root = ET.fromstring(fmi2_description(guid, has_friction, x_kiss_ref_m, table))
     _head(root, 2)
     p = None if x_kiss_ref_m is None else clutch_model.ClutchParameters(x_kiss_ref=x_kiss_ref_m)
     starts = thermal_starts(chain, p)
@@ -140,9 +142,8 @@ def thermal_fmi2_description(guid: str, has_friction: bool, chain: Chain, x_kiss
         real = scalar_real(variables, vr, name, causality, unit, desc)
         if causality in ("input", "parameter"):
             real.set("start", repr(starts[name]))
-        if causality in ("input", "parameter") or name == FRICTION_OUTPUT:
-            for k, v in _bounds(chain, name).items():
-                real.set(k, v)
+        for k, v in _bounds(chain, name).items():   # inputs, parameters and the nodes (thermal_ranges)
+            real.set(k, v)
         if name.startswith("der("):
             real.set("derivative", str(index[name[4:-1]]))
     variables.append(der_cs)
@@ -162,9 +163,11 @@ def thermal_fmi2_description(guid: str, has_friction: bool, chain: Chain, x_kiss
     return _finish(root)
 
 
-def thermal_fmi3_description(token: str, has_friction: bool, chain: Chain, x_kiss_ref_m: float | None = None) -> str:
-    """FMI 3.0 modelDescription.xml of the thermal FMU (ME and CS, independent variable time)."""
-    root = ET.fromstring(fmi3_description(token, has_friction, x_kiss_ref_m))
+def thermal_fmi3_description(token: str, has_friction: bool, chain: Chain, x_kiss_ref_m: float | None = None,
+                             table=None) -> str:
+    """FMI 3.0 modelDescription.xml of the thermal FMU (ME and CS, independent variable time; ``table``: its
+    SpringTable)."""
+    root = ET.fromstring(fmi3_description(token, has_friction, x_kiss_ref_m, table))
     _head(root, 3)
     p = None if x_kiss_ref_m is None else clutch_model.ClutchParameters(x_kiss_ref=x_kiss_ref_m)
     starts = thermal_starts(chain, p)
@@ -191,8 +194,7 @@ def thermal_fmi3_description(token: str, has_friction: bool, chain: Chain, x_kis
             attrs["derivative"] = str(vrs[name[4:-1]])
         if causality in ("input", "parameter"):
             attrs["start"] = repr(starts[name])
-        if causality in ("input", "parameter") or name == FRICTION_OUTPUT:
-            attrs.update(_bounds(chain, name))
+        attrs.update(_bounds(chain, name))          # inputs, parameters and the nodes (thermal_ranges)
         ET.SubElement(variables, "Float64", attrs)
     variables.append(der_cs)
     deps, ders = thermal_dependencies(chain, has_friction)
@@ -214,12 +216,12 @@ def thermal_fmi3_build_description() -> str:
 
 
 def thermal_descriptions_into(fmu: Path, guid: str, has_friction: bool, chain: Chain, x_kiss_ref_m: float | None,
-                              fmi_version: int) -> None:
+                              fmi_version: int, table=None) -> None:
     """Replace ``modelDescription.xml`` (and, FMI 3.0, ``sources/buildDescription.xml``) in the built ``fmu``
     with the thermal variant's (the native build writes the clutch FMU's; binaries and sources are the variant's)."""
     fmu = Path(fmu)
-    replace = {"modelDescription.xml": thermal_fmi2_description(guid, has_friction, chain, x_kiss_ref_m)
-               if fmi_version == 2 else thermal_fmi3_description(guid, has_friction, chain, x_kiss_ref_m)}
+    replace = {"modelDescription.xml": thermal_fmi2_description(guid, has_friction, chain, x_kiss_ref_m, table)
+               if fmi_version == 2 else thermal_fmi3_description(guid, has_friction, chain, x_kiss_ref_m, table)}
     if fmi_version == 3:
         replace["sources/buildDescription.xml"] = thermal_fmi3_build_description()
     tmp = fmu.with_suffix(".fmu.tmp")

@@ -20,7 +20,7 @@ HEADER = "cushion_variables.h"
 #: C causality codes (the header's enum)
 CAUSALITIES = {"input": "CC_INPUT", "output": "CC_OUTPUT", "parameter": "CC_PARAMETER", "local": "CC_LOCAL"}
 #: input limits of the model written as C macros
-LIMITS = ("X_TO_MIN", "X_TO_MAX", "THETA_MIN_K", "THETA_MAX_K", "THETA_CM_LIMIT", "OMEGA_SLIP_LIMIT")
+LIMITS = ("X_TO_MIN", "X_TO_MAX", "THETA_MIN_K", "THETA_MAX_K", "OMEGA_SLIP_LIMIT")
 
 
 def enum_name(name: str) -> str:
@@ -59,12 +59,12 @@ def variable_header(p: "clutch_model.ClutchParameters | None" = None, variant: t
     problems += [f"{n}: C name {e} is taken" for (n, _, _, _), e in zip(variables, names) if names.count(e) > 1]
     problems += [f"parameter {n}: no range in ClutchParameters.RANGES"
                  for n, c, _, _ in variables if c == "parameter" and n not in ranges]
-    ranges = {**ranges, **model.INPUT_RANGES}      # a variant's own inputs (omega_engine) come with its ranges
+    ranges = {**model.OUTPUT_RANGES, **ranges, **model.INPUT_RANGES}  # a variant's own inputs come with its ranges
     problems += [f"input {n}: no range in clutch_model.INPUT_RANGES"
                  for n, c, _, _ in variables if c == "input" and n not in ranges]
     if problems:
         raise ValueError("VARIABLES cannot be written as a C table: " + "; ".join(problems))
-    rows = [(n, CAUSALITIES[c], starts[n], ranges[n] if c in ("parameter", "input") else None, u)
+    rows = [(n, CAUSALITIES[c], starts[n], ranges.get(n) if c != "local" else None, u)
             for n, c, u, _ in variables]
     rows.append(("der(theta_cs)", "CC_LOCAL", 0.0, None, "K/s"))
     enum = ",\n    ".join([*names, "CC_VR_DER_THETA_CS", "CC_NVARS"])
@@ -91,7 +91,8 @@ typedef struct {{
     const char *name;
     int causality;
     double start;    /* value before initialisation (parameters: their defaults) */
-    double range[4]; /* inputs and parameters: low, high, low open, high open (INPUT_RANGES, RANGES) */
+    double range[4]; /* inputs, parameters, bounded outputs: low, high, low open, high open (INPUT_RANGES, RANGES,
+                        OUTPUT_RANGES); other variables {{0}} */
     const char *unit;
 }} CcVariable;
 

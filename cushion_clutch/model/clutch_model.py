@@ -27,13 +27,13 @@ from dataclasses import dataclass, field, fields
 from functools import lru_cache
 
 try:                                    # inside the pythonfmu FMU the modules are siblings
-    from .cover import CoverMap, CoverParameters, hold_problem, range_problems
+    from .cover import CoverMap, CoverParameters, hold_problem, range_problems, wear_limit
     from .friction import FrictionTable
     from .number_check import any_bool, is_finite_number, is_number, unit_hint
     from .spring_table import KELVIN, Curve, SpringTable, pchip_slopes
     from .table_format import load_csv
 except ImportError:
-    from cover import CoverMap, CoverParameters, hold_problem, range_problems
+    from cover import CoverMap, CoverParameters, hold_problem, range_problems, wear_limit
     from friction import FrictionTable
     from number_check import any_bool, is_finite_number, is_number, unit_hint
     from spring_table import KELVIN, Curve, SpringTable, pchip_slopes
@@ -43,7 +43,7 @@ __all__ = ["KELVIN", "VARIABLES", "ClutchParameters", "CoverParameters", "CoverM
            "load_csv", "pchip_slopes", "thermal_step", "friction_coefficient", "outputs", "x_to_for_torque", "kiss_point",
            "OMEGA_SLIP_START", "OMEGA_SLIP_LIMIT", "start_values", "INPUT_RANGES", "X_TO_MIN", "X_TO_MAX",
            "THETA_MIN_K", "THETA_MAX_K", "validity", "validity_warning", "table_problems", "variable_bounds",
-           "range_message"]
+           "range_message", "declared_ranges", "facing_wear_max", "OUTPUT_RANGES"]
 
 #: The FMU interface, in value-reference order: (name, causality, unit, description).
 #: Both FMUs (pythonfmu and native C) expose exactly these; parameters take
@@ -117,6 +117,8 @@ X_TO_MAX = 0.025
 #: (a tolerance study's P95 spring on a coarse mesh) push the default cover past its hold at 950 K
 THETA_MIN_K = 200.0
 THETA_MAX_K = 800.0
+
+
 def hold_theta_cm(theta_cm: float) -> float:
     """``theta_cm`` (K) held within the model's range ``[THETA_MIN_K, THETA_MAX_K]``: what a TCU's model is
     evaluated at when its own facing estimate runs past the range (far beyond the facings' damage limit);
@@ -124,15 +126,16 @@ def hold_theta_cm(theta_cm: float) -> float:
     return min(max(theta_cm, THETA_MIN_K), THETA_MAX_K)
 
 
-
-#: legacy names of the bounds (the pythonfmu slave): |x_to| <= X_TO_LIMIT, theta_cm < THETA_CM_LIMIT
-X_TO_LIMIT = X_TO_MAX
-THETA_CM_LIMIT = THETA_MAX_K
 #: the inputs' ranges: (low, high, low_open, high_open)
 INPUT_RANGES = {
     "x_to": (X_TO_MIN, X_TO_MAX, False, False),
     "theta_cm": (THETA_MIN_K, THETA_MAX_K, False, False),
     "omega_slip": (-OMEGA_SLIP_LIMIT, OMEGA_SLIP_LIMIT, False, False),
+}
+#: the bounded outputs' ranges (the modelDescription's min/max): theta_cs lies between theta_cm and theta_a
+#: (the exact solution of eq. 3), both in [THETA_MIN_K, THETA_MAX_K]
+OUTPUT_RANGES = {
+    "theta_cs": (THETA_MIN_K, THETA_MAX_K, False, False),
 }
 #: nominal values (FMI ``nominal``) where the default is 0 or not a scale: the rest use |default|
 NOMINAL_OVERRIDES = {"x_to": 0.01, "theta_cm": 373.15, "omega_slip": 100.0, "facing_wear": 0.001,
@@ -199,10 +202,44 @@ class ClutchParameters:
         return out + self.cover.problems(self.lever_ratio if "lever_ratio" not in " ".join(out) else None)
 
 
-def variable_bounds() -> dict[str, tuple[float, float, float]]:
-    """``(min, max, nominal)`` of every input and parameter of :data:`VARIABLES` (the FMU's modelDescription):
-    the ranges of :data:`INPUT_RANGES` and ``ClutchParameters.RANGES`` (an open bound is given as its value:
-    FMI min/max are inclusive; the model refuses the bound itself), nominal |default| or
+def facing_wear_max(table: SpringTable, p: ClutchParameters | None = None) -> float:
+    """The declared maximum of ``facing_wear`` with ``table``, m: the wear limit of ``p``'s cover (default: the
+    default cover) over [THETA_MIN_K, THETA_MAX_K] (:func:`cover.wear_limit`, what initialisation accepts), rounded
+    down to 1 um so that the C check (a second implementation of the same balance) accepts it too, and at most
+    ``ClutchParameters.RANGES``' maximum; 0.0 if the cover cannot hold even new facings."""
+    p = p or ClutchParameters()
+    limit = wear_limit(p.cover, p.lever_ratio, table, p.x_kiss_ref, THETA_MIN_K, THETA_MAX_K)
+    return min(max(math.floor(limit * 1e6) / 1e6, 0.0), ClutchParameters.RANGES["facing_wear"][1])
+
+
+def declared_ranges(table: SpringTable | None = None) -> dict[str, tuple]:
+    """The one range table of the FMU interface: ``(low, high, low_open, high_open)`` of every input
+    (:data:`INPUT_RANGES`), parameter (``ClutchParameters.RANGES``) and bounded output (:data:`OUTPUT_RANGES`) of
+    :data:`VARIABLES`, in their order. The FMUs' modelDescription min/max (:func:`variable_bounds`), their C checks
+    (the generated variable table), the pythonfmu slave's checks and the docs' "allowed" column all come from it.
+    With ``table`` (the FMU's table set) ``facing_wear``'s maximum is the default cover's wear limit
+    (:func:`facing_wear_max`): initialisation refuses more with that cover.
+
+    Raises
+    ------
+    KeyError
+        Naming an input or parameter without a range.
+    """
+    out = {}
+    for name, causality, _, _ in VARIABLES:
+        if causality in ("input", "parameter") or name in OUTPUT_RANGES:
+            table_ = {"input": INPUT_RANGES, "parameter": ClutchParameters.RANGES}.get(causality, OUTPUT_RANGES)
+            out[name] = tuple(table_[name])
+    if table is not None:
+        lo, _, lo_open, hi_open = out["facing_wear"]
+        out["facing_wear"] = (lo, facing_wear_max(table), lo_open, hi_open)
+    return out
+
+
+def variable_bounds(table: SpringTable | None = None) -> dict[str, tuple[float, float, float]]:
+    """``(min, max, nominal)`` of every input, parameter and bounded output of :data:`VARIABLES` (the FMU's
+    modelDescription) from :func:`declared_ranges` (``table``: the FMU's table set); an open bound is given as its
+    value (FMI min/max are inclusive; the model refuses the bound itself), nominal |default| or
     :data:`NOMINAL_OVERRIDES`.
 
     Raises
@@ -211,14 +248,8 @@ def variable_bounds() -> dict[str, tuple[float, float, float]]:
         Naming an input or parameter without a range.
     """
     defaults = start_values()
-    out = {}
-    for name, causality, _, _ in VARIABLES:
-        if causality not in ("input", "parameter"):
-            continue
-        lo, hi = (INPUT_RANGES if causality == "input" else ClutchParameters.RANGES)[name][:2]
-        nominal = NOMINAL_OVERRIDES.get(name, abs(defaults[name]) or 1.0)
-        out[name] = (float(lo), float(hi), float(nominal))
-    return out
+    return {name: (float(lo), float(hi), float(NOMINAL_OVERRIDES.get(name, abs(defaults[name]) or 1.0)))
+            for name, (lo, hi, _, _) in declared_ranges(table).items()}
 
 
 def start_values(p: ClutchParameters | None = None) -> dict[str, float]:

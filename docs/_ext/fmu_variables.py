@@ -1,30 +1,38 @@
 """Sphinx directive ``fmu-variables``: the FMU's variable table, generated at build time from
 ``cushion_clutch.model.clutch_model.VARIABLES`` (name, causality, unit, description), with the start value
-of every parameter and input and the allowed range the FMUs check. Nothing is copied by hand."""
+of every parameter and input and the allowed range the FMUs declare and check (``clutch_model.declared_ranges``,
+the one range table). Nothing is copied by hand."""
 from __future__ import annotations
 
 from docutils import nodes
 from sphinx.util.docutils import SphinxDirective
 
 
-def _rows() -> list[tuple[str, str, str, str, str, str]]:
-    from cushion_clutch.model.clutch_model import (OMEGA_SLIP_LIMIT, THETA_CM_LIMIT, VARIABLES, X_TO_LIMIT,
-                                                   ClutchParameters, start_values)
+def _number(v: float) -> str:
+    """A bound as short as it reads exactly (``:g`` where that is the same number, else repr)."""
+    return f"{v:g}" if float(f"{v:g}") == v else repr(float(v))
 
-    p = ClutchParameters()
-    starts = start_values(p)
-    inputs = {"x_to": f"|x_to| <= {X_TO_LIMIT:g}", "theta_cm": f"0 < theta_cm < {THETA_CM_LIMIT:g}",
-              "omega_slip": f"|omega_slip| <= {OMEGA_SLIP_LIMIT:g}"}
+
+def allowed_text(rng: tuple) -> str:
+    """The "allowed" cell of a range (low, high, low open, high open): ``[lo, hi]``, ``(`` / ``)`` at an open end."""
+    lo, hi, lo_open, hi_open = rng
+    return f"{'(' if lo_open else '['}{_number(lo)}, {_number(hi)}{')' if hi_open else ']'}"
+
+
+def _rows() -> list[tuple[str, str, str, str, str, str]]:
+    """(name, causality, unit, start, allowed, meaning) of every variable; allowed from the FMU's one range table
+    (``clutch_model.declared_ranges`` with the default tables, as the default FMU declares and checks them)."""
+    from cushion_clutch.model import load_table
+    from cushion_clutch.model.clutch_model import VARIABLES, ClutchParameters, declared_ranges, start_values
+
+    starts = start_values(ClutchParameters())
+    ranges = declared_ranges(load_table())
     rows = []
     for name, causality, unit, description in VARIABLES:
-        start, allowed = "", ""
-        if causality in ("parameter", "input"):
-            start = f"{starts[name]:g}"
-        if causality == "parameter" and name in p.RANGES:
-            lo, hi, lo_open, hi_open = p.RANGES[name]
-            allowed = f"{'(' if lo_open else '['}{lo:g}, {hi:g}{')' if hi_open else ']'}"
-        if causality == "input":
-            allowed = inputs.get(name, "")
+        start = f"{starts[name]:g}" if causality in ("parameter", "input") else ""
+        allowed = allowed_text(ranges[name]) if name in ranges else ""
+        if name == "facing_wear":
+            description += "; the maximum is the default cover's wear limit with the default tables"
         rows.append((name, causality, unit, start, allowed, description))
     return rows
 

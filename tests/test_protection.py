@@ -1,5 +1,6 @@
 """Thermal protection: its levels on the facing-temperature estimate, and on a heavy-duty launch run."""
 import dataclasses
+import math
 
 import numpy as np
 import pytest
@@ -75,5 +76,12 @@ def test_protected_tcus_keep_their_estimate_below_the_damage_limit(tmp_path):
         levels = [m["protection_level"] for m in r.metrics]
         assert max(levels) == INHIBIT and levels[0] == OK
         limited = [m["slip_energy_kJ"] for m in r.metrics if m["protection_level"] == LIMIT]
-        assert limited and max(limited) < 0.8 * r.metrics[0]["slip_energy_kJ"]
+        assert limited
+        if name == "aware":         # it knows mass and grade: a lower engine speed that still locks up in time
+            assert max(limited) < 0.8 * r.metrics[0]["slip_energy_kJ"]
+        # production's mass and grade estimate leaves no lower speed that surely locks up: the pedal's target
+        # (a limit that strands the launch is no protection)
+        for m in r.metrics:         # every launch it does not inhibit locks up
+            assert m["protection_level"] == INHIBIT or math.isfinite(m["engagement_time_s"]), m
+            assert not m["stranded"] and m["launch_possible"]
         assert np.nanmax(r.series["protection_level"]) == INHIBIT

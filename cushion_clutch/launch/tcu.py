@@ -83,6 +83,18 @@ OPEN, LAUNCH, CLOSE, PREFILL = 0, 1, 2, 3     #: TCU phases
 MEMO_SIZE = 64
 
 
+def _full_load_Nm(engine, w_rad_s: float) -> float:
+    """The engine's full-load torque at ``w_rad_s`` (the scenario's curve, linear, clamped at its ends), N.m."""
+    w = [x * math.pi / 30.0 for x in engine.torque_curve_rpm]
+    t = engine.torque_curve_Nm
+    if w_rad_s <= w[0]:
+        return float(t[0])
+    for i in range(1, len(w)):
+        if w_rad_s <= w[i]:
+            return t[i - 1] + (t[i] - t[i - 1]) * (w_rad_s - w[i - 1]) / (w[i] - w[i - 1])
+    return float(t[-1])
+
+
 def _memo(memo: dict, key: tuple, compute):
     """``memo[key]``, computed by ``compute()`` the first time: exact inputs, so exactly the value computed.
 
@@ -154,6 +166,10 @@ class TcuController:
         self.protection = (ThermalProtection(sc.protection)
                            if sc.protection.enabled and variant.temperature != "none" else None)
         self.inhibited = self.limited = False
+        #: the limited launch's engine-speed target at full pedal (:meth:`limited_target_rpm`), rpm
+        self.limit_full_rpm = sc.protection.limit_engine_speed_rpm
+        #: time since the launch's start (after the pre-fill), s
+        self.t_launch = 0.0
         #: the protection level the current launch runs at (decided at its start; 3: inhibited)
         self.launch_level = 0
         #: the calibration's friction at the last measured slip speed, relative to the nominal mu
@@ -241,6 +257,27 @@ class TcuController:
         hi = self.sc.tcu.x_to_closed_m
         return 0.0 if u < 0.0 else (hi if u > hi else u)
 
+    def limited_target_rpm(self, level: str) -> float:
+        """The engine-speed target at full pedal of a launch limited by the thermal protection, rpm.
+
+        The lowest of ``protection.limit_engine_speed_rpm``, then every 50 rpm up to the pedal's own
+        (``tcu.engine_speed_full_pedal_rpm``), at which the vehicle reaches the engine's target speed by
+        ``tcu.lockup_deadline_s + tcu.forced_sync_s`` (the latest lock-up): the engine's torque at the pedal there (its full-load curve, which the
+        engine control reports, minus its drag) less the holding torque the TCU believes accelerates the disc
+        and vehicle inertia it believes, ``w_t J_d / (pedal T_max(w_t) - drag w_t - T_load) <= deadline + sync``.
+        None that does (the load too heavy for the time): the pedal's own target, unlimited.
+        """
+        tc, eng, prot = self.sc.tcu, self.sc.engine, self.protection.p
+        pedal = self.sc.driver.pedal(level)
+        full = prot.limit_engine_speed_rpm
+        while full < tc.engine_speed_full_pedal_rpm:
+            w_t = self.w_idle + pedal * (full * math.pi / 30.0 - self.w_idle)
+            surplus = (pedal * _full_load_Nm(eng, w_t) - eng.drag_Nm_per_rad_s * w_t - self.t_load)
+            if surplus > 0.0 and w_t * self.j_d / surplus <= tc.lockup_deadline_s + tc.forced_sync_s:
+                return full
+            full += 50.0
+        return tc.engine_speed_full_pedal_rpm
+
     def _demand(self, level: str, w_e: float, w_d: float, t_e: float) -> float:
         """The launch's clutch-torque demand for this period, N.m (updates references and integral)."""
         tc, drv, dt = self.sc.tcu, self.sc.driver, self.period
@@ -248,12 +285,22 @@ class TcuController:
         kp, ki = tc.speed_kp_Nm_per_rad_s, tc.speed_ki_Nm_per_rad
         k = 1.0 / self.j_e + 1.0 / self.j_d
         t_lock = (self.j_d * t_e + self.j_e * self.t_load) / (self.j_e + self.j_d)
-        if not self.sync and slip <= tc.sync_slip_rad_s and self.t_dem > 0.0:
+        late = level != "creep" and self.t_launch >= tc.lockup_deadline_s and w_d >= self.w_idle
+        if not self.sync and self.t_dem > 0.0 and (slip <= tc.sync_slip_rad_s or (late and slip > 0.0)):
             # the slip rate falls linearly from the one the present demand gives (no torque step) to the
-            # lock-up rate, over the time that closes the slip: a parabolic landing
+            # lock-up rate, over the time that closes the slip: a parabolic landing; after the lock-up deadline
+            # (a pedal launch, the disc at idle speed or above) at least fast enough to close it in forced_sync_s
             r_end = tc.lockup_slip_rate_rad_s2
             r0 = max(r_end, k * (self.t_dem - t_lock))
+            if late:
+                r0 = max(r0, 2.0 * slip / tc.forced_sync_s - r_end)
             self.sync, self.s_ref, self.rate, self.t_sync = True, slip, r0, 2.0 * slip / (r0 + r_end)
+            self.jerk = (r0 - r_end) / self.t_sync
+        elif self.sync and late and self.t_sync > tc.forced_sync_s and self.s_ref > 0.0:
+            # a slow sync at the deadline: the rest of its slip reference closed within forced_sync_s
+            r_end = tc.lockup_slip_rate_rad_s2
+            r0 = max(self.rate, 2.0 * self.s_ref / tc.forced_sync_s - r_end)
+            self.rate, self.t_sync = r0, 2.0 * self.s_ref / (r0 + r_end)
             self.jerk = (r0 - r_end) / self.t_sync
         if self.sync:
             if self.t_sync > 0.0:
@@ -268,7 +315,7 @@ class TcuController:
             return drv.creep_torque_Nm
         full = tc.engine_speed_full_pedal_rpm
         if self.limited:                                  # slip energy limited (decided at the launch's start)
-            full = min(full, self.protection.p.limit_engine_speed_rpm)
+            full = min(full, self.limit_full_rpm)
         w_t = self.w_idle + drv.pedal(level) * (full * math.pi / 30.0 - self.w_idle)
         dw = (w_t - self.w_ref) / tc.engine_speed_time_constant_s
         self.w_ref += dw * dt
@@ -311,6 +358,8 @@ class TcuController:
                 # speed controller pull the engine down (a torque spike of 208 N.m, measured)
                 self.launch_level = prot.update(self.theta_facing_protect(), tl, launch)
                 self.limited = self.launch_level >= LIMIT
+                if self.limited:
+                    self.limit_full_rpm = self.limited_target_rpm(level)
         if prot is not None:
             prot.update(self.theta_facing_protect(), tl, launch)
             if self.inhibited:                    # no launch in this slot: the clutch stays open
@@ -318,7 +367,7 @@ class TcuController:
                 self.theta_now, self.kiss_now = self.theta_used(), self.kiss()
                 return
         was_launching = self.phase == LAUNCH
-        t_launch = tl - tc.prefill_s
+        t_launch = self.t_launch = tl - tc.prefill_s
         t_prev = self.t_dem
         if 0.0 <= t_launch < tc.drive_time_s and not locked_once:
             self.t_closed = self.model_torque(tc.x_to_closed_m)      # the largest torque it believes it has

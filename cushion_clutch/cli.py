@@ -488,7 +488,8 @@ def build_parser() -> argparse.ArgumentParser:
                   "CSV files.",
                   "cushion-clutch launch --scenario creep --out out_creep")
     la.add_argument("--scenario", default=DEFAULT_SCENARIO,
-                    help="scenario TOML, or a shipped one: default, trailer, creep, cooldown, fade, wear, wear_learned, tolerance, protection")
+                    help="scenario TOML, or a shipped one: default, trailer, creep, cooldown, fade, wear, wear_learned, tolerance, "
+                         "protection, hill_restart, hill_fade")
     la.add_argument("--fmu", help="clutch FMU (default: build one from --tables into --out)")
     la.add_argument("--tables", default=DEFAULT_TABLES, help="table folder")
     add_backend(la)

@@ -85,3 +85,73 @@ def test_protected_tcus_keep_their_estimate_below_the_damage_limit(tmp_path):
             assert m["protection_level"] == INHIBIT or math.isfinite(m["engagement_time_s"]), m
             assert not m["stranded"] and m["launch_possible"]
         assert np.nanmax(r.series["protection_level"]) == INHIBIT
+
+
+@pytest.mark.fmu
+def test_every_production_launch_of_the_protection_scenario_locks_up_or_is_inhibited(tmp_path):
+    """Issue 38's bar: in the shipped `protection` scenario (30 hill starts, 3500 kg, 12 %) every production
+    launch not inhibited at its start locks up; none is stranded; every launch is physically possible."""
+    from cushion_clutch.data import DEFAULT_TABLES
+    from cushion_clutch.fmu.build import build_fmu
+    from cushion_clutch.launch.scenario import load_scenario, scenario_path
+    from cushion_clutch.launch.simulate import simulate_launches
+    from cushion_clutch.model import load_table
+
+    fmu = build_fmu(DEFAULT_TABLES, tmp_path / "CushionClutch.fmu")
+    sc = load_scenario(scenario_path("protection"))
+    r = simulate_launches(fmu, sc, load_table(), "production", record_every=100)
+    assert len(r.metrics) == 30
+    levels = [m["protection_level"] for m in r.metrics]
+    assert max(levels) == INHIBIT and levels.count(INHIBIT) < 30
+    for m in r.metrics:
+        assert m["launch_possible"] and not m["stranded"], m
+        assert m["protection_level"] == INHIBIT or math.isfinite(m["engagement_time_s"]), m
+        assert m["protection_level"] < INHIBIT or math.isnan(m["engagement_time_s"]), m
+
+
+def test_launch_capability_is_the_engine_at_the_pedal_against_the_holding_torque():
+    """Closed forms: the holding torque m g (sin a + c_r cos a) r / (eta i) and the engine's best net torque
+    at the pedal over its curve's nodes; a launch on a grade the engine cannot hold is not possible."""
+    from cushion_clutch.launch.metrics import launch_capability, launch_possible
+    from cushion_clutch.launch.scenario import load_scenario, scenario_path
+
+    sc = load_scenario(scenario_path("protection"))
+    v, d, e = sc.vehicle, sc.driveline, sc.engine
+    a = math.atan(v.slope_percent / 100.0)
+    hold = v.mass_kg * 9.81 * (math.sin(a) + v.rolling_resistance * math.cos(a)) * d.wheel_radius_m / (
+        d.efficiency * d.gear_ratio * d.final_drive_ratio)
+    pedal = sc.driver.hard_pedal
+    best = max(pedal * t - e.drag_Nm_per_rad_s * w * math.pi / 30.0
+               for w, t in zip(e.torque_curve_rpm, e.torque_curve_Nm) if e.idle_speed_rpm <= w <= e.max_speed_rpm)
+    engine, load = launch_capability(sc, "hard")
+    assert load == pytest.approx(hold, rel=1e-9) and engine == pytest.approx(best, rel=1e-9)
+    assert launch_possible(sc, "hard")
+    steep = dataclasses.replace(sc, vehicle=dataclasses.replace(v, slope_percent=30.0),
+                                driver=dataclasses.replace(sc.driver, hard_pedal=0.3))
+    assert not launch_possible(steep, "hard")
+    creep_engine, _ = launch_capability(sc, "creep")       # the idle governor at full throttle, idle speed
+    assert creep_engine == pytest.approx(e.torque_curve_Nm[0] - e.drag_Nm_per_rad_s * e.idle_speed_rpm * math.pi / 30)
+
+
+def test_a_limited_launch_targets_the_lowest_speed_that_locks_up_in_time():
+    from cushion_clutch.launch.scenario import load_scenario, scenario_path
+    from cushion_clutch.launch.driveline import Driveline
+    from cushion_clutch.launch.tcu import VARIANTS, TcuController
+    from cushion_clutch.model import ClutchParameters, load_table
+
+    sc = load_scenario(scenario_path("protection"))
+    dl = Driveline(sc, 83.78)
+    ctl = TcuController(VARIANTS["aware"], sc, load_table(), ClutchParameters(), 293.15, dl.j_d, dl.t_load_rest)
+    full = ctl.limited_target_rpm("hard")
+    tc = sc.tcu
+    assert sc.protection.limit_engine_speed_rpm < full < tc.engine_speed_full_pedal_rpm
+
+    def lock_time(rpm):
+        w = ctl.w_idle + sc.driver.hard_pedal * (rpm * math.pi / 30 - ctl.w_idle)
+        from cushion_clutch.launch.tcu import _full_load_Nm
+        s = sc.driver.hard_pedal * _full_load_Nm(sc.engine, w) - sc.engine.drag_Nm_per_rad_s * w - ctl.t_load
+        return w * ctl.j_d / s if s > 0 else math.inf
+    assert lock_time(full) <= tc.lockup_deadline_s + tc.forced_sync_s < lock_time(full - 50.0)
+    light = TcuController(VARIANTS["aware"], sc, load_table(), ClutchParameters(), 293.15, dl.j_d / 3,
+                          dl.t_load_rest / 3)
+    assert light.limited_target_rpm("hard") == sc.protection.limit_engine_speed_rpm   # light: the limit itself

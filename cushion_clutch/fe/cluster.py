@@ -195,7 +195,7 @@ def open_cluster(scheduler=None, workers: int | None = None, timeout_s: float = 
     own_client = own_cluster = None
     if scheduler is None:
         own_cluster = LocalCluster(n_workers=workers or os.cpu_count() or 1, threads_per_worker=1,
-                                   processes=True, dashboard_address=None)
+                                   processes=True, dashboard_address=None, silence_logs=logging.ERROR)
         client = own_client = Client(own_cluster)
     elif isinstance(scheduler, str):
         try:

@@ -347,10 +347,14 @@ def plot_fleet(rows: list[dict], tcus: Sequence[str], png: Path, title: str) -> 
         axes[2].scatter([r["facing_wear_m"] * 1e3 for r in mine], [r[metric] for r in mine], s=8, color=c,
                         alpha=0.6, label=name)
     axes[0].axvline(ERROR_BAR_NM, color="k", ls=":", lw=1)
-    axes[0].text(ERROR_BAR_NM, 0.02, " 9.4 N·m (3 % of 312 N·m)", fontsize=8)
+    axes[0].text(ERROR_BAR_NM, 0.02, " 9.4 N·m (3 % of 312 N·m)", fontsize=8, transform=axes[0].get_xaxis_transform())
     for y in (0.95, 0.99):
         axes[0].axhline(y, color="grey", lw=0.5, ls="--")
-    axes[0].set_xlabel("characteristic error, worst of a sample's launches [N·m]")
+        axes[0].text(0.01, y, f"P{round(y * 100)}", fontsize=7, va="bottom", transform=axes[0].get_yaxis_transform())
+    axes[0].set_ylim(0.0, 1.02)
+    for ax in axes:                    # the TCUs' errors differ by orders of magnitude
+        ax.set_xscale("log") if ax is axes[0] else ax.set_yscale("log")
+    axes[0].set_xlabel("characteristic error, worst of a sample's launches [N·m] (log)")
     axes[0].set_ylabel("fraction of samples")
     axes[0].set_title("CDF of the characteristic error per TCU")
     axes[1].set_xlabel("ambient temperature [°C]")
@@ -358,7 +362,7 @@ def plot_fleet(rows: list[dict], tcus: Sequence[str], png: Path, title: str) -> 
     axes[2].set_xlabel("facing wear [mm]")
     axes[2].set_title("error against facing wear (TCUs believe new)")
     for ax in axes[1:]:
-        ax.set_ylabel("characteristic error [N·m]")
+        ax.set_ylabel("characteristic error [N·m] (log)")
     for ax in axes:
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)

@@ -40,12 +40,15 @@ import math
 from dataclasses import dataclass
 from pathlib import Path
 
+from statistics import NormalDist
+
 import numpy as np
 
 from ..config import load_toml, range_problem
 from ..errors import ParameterError
 from .scenario import Scenario, load_scenario, scenario_path
 
+_PHI = NormalDist()
 #: the folder of the shipped populations
 POPULATIONS = Path(__file__).parent / "populations"
 
@@ -80,16 +83,18 @@ class Dist:
             f = (mode - lo) / (hi - lo)
             return (lo + math.sqrt(u * (hi - lo) * (mode - lo)) if u < f
                     else hi - math.sqrt((1.0 - u) * (hi - lo) * (hi - mode)))
-        from scipy.stats import norm
         mean, sd, lo, hi = p
-        a, b = norm.cdf((lo - mean) / sd), norm.cdf((hi - mean) / sd)
-        return float(min(max(mean + sd * norm.ppf(a + u * (b - a)), lo), hi))
+        a, b = _PHI.cdf((lo - mean) / sd), _PHI.cdf((hi - mean) / sd)
+        q = min(max(a + u * (b - a), 1e-15), 1.0 - 1e-15)
+        return float(min(max(mean + sd * _PHI.inv_cdf(q), lo), hi))     # the bounds against round-off
 
     @property
     def bounds(self) -> tuple[float, float]:
+        """(lowest, highest) value it draws."""
         p = self.params
-        return {"fixed": (p[0], p[0]), "uniform": (p[0], p[1]), "triangular": (p[0], p[2])}.get(
-            self.kind, (p[2], p[3]) if len(p) == 4 else (math.nan, math.nan))
+        if self.kind == "fixed":
+            return p[0], p[0]
+        return (p[0], p[1]) if self.kind == "uniform" else (p[0], p[2]) if self.kind == "triangular" else (p[2], p[3])
 
 
 @dataclass(frozen=True)
@@ -326,8 +331,6 @@ class Sample:
 
 def draw(pop: Population, seed: int, i: int) -> Sample:
     """Sample ``i`` of the population with ``seed`` (its own random stream)."""
-    from scipy.stats import norm
-
     rng = np.random.default_rng([int(seed), int(i)])
     keys = list(pop.dists)
     z = rng.standard_normal(len(keys))
@@ -337,8 +340,7 @@ def draw(pop: Population, seed: int, i: int) -> Sample:
             ia, ib = keys.index(a), keys.index(b)
             m[ia, ib] = m[ib, ia] = rho
         z = np.linalg.cholesky(m) @ z
-    u = np.clip(norm.cdf(z), 1e-12, 1.0 - 1e-12)
-    vals = {k: pop.dists[k].ppf(float(u[n])) for n, k in enumerate(keys)}
+    vals = {k: pop.dists[k].ppf(min(max(_PHI.cdf(float(z[n])), 1e-12), 1.0 - 1e-12)) for n, k in enumerate(keys)}
     sc = pop.scenario
     trailer = bool(rng.random() < pop.trailer_probability)
     t_mass = pop.trailer_mass.ppf(float(rng.random())) if trailer else 0.0

@@ -277,8 +277,7 @@ def fleet_terminal_table(summary: list[dict]) -> str:
         if r["metric"] in FLEET_TERMINAL:
             lines.append(f"{r['tcu']:<26}{r['metric']:<30}" + "".join(
                 f"{'-' if math.isnan(r[k]) else format(r[k], '.2f'):>9}" for k in ("p50", "p95", "p99", "max")))
-    lines.append("stranded: launches per sample without lock-up that the vehicle could make and the TCU did not "
-                 "inhibit")
+    lines.append("stranded: launches of a sample without lock-up, possible and not inhibited")
     return "\n".join(lines)
 
 

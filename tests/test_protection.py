@@ -133,25 +133,50 @@ def test_launch_capability_is_the_engine_at_the_pedal_against_the_holding_torque
     assert creep_engine == pytest.approx(e.torque_curve_Nm[0] - e.drag_Nm_per_rad_s * e.idle_speed_rpm * math.pi / 30)
 
 
-def test_a_limited_launch_targets_the_lowest_speed_that_locks_up_in_time():
-    from cushion_clutch.launch.scenario import load_scenario, scenario_path
+def test_the_launch_target_locks_up_in_time():
+    """A limited launch aims at the lowest speed from the limit up that locks up by the deadline (the TCU's
+    beliefs), a light one at the limit itself; a launch whose pedal speed cannot lock up in time (a steep grade,
+    a light pedal) aims at the lowest faster speed that can."""
     from cushion_clutch.launch.driveline import Driveline
-    from cushion_clutch.launch.tcu import VARIANTS, TcuController
+    from cushion_clutch.launch.scenario import load_scenario, scenario_path
+    from cushion_clutch.launch.tcu import VARIANTS, TcuController, _full_load_Nm
     from cushion_clutch.model import ClutchParameters, load_table
 
     sc = load_scenario(scenario_path("protection"))
-    dl = Driveline(sc, 83.78)
-    ctl = TcuController(VARIANTS["aware"], sc, load_table(), ClutchParameters(), 293.15, dl.j_d, dl.t_load_rest)
-    full = ctl.limited_target_rpm("hard")
-    tc = sc.tcu
-    assert sc.protection.limit_engine_speed_rpm < full < tc.engine_speed_full_pedal_rpm
+    tc, rpm = sc.tcu, math.pi / 30.0
+    budget = tc.lockup_deadline_s + tc.forced_sync_s
 
-    def lock_time(rpm):
-        w = ctl.w_idle + sc.driver.hard_pedal * (rpm * math.pi / 30 - ctl.w_idle)
-        from cushion_clutch.launch.tcu import _full_load_Nm
-        s = sc.driver.hard_pedal * _full_load_Nm(sc.engine, w) - sc.engine.drag_Nm_per_rad_s * w - ctl.t_load
+    def tcu(scen, scale=1.0):
+        dl = Driveline(scen, 83.78)
+        return TcuController(VARIANTS["aware"], scen, load_table(), ClutchParameters(), 293.15, dl.j_d * scale,
+                             dl.t_load_rest * scale)
+
+    def lock_time(ctl, scen, w):
+        p = scen.driver.hard_pedal
+        s = p * _full_load_Nm(scen.engine, w) - scen.engine.drag_Nm_per_rad_s * w - ctl.t_load
         return w * ctl.j_d / s if s > 0 else math.inf
-    assert lock_time(full) <= tc.lockup_deadline_s + tc.forced_sync_s < lock_time(full - 50.0)
-    light = TcuController(VARIANTS["aware"], sc, load_table(), ClutchParameters(), 293.15, dl.j_d / 3,
-                          dl.t_load_rest / 3)
-    assert light.limited_target_rpm("hard") == sc.protection.limit_engine_speed_rpm   # light: the limit itself
+
+    ctl = tcu(sc)
+    pedal_w = ctl.w_idle + sc.driver.hard_pedal * (tc.engine_speed_full_pedal_rpm * rpm - ctl.w_idle)
+    assert ctl.launch_target_rad_s("hard") == pedal_w                  # unlimited: the pedal's own
+    ctl.limited = True
+    w = ctl.launch_target_rad_s("hard")
+    limit_w = ctl.w_idle + sc.driver.hard_pedal * (sc.protection.limit_engine_speed_rpm * rpm - ctl.w_idle)
+    assert limit_w < w < pedal_w
+    assert lock_time(ctl, sc, w) <= budget < lock_time(ctl, sc, w - 50.0 * rpm * sc.driver.hard_pedal)
+    light = tcu(sc, 1.0 / 3.0)
+    light.limited = True
+    assert light.launch_target_rad_s("hard") == pytest.approx(limit_w, rel=1e-12)
+    # 1536 kg on 16 % at pedal 0.35: the pedal's 1290 rpm barely holds the car (a fleet sample production
+    # stranded): a faster target that locks up in time
+    steep = dataclasses.replace(sc, vehicle=dataclasses.replace(sc.vehicle, mass_kg=1536.0, slope_percent=16.0,
+                                                                drag_area_m2=0.7),
+                                driver=dataclasses.replace(sc.driver, hard_pedal=0.35))
+    ctl = tcu(steep)
+    slow = ctl.w_idle + 0.35 * (tc.engine_speed_full_pedal_rpm * rpm - ctl.w_idle)
+    assert lock_time(ctl, steep, slow) > budget
+    w = ctl.launch_target_rad_s("hard")
+    faster = [slow + k * 50.0 * rpm for k in range(1, 200) if slow + k * 50.0 * rpm <= 6000.0 * rpm]
+    assert w > slow and lock_time(ctl, steep, w) == min(lock_time(ctl, steep, v) for v in faster)
+    assert lock_time(ctl, steep, w) < lock_time(ctl, steep, slow) / 3
+    assert not ctl.holds("hard", slow) and ctl.holds("hard", w)

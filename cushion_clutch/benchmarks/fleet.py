@@ -55,20 +55,25 @@ def part_possible(work: Path) -> dict:
 
 
 def _duty_run(fmu, sc, table, tcu):
-    """simulate the duty; if the facings leave the FMU's range, rerun up to the launch before (noted)."""
+    """Simulate the duty; if the facings leave the FMU's or the TCU model's temperature range (800 K), rerun
+    with fewer launches (up to the one before the FMU's refusal, or 4/5 of the launches for the model's
+    ValueError) until a run stays inside; the note says where it stopped."""
     import dataclasses
 
     from cushion_clutch.errors import FmuCallError
     from cushion_clutch.launch.report import run_all
-    try:
-        return run_all(fmu, sc, table, (tcu,))[tcu], None
-    except FmuCallError as exc:
-        m = re.search(r"t=([0-9.eE+-]+)", str(exc))
-        if not m:
-            raise
-        stop = int(float(m.group(1)) // sc.run.period_s) + 1      # the launch whose slot it failed in
-        short = dataclasses.replace(sc, run=dataclasses.replace(sc.run, launches=max(1, stop - 1)))
-        return run_all(fmu, short, table, (tcu,))[tcu], f"the FMU refused launch {stop} ({exc})"
+    launches, note = sc.run.launches, None
+    while True:
+        s = dataclasses.replace(sc, run=dataclasses.replace(sc.run, launches=launches))
+        try:
+            return run_all(fmu, s, table, (tcu,))[tcu], note
+        except (FmuCallError, ValueError) as exc:
+            m = re.search(r"t=([0-9.eE+-]+)", str(exc))
+            stop = int(float(m.group(1)) // sc.run.period_s) + 1 if m else launches
+            launches = max(1, min(stop - 1, int(launches * 0.8)))
+            note = f"stopped after launch {launches}: {str(exc).splitlines()[0][:120]}"
+            if launches <= 1:
+                raise
 
 
 def part_duty(work: Path) -> dict:

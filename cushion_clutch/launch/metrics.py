@@ -30,9 +30,10 @@ Each metric measures one cause (SI units unless a name says otherwise):
     1 warn, 2 limit, 3 inhibited: no launch; :mod:`.protection`).
 
 ``launch_possible``, ``stranded``
-    Whether the vehicle can make the launch at all (:func:`launch_capability`: the engine's largest
+    Whether the vehicle can make the launch at all (:func:`launch_possible`: the engine's largest
     torque at the launch's pedal, over its speed range, exceeds the torque that holds the car on the
-    grade, both at the disc), and a *stranded* launch: possible, not inhibited by the protection
+    grade, both at the disc, and at best it gets the car to a speed where the engine holds it within the
+    driver's pedal time), and a *stranded* launch: possible, not inhibited by the protection
     (``protection_level`` below 3), and no lock-up while the driver pressed the pedal. A launch that
     is not possible and does not lock up is not counted as stranded.
 
@@ -279,6 +280,24 @@ def launch_capability(sc, level: str) -> tuple[float, float]:
 
 
 def launch_possible(sc, level: str) -> bool:
-    """True if the vehicle can make a launch at ``level`` on the scenario's grade (:func:`launch_capability`)."""
+    """True if the vehicle can make a launch at ``level`` on the scenario's grade within the driver's pedal time.
+
+    The engine's torque at the pedal must exceed the holding torque (:func:`launch_capability`), and (a pedal
+    launch) the disc must reach, within ``tcu.drive_time_s``, the lowest engine speed at which the engine holds
+    the car, accelerated at best by the engine's largest surplus: ``w_hold J_d / (engine - load)`` (a lower
+    bound of any controller's time; ``J_d`` the disc and vehicle inertia at the disc).
+    """
     engine, load = launch_capability(sc, level)
-    return engine > load
+    if engine <= load:
+        return False
+    if level == "creep":
+        return True
+    from .driveline import Driveline
+    from .engine import EngineGovernor
+
+    eng = EngineGovernor(sc.engine, sc.run.step_s)
+    pedal = sc.driver.pedal(level)
+    n = 400
+    hold = next(w for w in (eng.w_idle + (eng.w_max - eng.w_idle) * k / n for k in range(n + 1))
+                if pedal * eng.max_torque(w) - eng.drag * w > load)
+    return hold * Driveline(sc, eng.w_idle).j_d / (engine - load) <= sc.tcu.drive_time_s

@@ -173,7 +173,8 @@ class Tcu(Checked):
     lockup_deadline_s: float = 5.5
     """pedal launches: this long after the launch's start (after the pre-fill) the TCU closes the slip that is
     left within ``forced_sync_s`` (it enters the sync from any slip, or shortens a slower sync), provided the
-    disc turns at least at the engine's idle speed (the engine runs on after lock-up), s"""
+    disc turns at least at the engine's idle speed and the engine's torque at the pedal there carries the
+    holding torque the TCU believes (locked, the engine runs on and the car does not roll back), s"""
     forced_sync_s: float = 1.5
     """the longest sync after ``lockup_deadline_s``, s"""
 

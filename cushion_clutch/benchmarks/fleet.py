@@ -30,7 +30,7 @@ import sys
 import time
 from pathlib import Path
 
-PARTS = ("possible", "duty", "bar", "identity", "scaling", "aware")
+PARTS = ("possible", "duty", "bar", "identity", "scaling", "aware", "big")
 DUTIES = ("hill_restart", "hill_fade")
 METRICS = ("characteristic_error_max_Nm", "characteristic_error_rms_Nm", "tracking_error_max_Nm",
            "engagement_time_s", "peak_theta_cm_degC", "stranded", "lockups")
@@ -41,16 +41,17 @@ def _load() -> list[float]:
 
 
 def part_possible(work: Path) -> dict:
-    from cushion_clutch.launch.metrics import launch_capability
+    from cushion_clutch.launch.metrics import launch_capability, launch_possible
     from cushion_clutch.launch.scenario import load_scenario, scenario_path, shipped_names
     rows = []
     for name in shipped_names():
         sc = load_scenario(scenario_path(name))
         for level in dict.fromkeys(sc.driver.levels):
             engine, load = launch_capability(sc, level)
+            possible = launch_possible(sc, level)
             rows.append({"scenario": name, "level": level, "pedal": sc.driver.pedal(level),
                          "mass_kg": sc.vehicle.mass_kg, "grade_percent": sc.vehicle.slope_percent,
-                         "engine_Nm": engine, "load_Nm": load, "possible": engine > load})
+                         "engine_Nm": engine, "load_Nm": load, "possible": possible})
     return {"rows": rows}
 
 
@@ -131,6 +132,12 @@ def part_aware(work: Path, samples: int) -> dict:
     return _fleet(work, "fleet_aware_estimated", samples, ("aware_estimated",), 2)
 
 
+def part_big(work: Path, samples: int) -> dict:
+    """naive, production (resuming the bar's folder) and aware_estimated on ``samples`` samples."""
+    return {"runs": [_fleet(work, "fleet_naive_production", samples, ("naive", "production"), 2),
+                     _fleet(work, "fleet_aware_estimated", samples, ("aware_estimated",), 2)]}
+
+
 def part_identity(work: Path) -> dict:
     from cushion_clutch.launch.fleet import SAMPLES_FILE, read_samples
     out = _fleet(work, "fleet_naive_production_20_jobs1", 20, ("naive", "production"), 1)
@@ -165,21 +172,23 @@ def write_page(work: Path, page: Path, argv: list[str]) -> None:
                       argv) as out:
         out.markdown(INTRO)
         out.markdown("## The production TCU over the fleet\n")
-        for part, label in (("bar", "naive and production"), ("aware", "aware_estimated")):
-            if part not in got:
-                out.markdown(f"*Part `{part}` ({label}) did not run for this page.*\n")
-                continue
-            g = got[part]
+        runs = [(r, ", ".join(r["tcus"])) for r in got["big"]["runs"]] if "big" in got else \
+            [(got[p], label) for p, label in (("bar", "naive and production"), ("aware", "aware_estimated"))
+             if p in got]
+        if not runs:
+            out.markdown("*No fleet run for this page.*\n")
+        for g, label in runs:
             out.markdown(f"Population `default`, samples 0-{g['samples'] - 1}, seed 1, {label}: {g['ran']} samples "
                          f"run ({g['kept']} kept from an earlier run) in {g['wall_s']:.0f} s on {g['workers']} "
                          f"worker(s); load average {g['load_before'][0]} before, {g['load_after'][0]} after.\n")
-            out.markdown("| TCU | metric (worst of a sample's launches) | P50 | P95 | P99 | max |\n|---|---|---|---|---|---|")
-            for r in g["summary"]:
-                if r["metric"] in METRICS:
-                    out.markdown(f"| {r['tcu']} | {r['metric']} | {_f(r['p50'])} | {_f(r['p95'])} | {_f(r['p99'])} "
-                                 f"| {_f(r['max'])} |")
-            out.markdown("")
+            lines = ["| TCU | metric (worst of a sample's launches) | P50 | P95 | P99 | max |", "|---|---|---|---|---|---|"]
+            lines += [f"| {r['tcu']} | {r['metric']} | {_f(r['p50'])} | {_f(r['p95'])} | {_f(r['p99'])} | {_f(r['max'])} |"
+                      for r in g["summary"] if r["metric"] in METRICS]
+            out.markdown("\n".join(lines) + "\n")
         if "bar" in got:
+            g = got["bar"]
+            out.markdown(f"### The bar: `cushion-clutch fleet --population default --samples {g['samples']} --tcus "
+                         f"naive,production --jobs 2 --seed 1`\n")
             p99 = next((r["p99"] for r in got["bar"]["summary"] if r["tcu"] == "production"
                         and r["metric"] == "characteristic_error_max_Nm"), math.nan)
             out.markdown(f"Bar: production's P99 of `characteristic_error_max_Nm` {_f(p99)} N·m (at most 9.4 N·m: "
@@ -189,12 +198,11 @@ def write_page(work: Path, page: Path, argv: list[str]) -> None:
                          f"load average {got['bar']['load_before'][0]}).\n")
             from cushion_clutch.launch.fleet import SAMPLES_FILE, plot_fleet, read_samples
             rows, tcus = [], []
-            for part in ("bar", "aware"):
-                if part in got:
-                    rows += read_samples(work / got[part]["folder"] / SAMPLES_FILE)
-                    tcus += got[part]["tcus"]
+            for g, _ in runs:
+                rows += read_samples(work / g["folder"] / SAMPLES_FILE)
+                tcus += g["tcus"]
             png = page.parent.parent / "images" / "fleet_default.png"
-            plot_fleet(rows, tcus, png, f"population 'default', {got['bar']['samples']} samples, seed 1")
+            plot_fleet(rows, tcus, png, f"population 'default', {runs[0][0]['samples']} samples, seed 1")
             out.markdown("![fleet](../images/fleet_default.png)\n\nCDF of the characteristic error per TCU (the worst "
                          "of each sample's launches), and the error against the ambient temperature and the facing "
                          "wear (drawn by this benchmark from the runs' `fleet_samples.parquet`).\n")
@@ -206,11 +214,12 @@ def write_page(work: Path, page: Path, argv: list[str]) -> None:
         out.markdown("## Throughput and parallel efficiency\n")
         if "scaling" in got:
             g = got["scaling"]
-            out.markdown("| workers | samples | launches | wall [s] | launches/s per core | load average before / after |"
-                         "\n|---|---|---|---|---|---|")
-            for r in g["runs"]:
-                out.markdown(f"| {r['workers']} | {r['samples']} | {r['launches_run']} | {r['wall_s']:.1f} | "
-                             f"{r['launches_per_s_per_core']:.3f} | {r['load_before'][0]} / {r['load_after'][0]} |")
+            lines = ["| workers | samples | launches | wall [s] | launches/s per core | load average before / after |",
+                     "|---|---|---|---|---|---|"]
+            lines += [f"| {r['workers']} | {r['samples']} | {r['launches_run']} | {r['wall_s']:.1f} | "
+                      f"{r['launches_per_s_per_core']:.3f} | {r['load_before'][0]} / {r['load_after'][0]} |"
+                      for r in g["runs"]]
+            out.markdown("\n".join(lines))
             contended = max(max(r["load_before"][0], r["load_after"][0]) for r in g["runs"]) > 1.5
             out.markdown(f"\nParallel efficiency at 2 workers: {g['efficiency_2']:.2f} (launches/s per core at 2 "
                          f"workers over that at 1). " + ("**Contended:** the machine's load average exceeded its "
@@ -221,24 +230,23 @@ def write_page(work: Path, page: Path, argv: list[str]) -> None:
             out.markdown("*Part `scaling` did not run for this page.*\n")
         out.markdown(DUTY_INTRO)
         if "duty" in got:
-            out.markdown("| duty | TCU | protection | launches run | restarts to damage | peak facing / surface "
-                         "[degC] | lock-ups | inhibited | stranded | note |\n|---|---|---|---|---|---|---|---|---|---|")
-            for r in got["duty"]["rows"]:
-                out.markdown(f"| {r['scenario']} | {r['tcu']} | {'on' if r['protection'] else 'off'} | "
-                             f"{r['simulated']} of {r['launches']} | {r['restarts_to_damage'] or 'none'} | "
-                             f"{r['peak_degC']:.0f} | {r['lockups']} | {r['inhibited']} | {r['stranded']} | "
-                             f"{(r['note'] or '').split(' (')[0]} |")
-            out.markdown("")
+            lines = ["| duty | TCU | protection | launches run | restarts to damage | peak facing / surface [degC] | "
+                     "lock-ups | inhibited | stranded | note |", "|---|---|---|---|---|---|---|---|---|---|"]
+            lines += [f"| {r['scenario']} | {r['tcu']} | {'on' if r['protection'] else 'off'} | "
+                      f"{r['simulated']} of {r['launches']} | {r['restarts_to_damage'] or 'none'} | "
+                      f"{r['peak_degC']:.0f} | {r['lockups']} | {r['inhibited']} | {r['stranded']} | "
+                      f"{(r['note'] or '').split(' (')[0]} |" for r in got["duty"]["rows"]]
+            out.markdown("\n".join(lines) + "\n")
         else:
             out.markdown("*Part `duty` did not run for this page.*\n")
         out.markdown(POSSIBLE_INTRO)
         if "possible" in got:
-            out.markdown("| scenario | level | pedal | mass [kg] | grade [%] | engine at the pedal [N·m] | "
-                         "holding torque [N·m] | possible |\n|---|---|---|---|---|---|---|---|")
-            for r in got["possible"]["rows"]:
-                out.markdown(f"| {r['scenario']} | {r['level']} | {r['pedal']:.2f} | {r['mass_kg']:.0f} | "
-                             f"{r['grade_percent']:.0f} | {r['engine_Nm']:.0f} | {r['load_Nm']:.0f} | "
-                             f"{'yes' if r['possible'] else 'no'} |")
+            lines = ["| scenario | level | pedal | mass [kg] | grade [%] | engine at the pedal [N·m] | holding torque "
+                     "[N·m] | possible |", "|---|---|---|---|---|---|---|---|"]
+            lines += [f"| {r['scenario']} | {r['level']} | {r['pedal']:.2f} | {r['mass_kg']:.0f} | "
+                      f"{r['grade_percent']:.0f} | {r['engine_Nm']:.0f} | {r['load_Nm']:.0f} | "
+                      f"{'yes' if r['possible'] else 'no'} |" for r in got["possible"]["rows"]]
+            out.markdown("\n".join(lines))
 
 
 INTRO = """`cushion-clutch fleet` draws samples of the `default` population
@@ -265,7 +273,8 @@ POSSIBLE_INTRO = """## Which launches are physically possible
 
 Per shipped scenario and demand level: the engine's largest net torque at the pedal over its speed range
 (creep: the idle governor's full throttle at idle) against the clutch torque that holds the car on the grade,
-both at the disc. A launch without lock-up is *stranded* only when it is possible and the protection did not
+both at the disc; possible when it exceeds it and, at best, gets the car within the pedal time to the engine
+speed that holds it (`launch_possible`). A launch without lock-up is *stranded* only when it is possible and the protection did not
 inhibit it (`stranded` in `launch_metrics.csv`); the others count as impossible.
 """
 
@@ -275,6 +284,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--part", default="", help="comma-separated parts: " + ", ".join(PARTS))
     ap.add_argument("--work", default="fleet_benchmark", help="working folder (fleet runs, part results)")
     ap.add_argument("--samples", type=int, default=200, help="samples of the bar and aware parts (default 200)")
+    ap.add_argument("--big-samples", type=int, default=1000, help="samples of the big part (default 1000)")
     ap.add_argument("--scaling-samples", type=int, default=8, help="samples of each scaling run (default 8)")
     ap.add_argument("--page", help="write the results page (from the parts' results in --work)")
     args = ap.parse_args(argv)
@@ -288,7 +298,8 @@ def main(argv: list[str] | None = None) -> int:
         fn = {"possible": lambda: part_possible(work), "duty": lambda: part_duty(work),
               "bar": lambda: part_bar(work, args.samples), "identity": lambda: part_identity(work),
               "scaling": lambda: part_scaling(work, args.scaling_samples),
-              "aware": lambda: part_aware(work, args.samples)}[part]
+              "aware": lambda: part_aware(work, args.samples),
+              "big": lambda: part_big(work, args.big_samples)}[part]
         res = fn()
         res["part_wall_s"] = time.perf_counter() - t0
         (work / f"{part}.json").write_text(json.dumps(res, indent=1, default=str))

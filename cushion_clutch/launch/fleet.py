@@ -347,7 +347,8 @@ def plot_fleet(rows: list[dict], tcus: Sequence[str], png: Path, title: str) -> 
         axes[2].scatter([r["facing_wear_m"] * 1e3 for r in mine], [r[metric] for r in mine], s=8, color=c,
                         alpha=0.6, label=name)
     axes[0].axvline(ERROR_BAR_NM, color="k", ls=":", lw=1)
-    axes[0].text(ERROR_BAR_NM, 0.02, " 9.4 N·m (3 % of 312 N·m)", fontsize=8, transform=axes[0].get_xaxis_transform())
+    axes[0].text(ERROR_BAR_NM, 0.5, " 9.4 N·m (3 % of 312 N·m)", fontsize=8, rotation=90, va="center",
+                 transform=axes[0].get_xaxis_transform())
     for y in (0.95, 0.99):
         axes[0].axhline(y, color="grey", lw=0.5, ls="--")
         axes[0].text(0.01, y, f"P{round(y * 100)}", fontsize=7, va="bottom", transform=axes[0].get_yaxis_transform())

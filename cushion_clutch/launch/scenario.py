@@ -176,7 +176,8 @@ class Tcu(Checked):
     disc turns at least at the engine's idle speed and the engine's torque at the pedal there carries the
     holding torque the TCU believes (locked, the engine runs on and the car does not roll back), s"""
     forced_sync_s: float = 1.5
-    """the longest sync after ``lockup_deadline_s``, s"""
+    """the longest sync after ``lockup_deadline_s``, s (a deadline later than ``drive_time_s - forced_sync_s``
+    leaves the forced sync less time than this: the driver lifts off first)"""
 
     _section = "tcu"
 
@@ -191,11 +192,6 @@ class Tcu(Checked):
             "drive_time_s": (0.5, 100.0), "prefill_s": (0.0, 5.0),
             "facing_mu_slope_per_100_rad_s": (-0.2, 0.2), "facing_mu_reference_slip_rad_s": (0.0, 1000.0),
             "lockup_deadline_s": (0.5, 100.0), "forced_sync_s": (0.1, 10.0)})
-        if all(isinstance(v, (int, float)) for v in (self.lockup_deadline_s, self.forced_sync_s, self.drive_time_s)) \
-                and self.lockup_deadline_s + self.forced_sync_s > self.drive_time_s:
-            yield (f"tcu.lockup_deadline_s + tcu.forced_sync_s = {self.lockup_deadline_s + self.forced_sync_s:g} s: "
-                   f"must not exceed tcu.drive_time_s = {self.drive_time_s:g} s (the launch must lock up while "
-                   "the driver presses the pedal)")
         k, w_ref = self.facing_mu_slope_per_100_rad_s, self.facing_mu_reference_slip_rad_s
         if not all(isinstance(v, (int, float)) for v in (k, w_ref)):
             return

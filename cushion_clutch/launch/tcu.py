@@ -49,7 +49,6 @@ uncompensated one keeps it fixed.
 from __future__ import annotations
 
 import copy
-import functools
 import math
 from dataclasses import dataclass
 
@@ -88,8 +87,6 @@ MEMO_SIZE = 64
 #: this many times the lock-up deadline (``tcu.lockup_deadline_s + tcu.forced_sync_s``): see
 #: :meth:`TcuController.launch_target_rad_s`
 RAISE_FACTOR = 2.0
-#: below this measured disc speed the car stands (rad/s at the disc: 0.01 m/s on the default car)
-STANDING_RAD_S = 0.5
 
 
 def _full_load_Nm(engine, w_rad_s: float) -> float:
@@ -177,9 +174,6 @@ class TcuController:
         self.inhibited = self.limited = False
         #: the launch's engine-speed target (:meth:`launch_target_rad_s`, decided at its start), rad/s
         self.w_target = w_idle_rad_s
-        #: the largest clutch-torque demand of this launch while the car stood (the holding torque is at least
-        #: that), and of the last launch, N.m
-        self.held_Nm = self.held_last_Nm = 0.0
         #: time since the launch's start (after the pre-fill), s
         self.t_launch = 0.0
         #: the protection level the current launch runs at (decided at its start; 3: inhibited)
@@ -276,13 +270,6 @@ class TcuController:
         return (self.sc.driver.pedal(level) * _full_load_Nm(eng, w_rad_s) - eng.drag_Nm_per_rad_s * w_rad_s
                 > self.t_load)
 
-    def holding_Nm(self) -> float:
-        """The torque holding the car the TCU plans a launch's target with, N.m: its estimate (``t_load``), but at
-        least the largest demand of the last launch while the car stood (a car that did not move on a torque
-        is held by more: the evidence a mass-and-grade estimator never gets when the car does not move; an
-        upper bound, as the demand rises on while the speed sensors still read standstill, so it only raises
-        targets and is not used for :meth:`holds`)."""
-        return self.t_load if self.t_load >= self.held_last_Nm else self.held_last_Nm
 
     def launch_target_rad_s(self, level: str) -> float:
         """The launch's engine-speed target, rad/s: ``idle + pedal (full - idle)`` with ``full`` the pedal's
@@ -290,15 +277,14 @@ class TcuController:
 
         The time to lock-up the TCU believes at a target ``w``: the engine's torque at the pedal there (its
         full-load curve, which the engine control reports, minus its drag) less the holding torque the TCU
-        believes (:meth:`holding_Nm`) accelerates the disc and vehicle inertia it believes to ``w``,
+        believes accelerates the disc and vehicle inertia it believes to ``w``,
         ``w J_d / (pedal T_max(w) - drag w - T_load)``; in time: by ``tcu.lockup_deadline_s +
         tcu.forced_sync_s``.
 
         * limited by the thermal protection: the lowest ``full`` from ``protection.limit_engine_speed_rpm`` up
           (50 rpm steps, below the pedal's) whose target locks up in time with the estimate ``t_load`` (a
           limit that strands the launch keeps it slipping: heat);
-        * otherwise, or if none does: the pedal's target; if that is believed (with :meth:`holding_Nm`) to
-          lock up only after
+        * otherwise, or if none does: the pedal's target; if that is believed to lock up only after
           :data:`RAISE_FACTOR` times the time (a steep grade, a heavy car, a light pedal: the engine at that
           speed barely holds the car), the lowest faster one, in 50 rpm steps up to 500 rpm below
           ``engine.max_speed_rpm``, that locks up in time, else the quickest of them (none at all: the
@@ -312,8 +298,8 @@ class TcuController:
         budget = tc.lockup_deadline_s + tc.forced_sync_s
         rpm = math.pi / 30.0
 
-        def lock_time(w: float, load: float = self.t_load) -> float:
-            surplus = pedal * _full_load_Nm(eng, w) - eng.drag_Nm_per_rad_s * w - load
+        def lock_time(w: float) -> float:
+            surplus = pedal * _full_load_Nm(eng, w) - eng.drag_Nm_per_rad_s * w - self.t_load
             return w * self.j_d / surplus if surplus > 0.0 else math.inf
 
         if self.limited:
@@ -324,10 +310,8 @@ class TcuController:
                     return w
                 full += 50.0
         w_pedal = self.w_idle + pedal * (tc.engine_speed_full_pedal_rpm * math.pi / 30.0 - self.w_idle)
-        held = self.holding_Nm()          # raising a target, the standing car's evidence counts too
-        if level == "creep" or lock_time(w_pedal, held) <= RAISE_FACTOR * budget:
+        if level == "creep" or lock_time(w_pedal) <= RAISE_FACTOR * budget:
             return w_pedal
-        lock_time = functools.partial(lock_time, load=held)
         faster = [w_pedal + k * 50.0 * rpm for k in range(1, 200)
                   if w_pedal + k * 50.0 * rpm <= (eng.max_speed_rpm - 500.0) * rpm]
         for w in faster:
@@ -415,7 +399,6 @@ class TcuController:
                 # speed controller pull the engine down (a torque spike of 208 N.m, measured)
                 self.launch_level = prot.update(self.theta_facing_protect(), tl, launch)
                 self.limited = self.launch_level >= LIMIT
-            self.held_last_Nm, self.held_Nm = self.held_Nm, 0.0
             self.w_target = self.launch_target_rad_s(level)
         if prot is not None:
             prot.update(self.theta_facing_protect(), tl, launch)
@@ -436,8 +419,6 @@ class TcuController:
             demand = self._demand(level, w_e, w_d, t_e)
             limit = min(t_prev + tc.torque_ramp_Nm_per_s * self.period, self.t_closed)
             self.t_dem = 0.0 if demand < 0.0 else (limit if demand > limit else demand)
-            if (w_d if w_v is None else w_v) < STANDING_RAD_S and self.t_dem > self.held_Nm:
-                self.held_Nm = self.t_dem        # the car stood while the clutch was asked for this torque
             if self.learner is not None:
                 torque = self.learner.sample(w_d if w_v is None else w_v, x_meas)
                 if torque is not None:

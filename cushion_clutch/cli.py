@@ -299,6 +299,49 @@ def launch_terminal_table(rows: list[dict], width: int = 100) -> str:
     return "\n".join(lines)
 
 
+def _fleet(args: argparse.Namespace) -> int:
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn, \
+        TimeRemainingColumn
+
+    from .launch.fleet import PARTS, run_fleet
+    from .launch.population import load_population, population_path
+
+    pop = load_population(population_path(args.population))
+    tcus = tuple(t.strip() for t in args.tcus.split(",") if t.strip())
+    out = _guard_out(Path(args.out), args.force)
+    _check_tables(args.tables)
+    args.resume_hint = f"finished samples are kept in {out / PARTS}; run the same command again to resume"
+    with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
+                  TimeRemainingColumn(), refresh_per_second=2) as bar:
+        task = bar.add_task(f"fleet '{pop.name}': samples", total=args.samples)
+        res = run_fleet(pop, Path(args.tables), out, args.samples, tcus, args.seed, scheduler=args.scheduler,
+                        jobs=args.jobs, serial=args.serial, backend=args.backend,
+                        progress=lambda done, total: bar.update(task, completed=done))
+    print(fleet_terminal_table(res.summary))
+    print(f"{res.ran} sample(s) run, {res.kept} kept from an earlier run; {res.launches_run} launches in "
+          f"{res.wall_s:.1f} s on {res.workers} worker(s): {res.launches_per_s_per_core:.2f} launches/s per core")
+    print(f"{len(res.paths)} files written to {out}: " + ", ".join(p.name for p in res.paths))
+    return 0
+
+
+#: the fleet summary's terminal rows: metrics shown per TCU
+FLEET_TERMINAL = ("characteristic_error_max_Nm", "tracking_error_max_Nm", "engagement_time_s", "peak_theta_cm_degC",
+                  "stranded")
+
+
+def fleet_terminal_table(summary: list[dict]) -> str:
+    """P50/P95/P99/max per TCU of a few metrics (every metric is in fleet_summary.csv)."""
+    import math
+    lines = [f"{'TCU':<26}{'metric (worst of a sample)':<30}{'P50':>9}{'P95':>9}{'P99':>9}{'max':>9}"]
+    lines.append("-" * len(lines[0]))
+    for r in summary:
+        if r["metric"] in FLEET_TERMINAL:
+            lines.append(f"{r['tcu']:<26}{r['metric']:<30}" + "".join(
+                f"{'-' if math.isnan(r[k]) else format(r[k], '.2f'):>9}" for k in ("p50", "p95", "p99", "max")))
+    lines.append("stranded: launches of a sample without lock-up, possible and not inhibited")
+    return "\n".join(lines)
+
+
 def _export(args: argparse.Namespace) -> int:
     from .fe.exports import build, export_mat, export_modelica
 
@@ -584,7 +627,8 @@ def build_parser() -> argparse.ArgumentParser:
                   "CSV files.",
                   "cushion-clutch launch --scenario creep --out out_creep")
     la.add_argument("--scenario", default=DEFAULT_SCENARIO,
-                    help="scenario TOML, or a shipped one: default, trailer, creep, cooldown, fade, wear, wear_learned, tolerance, protection")
+                    help="scenario TOML, or a shipped one: default, trailer, creep, cooldown, fade, wear, wear_learned, tolerance, "
+                         "protection, hill_restart, hill_fade")
     la.add_argument("--fmu", help="clutch FMU, or an SSP archive (.ssp, from export-ssp) whose FMU is the plant "
                                   "(default: build one from --tables into --out)")
     la.add_argument("--parameter-set", help="with an .ssp: the plant's parameter set (default new); the scenario "
@@ -596,6 +640,30 @@ def build_parser() -> argparse.ArgumentParser:
                     help="write every N-th row of the time series launch_<tcu>.csv (default 1: every recorded "
                          "row, one per 10 simulation steps); metrics, summary and plots use every row")
     _force(la)
+
+    fl = _command(sub, "fleet", _fleet, "a population of vehicles, drivers and clutches, each TCU, on Dask",
+                  "Draw --samples samples (vehicle mass, trailer, grade, ambient and start temperature, pedal, "
+                  "launch interval, spring tolerance, facing wear, noise seeds) from a population TOML, run each "
+                  "sample's launches with each of --tcus on a Dask cluster (a LocalCluster of --jobs workers, or "
+                  "--scheduler), and write fleet_samples.parquet (one row per sample and TCU: each metric's worst "
+                  "over the sample's launches), fleet_summary.csv (P50/P95/P99/max per TCU and metric) and "
+                  "fleet.png. Reproducible by --seed; a rerun into the same --out resumes.",
+                  "cushion-clutch fleet --population default --samples 200 --tcus naive,production --jobs 2 "
+                  "--seed 1 --out out_fleet")
+    fl.add_argument("--population", default="default", help="population TOML, or a shipped one: default")
+    fl.add_argument("--samples", type=int, default=200, help="number of samples, 0 .. N-1 (default 200)")
+    fl.add_argument("--tcus", default="naive,aware_estimated,production",
+                    help=f"comma-separated TCU variants (default naive,aware_estimated,production; "
+                         f"allowed {', '.join(VARIANTS)})")
+    fl.add_argument("--seed", type=int, default=0, help="random seed of the samples (default 0)")
+    _jobs(fl, "LocalCluster worker processes, one thread each (default: cores)")
+    fl.add_argument("--scheduler", help="Dask scheduler address, e.g. tcp://host:8786 (default: a LocalCluster)")
+    fl.add_argument("--serial", action="store_true", help="run the samples one after the other in this process")
+    fl.add_argument("--tables", default=DEFAULT_TABLES, help="table folder (the plant's and TCUs' unless the "
+                                                            "population's spring sets name others)")
+    add_backend(fl)
+    _out(fl, "output folder (default: out_fleet)", default="out_fleet")
+    _force(fl)
 
     sm = _command(sub, "simulate", _simulate, "repeated engagements through the FMU with fmpy, with plots",
                   "Drive the clutch FMU through fmpy over repeated engagements 60 s apart (bearing ramp, "

@@ -54,7 +54,7 @@ def test_out_has_short_form_o(name):
     assert {"-o", "--out"} <= opts, name
 
 
-@pytest.mark.parametrize("name", ["sweep", "calibrate", "tolerance"])
+@pytest.mark.parametrize("name", ["sweep", "calibrate", "tolerance", "fleet"])
 def test_jobs_and_workers_are_one_option(name):
     p = _subparsers()[name]
     action = next(a for a in p._actions if "--jobs" in a.option_strings)
@@ -113,6 +113,15 @@ def test_build_fmu_out_file_works(tmp_path, capsys):
     assert (tmp_path / "c.fmu").stat().st_size > 0
     assert [p.name for p in tmp_path.iterdir()] == ["c.fmu"]
     assert f"built {tmp_path / 'c.fmu'}" in capsys.readouterr().out
+
+
+def test_fleet_terminal_table_fits_100_columns():
+    from cushion_clutch.cli import FLEET_TERMINAL, fleet_terminal_table
+    rows = [{"tcu": "adaptive_aware_estimated", "metric": m, "p50": 1234.5678, "p95": math.nan, "p99": -0.001,
+             "max": 99999.99} for m in FLEET_TERMINAL]
+    text = fleet_terminal_table(rows)
+    assert max(len(line) for line in text.splitlines()) <= 100, text
+    assert len(text.splitlines()) == len(FLEET_TERMINAL) + 3
 
 
 def test_launch_terminal_table_fits_100_columns():

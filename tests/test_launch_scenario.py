@@ -101,3 +101,33 @@ def test_rules_over_two_keys_name_a_key_first(tmp_path, table, head):
     with pytest.raises(ParameterError) as exc:
         load_scenario(path)
     assert any(p.startswith(head) for p in exc.value.problems), exc.value.problems
+
+
+@pytest.mark.fmu
+def test_the_duty_cycles_ship_with_their_sources_and_run(tmp_path):
+    """hill_restart (90 restarts, 12 %, 3500 kg with a trailer) and hill_fade (150 launches, 15 %) load; a few of
+    their launches run with the production TCU and lock up; restarts to damage reads the recorded series."""
+    import dataclasses
+    import math
+    from pathlib import Path
+
+    from cushion_clutch.data import DEFAULT_TABLES
+    from cushion_clutch.launch.duty import DAMAGE_DEGC, peak_degC, restarts_to_damage
+    from cushion_clutch.launch.plant import build_plant_fmu
+    from cushion_clutch.launch.simulate import simulate_launches
+    from cushion_clutch.model import load_table
+
+    expect = {"hill_restart": (90, 12.0, 3500.0, "SAE 2026-26-0434"), "hill_fade": (150, 15.0, 1900.0,
+                                                                                   "SAE 2021-26-0329")}
+    for name, (launches, grade, mass, source) in expect.items():
+        text = (SHIPPED / f"{name}.toml").read_text()
+        assert source in text and "350" in text
+        sc = load_scenario(scenario_path(name))
+        assert (sc.run.launches, sc.vehicle.slope_percent, sc.vehicle.mass_kg) == (launches, grade, mass)
+        assert sc.protection.enabled and sc.protection.damage_degC == DAMAGE_DEGC
+        short = dataclasses.replace(sc, run=dataclasses.replace(sc.run, launches=2))
+        fmu = build_plant_fmu(Path(DEFAULT_TABLES), short, tmp_path / name / "CushionClutch.fmu")
+        r = simulate_launches(fmu, short, load_table(), "production", record_every=50)
+        assert all(math.isfinite(m["engagement_time_s"]) and m["launch_possible"] for m in r.metrics)
+        assert restarts_to_damage(r.series) is None and 20.0 < peak_degC(r.series) < DAMAGE_DEGC
+        assert restarts_to_damage(r.series, peak_degC(r.series) - 1.0) in (1, 2)

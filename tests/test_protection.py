@@ -1,5 +1,6 @@
 """Thermal protection: its levels on the facing-temperature estimate, and on a heavy-duty launch run."""
 import dataclasses
+import math
 
 import numpy as np
 import pytest
@@ -75,5 +76,107 @@ def test_protected_tcus_keep_their_estimate_below_the_damage_limit(tmp_path):
         levels = [m["protection_level"] for m in r.metrics]
         assert max(levels) == INHIBIT and levels[0] == OK
         limited = [m["slip_energy_kJ"] for m in r.metrics if m["protection_level"] == LIMIT]
-        assert limited and max(limited) < 0.8 * r.metrics[0]["slip_energy_kJ"]
+        assert limited
+        if name == "aware":         # it knows mass and grade: a lower engine speed that still locks up in time
+            assert max(limited) < 0.8 * r.metrics[0]["slip_energy_kJ"]
+        # production's mass and grade estimate leaves no lower speed that surely locks up: the pedal's target
+        # (a limit that strands the launch is no protection)
+        for m in r.metrics:         # every launch it does not inhibit locks up
+            assert m["protection_level"] == INHIBIT or math.isfinite(m["engagement_time_s"]), m
+            assert not m["stranded"] and m["launch_possible"]
         assert np.nanmax(r.series["protection_level"]) == INHIBIT
+
+
+@pytest.mark.fmu
+def test_every_production_launch_of_the_protection_scenario_locks_up_or_is_inhibited(tmp_path):
+    """Issue 38's bar: in the shipped `protection` scenario (30 hill starts, 3500 kg, 12 %) every production
+    launch not inhibited at its start locks up; none is stranded; every launch is physically possible."""
+    from cushion_clutch.data import DEFAULT_TABLES
+    from cushion_clutch.fmu.build import build_fmu
+    from cushion_clutch.launch.scenario import load_scenario, scenario_path
+    from cushion_clutch.launch.simulate import simulate_launches
+    from cushion_clutch.model import load_table
+
+    fmu = build_fmu(DEFAULT_TABLES, tmp_path / "CushionClutch.fmu")
+    sc = load_scenario(scenario_path("protection"))
+    r = simulate_launches(fmu, sc, load_table(), "production", record_every=100)
+    assert len(r.metrics) == 30
+    levels = [m["protection_level"] for m in r.metrics]
+    assert max(levels) == INHIBIT and levels.count(INHIBIT) < 30
+    for m in r.metrics:
+        assert m["launch_possible"] and not m["stranded"], m
+        assert m["protection_level"] == INHIBIT or math.isfinite(m["engagement_time_s"]), m
+        assert m["protection_level"] < INHIBIT or math.isnan(m["engagement_time_s"]), m
+
+
+def test_launch_capability_is_the_engine_at_the_pedal_against_the_holding_torque():
+    """Closed forms: the holding torque m g (sin a + c_r cos a) r / (eta i) and the engine's best net torque
+    at the pedal over its curve's nodes; a launch on a grade the engine cannot hold is not possible."""
+    from cushion_clutch.launch.metrics import launch_capability, launch_possible
+    from cushion_clutch.launch.scenario import load_scenario, scenario_path
+
+    sc = load_scenario(scenario_path("protection"))
+    v, d, e = sc.vehicle, sc.driveline, sc.engine
+    a = math.atan(v.slope_percent / 100.0)
+    hold = v.mass_kg * 9.81 * (math.sin(a) + v.rolling_resistance * math.cos(a)) * d.wheel_radius_m / (
+        d.efficiency * d.gear_ratio * d.final_drive_ratio)
+    pedal = sc.driver.hard_pedal
+    best = max(pedal * t - e.drag_Nm_per_rad_s * w * math.pi / 30.0
+               for w, t in zip(e.torque_curve_rpm, e.torque_curve_Nm) if e.idle_speed_rpm <= w <= e.max_speed_rpm)
+    engine, load = launch_capability(sc, "hard")
+    assert load == pytest.approx(hold, rel=1e-9) and engine == pytest.approx(best, rel=1e-9)
+    assert launch_possible(sc, "hard")
+    steep = dataclasses.replace(sc, vehicle=dataclasses.replace(v, slope_percent=30.0),
+                                driver=dataclasses.replace(sc.driver, hard_pedal=0.3))
+    assert not launch_possible(steep, "hard")
+    creep_engine, _ = launch_capability(sc, "creep")       # the idle governor at full throttle, idle speed
+    assert creep_engine == pytest.approx(e.torque_curve_Nm[0] - e.drag_Nm_per_rad_s * e.idle_speed_rpm * math.pi / 30)
+
+
+def test_the_launch_target_locks_up_in_time():
+    """A limited launch aims at the lowest speed from the limit up that locks up by the deadline (the TCU's
+    beliefs), a light one at the limit itself; a launch whose pedal speed cannot lock up in time (a steep grade,
+    a light pedal) aims at the lowest faster speed that can."""
+    from cushion_clutch.launch.driveline import Driveline
+    from cushion_clutch.launch.scenario import load_scenario, scenario_path
+    from cushion_clutch.launch.tcu import VARIANTS, TcuController, _full_load_Nm
+    from cushion_clutch.model import ClutchParameters, load_table
+
+    sc = load_scenario(scenario_path("protection"))
+    tc, rpm = sc.tcu, math.pi / 30.0
+    budget = tc.lockup_deadline_s + tc.forced_sync_s
+
+    def tcu(scen, scale=1.0):
+        dl = Driveline(scen, 83.78)
+        return TcuController(VARIANTS["aware"], scen, load_table(), ClutchParameters(), 293.15, dl.j_d * scale,
+                             dl.t_load_rest * scale)
+
+    def lock_time(ctl, scen, w):
+        p = scen.driver.hard_pedal
+        s = p * _full_load_Nm(scen.engine, w) - scen.engine.drag_Nm_per_rad_s * w - ctl.t_load
+        return w * ctl.j_d / s if s > 0 else math.inf
+
+    ctl = tcu(sc)
+    pedal_w = ctl.w_idle + sc.driver.hard_pedal * (tc.engine_speed_full_pedal_rpm * rpm - ctl.w_idle)
+    assert ctl.launch_target_rad_s("hard") == pedal_w                  # unlimited: the pedal's own
+    ctl.limited = True
+    w = ctl.launch_target_rad_s("hard")
+    limit_w = ctl.w_idle + sc.driver.hard_pedal * (sc.protection.limit_engine_speed_rpm * rpm - ctl.w_idle)
+    assert limit_w < w < pedal_w
+    assert lock_time(ctl, sc, w) <= budget < lock_time(ctl, sc, w - 50.0 * rpm * sc.driver.hard_pedal)
+    light = tcu(sc, 1.0 / 3.0)
+    light.limited = True
+    assert light.launch_target_rad_s("hard") == pytest.approx(limit_w, rel=1e-12)
+    # 1536 kg on 16 % at pedal 0.35: the pedal's 1290 rpm barely holds the car (a fleet sample production
+    # stranded): a faster target that locks up in time
+    steep = dataclasses.replace(sc, vehicle=dataclasses.replace(sc.vehicle, mass_kg=1536.0, slope_percent=16.0,
+                                                                drag_area_m2=0.7),
+                                driver=dataclasses.replace(sc.driver, hard_pedal=0.35))
+    ctl = tcu(steep)
+    slow = ctl.w_idle + 0.35 * (tc.engine_speed_full_pedal_rpm * rpm - ctl.w_idle)
+    assert lock_time(ctl, steep, slow) > budget
+    w = ctl.launch_target_rad_s("hard")
+    faster = [slow + k * 50.0 * rpm for k in range(1, 200) if slow + k * 50.0 * rpm <= 6000.0 * rpm]
+    assert w > slow and lock_time(ctl, steep, w) == min(lock_time(ctl, steep, v) for v in faster)
+    assert lock_time(ctl, steep, w) < lock_time(ctl, steep, slow) / 3
+    assert not ctl.holds("hard", slow) and ctl.holds("hard", w)

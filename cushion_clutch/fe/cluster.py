@@ -38,13 +38,15 @@ LOST_GRACE_S = 30.0
 POLL_S = 0.5
 
 _PROBE_SOURCE = '''
-def cushion_probe(package):
+def cushion_probe(package, need_ccx=True):
     import importlib, os, platform, shutil, subprocess, sys
     out = {"host": platform.node(), "python": sys.version.split()[0], "cores": os.cpu_count() or 1}
     try:
         out["package"] = getattr(importlib.import_module(package), "__version__", "unknown")
     except BaseException as exc:
         out["package_error"] = type(exc).__name__ + ": " + str(exc)
+    if not need_ccx:
+        return out
     exe = os.environ.get("CCX", "ccx")
     path = shutil.which(exe)
     if path is None:
@@ -100,7 +102,7 @@ class ClusterInfo:
         return max(1, min(self.slots // n_cases, min(w.cores for w in self.workers)))
 
 
-def _judge(address: str, threads: int, answer) -> WorkerInfo:
+def _judge(address: str, threads: int, answer, need_ccx: bool = True) -> WorkerInfo:
     if isinstance(answer, BaseException):
         return WorkerInfo(address, "?", threads, 1, None, None,
                           (f"the check failed: {type(answer).__name__}: {answer}",))
@@ -112,7 +114,9 @@ def _judge(address: str, threads: int, answer) -> WorkerInfo:
     elif package != __version__:
         problems.append(f"has {PACKAGE} {package}, the client {__version__}; install the same version")
     version = None
-    if "ccx_error" in answer:
+    if not need_ccx:
+        pass
+    elif "ccx_error" in answer:
         problems.append(f"cannot run CalculiX: {answer['ccx_error']} (apt-get install calculix-ccx, or set CCX)")
     else:
         version = parse_version(answer.get("ccx_output", ""))
@@ -125,8 +129,11 @@ def _judge(address: str, threads: int, answer) -> WorkerInfo:
 _CHECKED: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 
 
-def check_workers(client, timeout_s: float = CHECK_TIMEOUT_S) -> ClusterInfo:
+def check_workers(client, timeout_s: float = CHECK_TIMEOUT_S, need_ccx: bool = True) -> ClusterInfo:
     """Probe every worker of ``client``; return the cluster's ccx version or name what each worker lacks.
+
+    ``need_ccx`` False (work without CalculiX, e.g. the fleet's launch simulations): only the package is
+    checked, and the info's ``ccx_version`` is "".
 
     Raises
     ------
@@ -136,7 +143,7 @@ def check_workers(client, timeout_s: float = CHECK_TIMEOUT_S) -> ClusterInfo:
         or workers with different ccx versions. Every worker concerned is named.
     """
     with contextlib.suppress(TypeError):
-        if client in _CHECKED:
+        if client in _CHECKED and (_CHECKED[client].ccx_version or not need_ccx):
             return _CHECKED[client]
     address = getattr(client.scheduler, "address", str(client))
     start = time.monotonic()
@@ -148,7 +155,7 @@ def check_workers(client, timeout_s: float = CHECK_TIMEOUT_S) -> ClusterInfo:
                            f"{address}") from None
     threads = client.nthreads()
     pool = ThreadPoolExecutor(max_workers=1)
-    future = pool.submit(client.run, _probe(), PACKAGE, on_error="return")
+    future = pool.submit(client.run, _probe(), PACKAGE, need_ccx, on_error="return")
     try:
         answers = future.result(timeout=max(1.0, timeout_s - (time.monotonic() - start)))
     except FuturesTimeout:
@@ -158,16 +165,16 @@ def check_workers(client, timeout_s: float = CHECK_TIMEOUT_S) -> ClusterInfo:
         raise ClusterError(f"checking the workers of {address} failed: {type(exc).__name__}: {exc}") from None
     finally:
         pool.shutdown(wait=False)
-    workers = [_judge(a, threads.get(a, 1), answers[a]) for a in sorted(answers)]
+    workers = [_judge(a, threads.get(a, 1), answers[a], need_ccx) for a in sorted(answers)]
     problems = [f"worker {w.address} (host {w.host}) {p}" for w in workers for p in w.problems]
     versions = {w.ccx_version for w in workers if w.ccx_version}
     if not problems and len(versions) > 1:
         problems.append("the workers run different CalculiX versions (cases would not be comparable): "
                         + "; ".join(f"{w.address} {w.ccx_version}" for w in workers))
     if problems:
-        raise ClusterError(f"the Dask cluster at {address} cannot run the FE cases:\n  - "
-                           + "\n  - ".join(problems))
-    info = ClusterInfo(address, tuple(workers), versions.pop())
+        raise ClusterError(f"the Dask cluster at {address} cannot run the {'FE cases' if need_ccx else 'tasks'}:"
+                           "\n  - " + "\n  - ".join(problems))
+    info = ClusterInfo(address, tuple(workers), versions.pop() if versions else "")
     log.info("cluster %s: %d worker(s), %d slot(s), CalculiX %s", address, len(workers), info.slots,
              info.ccx_version)
     with contextlib.suppress(TypeError):
@@ -176,19 +183,19 @@ def check_workers(client, timeout_s: float = CHECK_TIMEOUT_S) -> ClusterInfo:
 
 
 @contextlib.contextmanager
-def open_cluster(scheduler=None, workers: int | None = None,
-                 timeout_s: float = CHECK_TIMEOUT_S) -> Iterator[tuple[object, ClusterInfo]]:
+def open_cluster(scheduler=None, workers: int | None = None, timeout_s: float = CHECK_TIMEOUT_S,
+                 need_ccx: bool = True) -> Iterator[tuple[object, ClusterInfo]]:
     """A checked Dask client, closed (with the LocalCluster it owns) on exit.
 
     ``scheduler``: an address (``tcp://host:8786``), a ``distributed.Client``
     (not closed here), or None for a LocalCluster of ``workers`` single-threaded
-    processes (default: cores).
+    processes (default: cores). ``need_ccx``: as :func:`check_workers`.
     """
     from distributed import Client, LocalCluster
     own_client = own_cluster = None
     if scheduler is None:
         own_cluster = LocalCluster(n_workers=workers or os.cpu_count() or 1, threads_per_worker=1,
-                                   processes=True, dashboard_address=None)
+                                   processes=True, dashboard_address=None, silence_logs=logging.ERROR)
         client = own_client = Client(own_cluster)
     elif isinstance(scheduler, str):
         try:
@@ -199,7 +206,7 @@ def open_cluster(scheduler=None, workers: int | None = None,
     else:
         client = scheduler
     try:
-        yield client, check_workers(client, timeout_s)
+        yield client, check_workers(client, timeout_s, need_ccx)
     finally:
         if own_client is not None:
             own_client.close()
@@ -226,9 +233,6 @@ def run_cases(client, info: ClusterInfo, solve: Callable[..., dict],
         When no worker has been left for ``lost_grace_s``; names the lost workers
         and how many cases were unfinished.
     """
-    from distributed import as_completed
-    from distributed.scheduler import KilledWorker
-
     threads = info.threads_per_case(len(cases))
     blobs, futures = {}, {}
     for key, params, theta, paddles in cases:
@@ -237,6 +241,23 @@ def run_cases(client, info: ClusterInfo, solve: Callable[..., dict],
             blobs[sf] = client.scatter(Path(sf).read_bytes(), broadcast=True)
         fut = client.submit(solve, params, theta, paddles, blobs.get(sf) if sf else None, threads, pure=False)
         futures[fut] = key
+    watch(client, info, futures, on_done, lost_grace_s=lost_grace_s)
+
+
+def watch(client, info: ClusterInfo, futures: dict, on_done: Callable[[Hashable, object, BaseException | None], None],
+          *, lost_grace_s: float = LOST_GRACE_S, what: str = "case(s)",
+          resume: str = "finished cases are cached, a rerun resumes") -> None:
+    """Wait for ``futures`` (future -> key), calling ``on_done(key, result, None)`` or ``on_done(key, None, exc)``
+    as each ends; workers that leave are logged by address.
+
+    Raises
+    ------
+    ClusterError
+        When no worker has been left for ``lost_grace_s``: the lost workers named, how many were unfinished.
+    """
+    from distributed import as_completed
+    from distributed.scheduler import KilledWorker
+
     known = set(client.nthreads())
     lost: list[str] = []
     alone_since = None
@@ -274,5 +295,4 @@ def run_cases(client, info: ClusterInfo, solve: Callable[..., dict],
             client.cancel(list(futures))
             raise ClusterError(
                 f"all Dask workers of {info.scheduler} were lost ({', '.join(lost) or 'none known'}) and none "
-                f"joined for {lost_grace_s:g} s; {remaining} case(s) unfinished; finished cases are cached, "
-                "a rerun resumes")
+                f"joined for {lost_grace_s:g} s; {remaining} {what} unfinished; {resume}")

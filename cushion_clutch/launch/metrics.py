@@ -29,6 +29,14 @@ Each metric measures one cause (SI units unless a name says otherwise):
     The level of the TCU's thermal protection the launch ran at, decided at its start (0 ok,
     1 warn, 2 limit, 3 inhibited: no launch; :mod:`.protection`).
 
+``launch_possible``, ``stranded``
+    Whether the vehicle can make the launch at all (:func:`launch_possible`: the engine's largest
+    torque at the launch's pedal, over its speed range, exceeds the torque that holds the car on the
+    grade, both at the disc, and at best it gets the car to a speed where the engine holds it within the
+    driver's pedal time), and a *stranded* launch: possible, not inhibited by the protection
+    (``protection_level`` below 3), and no lock-up while the driver pressed the pedal. A launch that
+    is not possible and does not lock up is not counted as stranded.
+
 ``peak_theta_cm_degC``, ``peak_theta_cs_degC``, ``beyond_tables_s``, ``above_damage_s``
     Where the plant model leaves what it knows (issue 28; :func:`temperature_metrics`, from the
     recorded time series): the peak facing and cushion-spring temperatures, the time with
@@ -49,7 +57,7 @@ METRIC_COLUMNS = ("tcu", "launch", "demand_level", "theta_cs_start_degC", "chara
                   "characteristic_error_max_Nm", "tracking_error_rms_Nm", "tracking_error_max_Nm",
                   "creep_error_Nm", "lockup_accel_step_m_s2", "shuffle_amplitude_m_s2", "kiss_point_error_mm",
                   "engagement_time_s", "slip_energy_kJ", "peak_jerk_m_s3", "engine_stall", "theta_cs_error_K",
-                  "hot", "phase", "protection_level", "peak_theta_cm_degC", "peak_theta_cs_degC",
+                  "hot", "phase", "protection_level", "launch_possible", "stranded", "peak_theta_cm_degC", "peak_theta_cs_degC",
                   "beyond_tables_s", "above_damage_s")
 #: the temperature columns added by temperature_metrics
 TEMPERATURE_COLUMNS = METRIC_COLUMNS[-4:]
@@ -86,10 +94,10 @@ class LaunchRecord:
 
     __slots__ = ("launch", "cool", "lock_time", "stall", "slip_J", "n_err", "sq_err", "max_err", "jerk",
                  "n_ch", "sq_ch", "max_ch", "n_creep", "sum_creep", "kiss_err", "theta_cs", "theta_err",
-                 "a_filt", "alpha", "h", "started", "acc", "t_first", "window", "level", "protection")
+                 "a_filt", "alpha", "h", "started", "acc", "t_first", "window", "level", "protection", "possible")
 
-    def __init__(self, launch: int, cool: bool, h: float, level: str = ""):
-        self.launch, self.cool, self.h, self.level = launch, cool, h, level
+    def __init__(self, launch: int, cool: bool, h: float, level: str = "", possible: bool = True):
+        self.launch, self.cool, self.h, self.level, self.possible = launch, cool, h, level, possible
         self.window = LOCKUP_WINDOW_S
         self.lock_time = None
         self.stall = False
@@ -181,6 +189,8 @@ class LaunchRecord:
             "hot": bool(theta >= hot_degC),
             "phase": "cool-down" if self.cool else "repeated",
             "protection_level": self.protection,
+            "launch_possible": bool(self.possible),
+            "stranded": bool(self.possible and self.protection < 3 and self.lock_time is None),
         }
 
 
@@ -197,11 +207,14 @@ def summarise(rows: list[dict], select) -> dict:
     """Mean and worst of the ``SUMMARY`` columns over the rows for which ``select(row)`` is true.
 
     Returns ``{"n": count, "<col>_mean": ..., "<col>_worst": ...}`` (NaN for no rows),
-    plus ``stalls`` (count) and ``no_lockup`` (launches without lock-up).
+    plus ``stalls`` (count), ``no_lockup`` (launches without lock-up), ``stranded`` (of those, the ones the
+    vehicle could make and the protection did not inhibit) and ``impossible`` (launches the vehicle cannot make).
     """
     rows = [r for r in rows if select(r)]
     out: dict = {"n": len(rows), "stalls": sum(bool(r["engine_stall"]) for r in rows),
-                 "no_lockup": sum(math.isnan(r["engagement_time_s"]) for r in rows)}
+                 "no_lockup": sum(math.isnan(r["engagement_time_s"]) for r in rows),
+                 "stranded": sum(bool(r.get("stranded", False)) for r in rows),
+                 "impossible": sum(not r.get("launch_possible", True) for r in rows)}
     for col, how in SUMMARY:
         vals = [r[col] for r in rows if col in r and not math.isnan(r[col])]
         if not vals:
@@ -243,3 +256,48 @@ def add_temperature_metrics(metrics: list[dict], series, theta_min_K: float, the
     per = temperature_metrics(series, theta_min_K, theta_max_K, damage_K)
     for row in metrics:
         row.update(per.get(int(row["launch"]), dict.fromkeys(TEMPERATURE_COLUMNS, math.nan)))
+
+
+def launch_capability(sc, level: str) -> tuple[float, float]:
+    """What a launch at the demand ``level`` can do on the scenario's grade: ``(engine_Nm, load_Nm)``.
+
+    ``engine_Nm``: the engine's largest net torque at the level's pedal over its speed range (idle to
+    ``engine.max_speed_rpm``; a creep launch: the idle governor's full throttle at idle speed),
+    ``pedal T_max(w) - drag w``; ``load_Nm``: the clutch torque that holds the car on the grade against
+    rolling resistance (the driveline's ``t_load_rest``). Both at the disc, N.m. The launch is physically
+    possible when ``engine_Nm > load_Nm`` (the car can be accelerated once locked).
+    """
+    from .driveline import Driveline
+    from .engine import RPM, EngineGovernor
+
+    eng = EngineGovernor(sc.engine, sc.run.step_s)
+    load = Driveline(sc, eng.w_idle).t_load_rest
+    if level == "creep":
+        return eng.max_torque(eng.w_idle) - eng.drag * eng.w_idle, load
+    pedal = sc.driver.pedal(level)
+    speeds = [eng.w_idle, eng.w_max] + [w for w in eng.w if eng.w_idle < w < eng.w_max]
+    return max(pedal * eng.max_torque(w) - eng.drag * w for w in speeds), load
+
+
+def launch_possible(sc, level: str) -> bool:
+    """True if the vehicle can make a launch at ``level`` on the scenario's grade within the driver's pedal time.
+
+    The engine's torque at the pedal must exceed the holding torque (:func:`launch_capability`), and (a pedal
+    launch) the disc must reach, within ``tcu.drive_time_s``, the lowest engine speed at which the engine holds
+    the car, accelerated at best by the engine's largest surplus: ``w_hold J_d / (engine - load)`` (a lower
+    bound of any controller's time; ``J_d`` the disc and vehicle inertia at the disc).
+    """
+    engine, load = launch_capability(sc, level)
+    if engine <= load:
+        return False
+    if level == "creep":
+        return True
+    from .driveline import Driveline
+    from .engine import EngineGovernor
+
+    eng = EngineGovernor(sc.engine, sc.run.step_s)
+    pedal = sc.driver.pedal(level)
+    n = 400
+    hold = next(w for w in (eng.w_idle + (eng.w_max - eng.w_idle) * k / n for k in range(n + 1))
+                if pedal * eng.max_torque(w) - eng.drag * w > load)
+    return hold * Driveline(sc, eng.w_idle).j_d / (engine - load) <= sc.tcu.drive_time_s

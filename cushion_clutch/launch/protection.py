@@ -16,8 +16,12 @@ level  name        when / what
 0      ok          ``theta < warn_degC``
 1      warn        ``theta >= warn_degC``: the driver is told (a message, the signal)
 2      limit       ``theta >= limit_degC`` at a launch's start: slip energy limited, the
-                   launch's engine-speed target lowered to ``limit_engine_speed_rpm`` (the
-                   slip speed, and with it the slip power, falls with it); decided per
+                   launch's engine-speed target lowered towards ``limit_engine_speed_rpm``
+                   (the slip speed, and with it the slip power, falls with it), but no lower
+                   than the speed at which the engine's torque at the pedal, less the
+                   holding torque the TCU believes, still brings the car to lock-up by the
+                   lock-up deadline (:meth:`.tcu.TcuController.limited_target_rpm`: a limit
+                   that strands the launch keeps it slipping, which is heat); decided per
                    launch (switched within a launch, the speed controller pulled the
                    engine down: a 208 N.m torque spike)
 3      inhibit     at a launch's start, ``theta >= inhibit_degC`` or ``theta`` plus the
@@ -25,7 +29,10 @@ level  name        when / what
                    (the driver holds the brake) until ``theta < resume_degC``
 ====  ===========  =================================================================
 
-Levels 1 and 2 fall back ``hysteresis_K`` below their threshold.
+Levels 1 and 2 fall back ``hysteresis_K`` below their threshold. A launch that is not inhibited locks up
+(the launch controller closes what slip is left at ``tcu.lockup_deadline_s``); one the vehicle cannot make
+at all (the engine's torque at the pedal below the grade's holding torque) is counted apart from the
+stranded ones (``launch_possible``, ``stranded`` in the launch metrics).
 
 **Thresholds and their source.** The seed paper (cushion-spring study, its
 ref. [9]): after repeated engagements the facings reach 300-350 degC, and

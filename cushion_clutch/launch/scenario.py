@@ -170,6 +170,14 @@ class Tcu(Checked):
     """the calibration's relative change of mu per 100 rad/s of slip (the facing's nominal shape), 1"""
     facing_mu_reference_slip_rad_s: float = 190.0
     """slip speed at which the calibration's mu is the nominal mu, rad/s"""
+    lockup_deadline_s: float = 5.5
+    """pedal launches: this long after the launch's start (after the pre-fill) the TCU closes the slip that is
+    left within ``forced_sync_s`` (it enters the sync from any slip, or shortens a slower sync), provided the
+    disc turns at least at the engine's idle speed and the engine's torque at the pedal there carries the
+    holding torque the TCU believes (locked, the engine runs on and the car does not roll back), s"""
+    forced_sync_s: float = 1.5
+    """the longest sync after ``lockup_deadline_s``, s (a deadline later than ``drive_time_s - forced_sync_s``
+    leaves the forced sync less time than this: the driver lifts off first)"""
 
     _section = "tcu"
 
@@ -182,7 +190,8 @@ class Tcu(Checked):
             "x_to_closed_m": (0.0, 0.05),
             "close_rate_m_per_s": (1e-4, 1.0), "actuator_time_constant_s": (0.0, 1.0),
             "drive_time_s": (0.5, 100.0), "prefill_s": (0.0, 5.0),
-            "facing_mu_slope_per_100_rad_s": (-0.2, 0.2), "facing_mu_reference_slip_rad_s": (0.0, 1000.0)})
+            "facing_mu_slope_per_100_rad_s": (-0.2, 0.2), "facing_mu_reference_slip_rad_s": (0.0, 1000.0),
+            "lockup_deadline_s": (0.5, 100.0), "forced_sync_s": (0.1, 10.0)})
         k, w_ref = self.facing_mu_slope_per_100_rad_s, self.facing_mu_reference_slip_rad_s
         if not self._passed(spec, "facing_mu_slope_per_100_rad_s", "facing_mu_reference_slip_rad_s"):
             return

@@ -40,7 +40,7 @@ from .driveline import Driveline, Energy
 from .engine import EngineGovernor
 from ..errors import FmuCallError
 from .fmu_client import ClutchFmu
-from .metrics import LaunchRecord
+from .metrics import LaunchRecord, launch_possible
 from .observer import SpeedSensors
 from .scenario import Scenario
 from .engine import RPM
@@ -175,7 +175,8 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
     total = run.duration()
     ends = starts[1:] + [total]
     levels = [drv.level(i + 1) for i in range(len(starts))]
-    recs = [LaunchRecord(i + 1, i >= run.launches, h, levels[i]) for i in range(len(starts))]
+    possible = {lv: launch_possible(sc, lv) for lv in set(levels)}
+    recs = [LaunchRecord(i + 1, i >= run.launches, h, levels[i], possible[levels[i]]) for i in range(len(starts))]
     tcu_every = max(1, int(round(tc.period_s / h)))
     act = math.exp(-h / tc.actuator_time_constant_s) if tc.actuator_time_constant_s > 0 else 0.0
     w_idle, w_stall = engine.w_idle, engine.w_stall

@@ -96,14 +96,14 @@ static int inputs_ok(CcModel *m, double t, const char *what) {
 
 /* 1 if every node temperature th (K) is finite and in the nodes' one declared range [TN_THETA_MIN_K,
    TN_THETA_MAX_K] (thermal_chain.NODE_RANGE, the modelDescription's min/max of every theta_<node>) and their facing
-   mean theta_cm and the friction surface theta_friction in their declared range [THETA_MIN_K, THETA_MAX_K]; otherwise logs every problem with the status
+   mean theta_cm in its declared range [THETA_MIN_K, THETA_MAX_K] (theta_friction, the mean of two nodes, is then in
+   the nodes' range, as it declares); otherwise logs every problem with the status
    (fn: the call, what: what happens) and returns 0. The one check of the nodes: CS step, ME states, saved states */
 static int nodes_ok(CcModel *m, const double *th, int status, const char *fn, const char *what) {
-    double mean = 0.0, surface = 0.0;
+    double mean = 0.0;
     int k, ok = 1;
     for (k = 0; k < TN_N; ++k) {
         mean += TN_WEIGHT[k] * th[k];
-        surface += TN_FRICTION_WEIGHT[k] * th[k];
         if (!(th[k] >= TN_THETA_MIN_K && th[k] <= TN_THETA_MAX_K)) { /* false for NaN */
             cc_log(m, status, "%s: t = %g s: %s = %.17g K is not finite or outside [%.15g, %.15g] K; %s", fn,
                    m->time, TN_NAME[k], th[k], TN_THETA_MIN_K, TN_THETA_MAX_K, what);
@@ -113,11 +113,6 @@ static int nodes_ok(CcModel *m, const double *th, int status, const char *fn, co
     if (ok && !(mean >= THETA_MIN_K && mean <= THETA_MAX_K)) {
         cc_log(m, status, "%s: t = %g s: the facing temperature theta_cm = %.17g K (the facing nodes' mean) is "
                "outside [%.15g, %.15g] K; %s", fn, m->time, mean, THETA_MIN_K, THETA_MAX_K, what);
-        ok = 0;
-    }
-    if (ok && !(surface >= THETA_MIN_K && surface <= THETA_MAX_K)) { /* mu is read there (theta_friction) */
-        cc_log(m, status, "%s: t = %g s: the friction-surface temperature theta_friction = %.17g K is outside "
-               "[%.15g, %.15g] K; %s", fn, m->time, surface, THETA_MIN_K, THETA_MAX_K, what);
         ok = 0;
     }
     return ok;

@@ -237,7 +237,7 @@ def thermal_ranges(chain: Chain) -> dict[str, tuple]:
         ranges.update({v: (0.0, 1e6, False, False) for v in _link_params(a, b).values()})
     ranges.update({n: r for n, (_, _, r) in GLOBALS.items()})
     ranges["omega_engine"] = (-clutch_model.OMEGA_SLIP_LIMIT, clutch_model.OMEGA_SLIP_LIMIT, False, False)
-    ranges[FRICTION_OUTPUT] = clutch_model.INPUT_RANGES["theta_cm"]      # as theta_cm; a step leaving it is refused
+    ranges[FRICTION_OUTPUT] = NODE_RANGE         # the two metal surface nodes' mean: in their range when they are
     return ranges
 
 

@@ -32,7 +32,17 @@ FIGURES = {
 CALIBRATION_SOURCES = ("cushion_clutch/benchmarks/calibrate.py", "cushion_clutch/fe/*.py",
                        "cushion_clutch/fe/springs/default.toml", "cushion_clutch/fe/studies/calibrate.py",
                        "cushion_clutch/fe/studies/measured.py", "cushion_clutch/fe/studies/calibration_report.py")
+#: the heat path (a transient thermal FE of the disc sector and the kiss shift under its field, about 10 min)
+HEAT_PATH_SOURCES = ("cushion_clutch/fe/heat_*.py", "cushion_clutch/fe/kiss_field.py", "cushion_clutch/fe/deck.py",
+                     "cushion_clutch/fe/springs/default.toml")
+#: the fleet study (1000 samples of three TCUs on Dask, about 15 min; docs/results/fleet.md names its commit)
+FLEET_SOURCES = ("cushion_clutch/benchmarks/fleet.py", "cushion_clutch/launch/fleet.py",
+                 "cushion_clutch/launch/population.py", "cushion_clutch/launch/populations/*.toml")
 RECORDED = {
+    "images/heat_path.png": ("cushion-clutch heat-path --kiss-shift --out heat_path_out "
+                             "(then copied as docs/developer/guide.md says)", HEAT_PATH_SOURCES),
+    "images/fleet_default.png": ("python -m cushion_clutch.benchmarks.fleet --part possible,bar,identity,duty,"
+                                 "scaling,big --work W --page docs/results/fleet.md", FLEET_SOURCES),
     "fe_vs_measured.png": ("python -m cushion_clutch.benchmarks.calibrate --png docs/fe_vs_measured.png",
                            CALIBRATION_SOURCES),
     "fe_vs_measured_hot.png": ("python -m cushion_clutch.benchmarks.calibrate --hot "

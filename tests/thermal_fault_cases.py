@@ -283,7 +283,9 @@ def c_every_declared_parameter_max_is_accepted_alone(c):
 
 
 # -------------------------------------------------------------------------------------- saved states
-def _seal(blob: bytearray) -> bytes:
+def seal(blob: bytearray) -> bytes:
+    """The native state with its FNV-1a 64 checksum recomputed (clutch_core.c fnv1a): a crafted state that only
+    the range checks can refuse (also used by test_thermal_fmu)."""
     h = 1469598103934665603
     for b in blob[:-8]:
         h = ((h ^ b) * 1099511628211) & 0xFFFFFFFFFFFFFFFF
@@ -302,7 +304,7 @@ def _crafted(c, node_index: int, value: float, expect_refused: bool = True):
     blob[at:at + 8] = struct.pack("<d", value)
     n = len(c.log)
     try:
-        state = c.s.deSerializeFMUstate(_seal(blob))
+        state = c.s.deSerializeFMUstate(seal(blob))
         st = c.call(c.s.setFMUstate, state)
     except FMICallException as e:
         st = int(e.status)

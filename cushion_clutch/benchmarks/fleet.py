@@ -202,6 +202,7 @@ def write_page(work: Path, page: Path, argv: list[str]) -> None:
                 rows += read_samples(work / g["folder"] / SAMPLES_FILE)
                 tcus += g["tcus"]
             png = page.parent.parent / "images" / "fleet_default.png"
+            out.written.append(png)                 # the page's own figure: not a change of the measured code
             plot_fleet(rows, tcus, png, f"population 'default', {runs[0][0]['samples']} samples, seed 1")
             out.markdown("![fleet](../images/fleet_default.png)\n\nCDF of the characteristic error per TCU (the worst "
                          "of each sample's launches), and the error against the ambient temperature and the facing "

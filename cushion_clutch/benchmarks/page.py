@@ -39,12 +39,13 @@ def _git(*args: str) -> str:
                           timeout=10).stdout.strip()
 
 
-def tree_state() -> tuple[str, bool]:
+def tree_state(ignore: tuple[Path, ...] = ()) -> tuple[str, bool]:
     """The checkout's commit (short hash, or ``unknown`` outside git) and whether tracked files have
-    uncommitted changes."""
+    uncommitted changes (``ignore``: files the page's own benchmark writes, e.g. its figure)."""
     try:
         head = _git("rev-parse", "--short", "HEAD")
-        dirty = bool(_git("status", "--porcelain", "--untracked-files=no"))
+        excluded = [f":(exclude){Path(p).resolve().relative_to(ROOT).as_posix()}" for p in ignore]
+        dirty = bool(_git("status", "--porcelain", "--untracked-files=no", "--", ".", *excluded))
     except (OSError, subprocess.SubprocessError):
         return "unknown", False
     return head or "unknown", dirty
@@ -56,9 +57,10 @@ def add_draft_option(ap) -> None:
                     help="with --out: write the page from a tree with uncommitted changes, marked as a draft")
 
 
-def check_tree(draft: bool) -> tuple[str, bool]:
-    """The commit and dirtiness; raises :class:`DirtyTreeError` for a dirty tree unless ``draft``."""
-    head, dirty = tree_state()
+def check_tree(draft: bool, ignore: tuple[Path, ...] = ()) -> tuple[str, bool]:
+    """The commit and dirtiness (but for ``ignore``, :func:`tree_state`); raises :class:`DirtyTreeError` for a
+    dirty tree unless ``draft``."""
+    head, dirty = tree_state(ignore)
     if dirty and not draft:
         raise DirtyTreeError(f"the checkout has uncommitted changes (commit {head}): a results page must name the "
                              "commit that measured it; commit first, or pass --draft to write a page marked as a "
@@ -100,10 +102,11 @@ def _machine() -> str:
     return f"{cpu}, {os.cpu_count()} cores, load average {load:.1f} at the start; Python {platform.python_version()}"
 
 
-def provenance(command: str, draft: bool = False) -> str:
+def provenance(command: str, draft: bool = False, ignore: tuple[Path, ...] = ()) -> str:
     """The header block of a results page: how to regenerate it (``command``, run from the repository root)
-    and where and when it was measured; a loud draft warning first when ``draft`` and the tree is dirty."""
-    head, dirty = check_tree(draft)
+    and where and when it was measured; a loud draft warning first when ``draft`` and the tree is dirty
+    (``ignore``: the files the benchmark itself wrote for the page, which are not a change of the code)."""
+    head, dirty = check_tree(draft, ignore)
     now = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
     warn = (f"```{{danger}} {DRAFT_MARK}\nThe figures below were measured by code that differs from commit "
             f"`{head}`. Do not commit this page: regenerate it from a clean tree.\n```\n\n" if dirty else "")
@@ -117,6 +120,8 @@ def provenance(command: str, draft: bool = False) -> str:
 class _Page:
     def __init__(self) -> None:
         self.parts: list[str] = []
+        self.written: list[Path] = []
+        """files the benchmark writes for the page (its figures): not a change of the measured code"""
 
     def markdown(self, text: str) -> None:
         """Append Markdown (a table, a heading, a paragraph) to the page."""
@@ -155,7 +160,7 @@ def results_page(out: Path | None, title: str, module: str, argv: list[str] | No
 
     with contextlib.redirect_stdout(_Tee()):
         yield page
-    text = f"# {title}\n\n{provenance(command, draft)}\n" + (intro.rstrip() + "\n\n" if intro else "")
+    text = f"# {title}\n\n{provenance(command, draft, tuple(page.written))}\n" + (intro.rstrip() + "\n\n" if intro else "")
     text += "\n".join(page.parts)
     printed = buffer.getvalue().strip()
     if printed:

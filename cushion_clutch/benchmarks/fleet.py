@@ -268,9 +268,10 @@ INTRO = """`cushion-clutch fleet` draws samples of the `default` population
 trailer, grades 0-20 %, ambient -30..40 degC, start temperature up to 40 K above ambient, pedal 0.3-1.0
 correlated with the mass, a launch every 20-120 s, nine in ten springs nominal and one in ten the P95 spring,
 facing wear up to 0.5 mm the TCUs do not know, noise seeds per sample), runs each sample's five launches with
-each TCU on a local Dask cluster and keeps of every launch metric the worst over the sample's launches. Below
-20 degC the default tables clamp the characteristic (plant and TCUs alike; `beyond_tables_s` counts it), so
-the cold samples measure no temperature error. How to run it: [the fleet tutorial](../tutorials/fleet.md).
+each TCU on a local Dask cluster and keeps of every launch metric the worst over the sample's launches. The
+default tables reach down to -40 degC; the P95 spring's tables (the tolerance study's, not swept again) start
+at 20 degC and clamp the characteristic below it (plant and TCUs alike; `beyond_tables_s` counts it), so a cold
+sample with that spring measures no temperature error. How to run it: [the fleet tutorial](../tutorials/fleet.md).
 """
 
 DUTY_INTRO = """## Duty cycles: restarts to damage

@@ -359,7 +359,7 @@ def plot_fleet(rows: list[dict], tcus: Sequence[str], png: Path, title: str) -> 
     axes[0].set_ylabel("fraction of samples")
     axes[0].set_title("CDF of the characteristic error per TCU")
     axes[1].set_xlabel("ambient temperature [°C]")
-    axes[1].set_title("error against ambient (tables start at 20 °C)")
+    axes[1].set_title("error against ambient")
     axes[2].set_xlabel("facing wear [mm]")
     axes[2].set_title("error against facing wear (TCUs believe new)")
     for ax in axes[1:]:

@@ -41,7 +41,8 @@ def test_every_file_validates_and_fmpy_reads_it(archive):
         for n in ssvs:
             assert ssp.validate(z.read(n), "SystemStructureParameterValues.xsd") == [], n
     expected = {f"resources/parameters/{s}.ssv" for s in
-                ("new", "worn_1mm", "worn_2mm", "thermal_paper", "spring_default", "spring_soft")}
+                ("new", "worn_1mm", "worn_2mm", "thermal_fe_default", "thermal_paper", "spring_default",
+                 "spring_soft")}
     assert expected <= set(ssvs)
     ssd = read_ssd(str(archive.path), validate=True)
     (clutch,) = ssd.system.elements
@@ -65,7 +66,7 @@ def test_every_value_carries_its_unit_and_every_unit_is_defined(archive):
 
 def test_the_shipped_sets_are_data():
     sets = {s.name: s for s in shipped_sets()}
-    assert {"new", "worn_1mm", "worn_2mm", "thermal_paper"} <= set(sets)
+    assert {"new", "worn_1mm", "worn_2mm", "thermal_paper", "thermal_fe_default"} <= set(sets)
     assert dict(sets["worn_1mm"].values) == {"facing_wear": 0.001}
     assert sets["worn_2mm"].parameters().facing_wear == 0.002
 
@@ -97,13 +98,16 @@ def test_a_run_with_each_set_equals_the_plain_fmu_with_the_same_start_values(arc
         ps = read_ssv(str(archive.path), resource=f"resources/parameters/{name}.ssv")       # fmpy's reader
         items = {"default": 1, "soft": 2}
         start = {p.name: (items[p.value] if p.type == "Enumeration" else float(p.value)) for p in ps.parameters}
+        from cushion_clutch.model.thermal_set import load_thermal_set
         plain = {"worn_1mm": {"facing_wear": 0.001}, "worn_2mm": {"facing_wear": 0.002},
-                 "spring_soft": {"spring": 2}}.get(name, {})
+                 "spring_soft": {"spring": 2},
+                 "thermal_fe_default": load_thermal_set("fe_default").parameters()}.get(name, {})
         runs[name] = _run(fmu, start)
         assert np.array_equal(runs[name], _run(two_set_fmu(2), plain)), name
     assert not np.array_equal(runs["worn_2mm"], runs["new"])
     assert not np.array_equal(runs["spring_soft"], runs["new"])
     assert np.array_equal(runs["thermal_paper"], runs["new"])     # the paper's set is the FMU's default
+    assert not np.array_equal(runs["thermal_fe_default"], runs["new"])      # the FE's heat path: slower, hotter
 
 
 def test_ssv_into_clutch_parameters(archive):
@@ -134,7 +138,7 @@ def test_export_ssp_cli_and_simulate_with_a_parameter_set(archive, tmp_path, cap
     out = tmp_path / "D.ssp"
     assert main(["export-ssp", "--fmu", str(two_set_fmu(2)), "-o", str(out)]) == 0
     said = capsys.readouterr().out
-    assert "SSD and 6 SSV parameter sets validated" in said and "spring: 1 = default, 2 = soft" in said
+    assert "SSD and 7 SSV parameter sets validated" in said and "spring: 1 = default, 2 = soft" in said
     assert main(["export-ssp", "--fmu", str(two_set_fmu(2)), "-o", str(tmp_path / "D.zip")]) == 2
     assert "must end in .ssp" in capsys.readouterr().err
     assert main(["simulate", "--fmu", str(out), "--parameter-set", "spring_soft", "--engagements", "1",

@@ -1,4 +1,6 @@
-"""Named FMU parameter sets shipped as data (``*.toml`` here): wear states and thermal parameter sets.
+"""Named FMU parameter sets shipped as data (``*.toml`` here: the wear states), and the cushion spring's thermal
+parameter sets (:mod:`cushion_clutch.model.thermal_set`: the paper's U, H, C and every set in
+``cushion_clutch/thermal_sets``, e.g. the FE-identified ``fe_default``) as ``thermal_<name>``.
 
 Each file holds ``name``, ``kind`` (``wear`` or ``thermal``), ``description`` and a ``[parameters]`` table of
 FMU parameter names with values in the FMU's units (SI; temperatures in K). ``cushion-clutch export-ssp``
@@ -70,6 +72,18 @@ def load_set(path: Path) -> NamedSet:
                     tuple((k, float(v)) for k, v in params.items()))
 
 
+def thermal_sets() -> list[NamedSet]:
+    """The shipped cushion-spring thermal sets as parameter sets ``thermal_<name>`` (FMU parameters U, H, C):
+    declared once, in :mod:`cushion_clutch.model.thermal_set`, which the launch plant reads too."""
+    from ..model.thermal_set import load_thermal_set, shipped_names
+    out = []
+    for name in shipped_names():
+        ts = load_thermal_set(name)
+        out.append(NamedSet(f"thermal_{name}", "thermal", f"cushion-spring U, H, C: {ts.description}",
+                            tuple(ts.parameters().items())))
+    return out
+
+
 def shipped_sets() -> tuple[NamedSet, ...]:
     """Every shipped set, wear states first (new first), then the thermal sets, each by name.
 
@@ -78,7 +92,7 @@ def shipped_sets() -> tuple[NamedSet, ...]:
     ParameterError
         A bad file, or two files with one name.
     """
-    sets = [load_set(p) for p in sorted(folder().glob("*.toml"))]
+    sets = [load_set(p) for p in sorted(folder().glob("*.toml"))] + thermal_sets()
     names = [s.name for s in sets]
     dup = sorted({n for n in names if names.count(n) > 1})
     if dup:

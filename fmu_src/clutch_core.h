@@ -145,7 +145,7 @@ int cc_net_states_ok(CcModel *m, const double *x, int status, const char *fn, co
 int cc_net_saved_ok(CcModel *m, const double *r, const char *fn);
 /* after a rollback or a state load: theta_cm from the nodes, the next output update computes the derivatives */
 void cc_net_restore(CcModel *m);
-/* 1 if vr is a node temperature or theta_cm (states, not computed from the inputs) */
+/* 1 if vr is a node temperature, theta_cm or theta_friction (states and their means, not computed from the inputs) */
 int cc_net_state_output(unsigned int vr);
 void cc_net_set_states(CcModel *m, const double *x);
 void cc_net_get_states(CcModel *m, double *x);

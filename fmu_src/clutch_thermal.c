@@ -174,7 +174,7 @@ int cc_net_saved_ok(CcModel *m, const double *r, const char *fn) {
 
 int cc_net_state_output(unsigned int vr) {
     int k;
-    if (vr == VR_THETA_CM) return 1;
+    if (vr == VR_THETA_CM || vr == CC_VR_THETA_MU) return 1;   /* the facings' and the friction surfaces' means */
     for (k = 0; k < TN_N; ++k)
         if (vr == (unsigned int)TN_VR_THETA[k]) return 1;
     return 0;

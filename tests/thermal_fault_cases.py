@@ -39,7 +39,7 @@ class Case:
         self.vr = {v.name: v.valueReference for v in self.md.modelVariables}
         self.vars = {v.name: v for v in self.md.modelVariables}
         self.nodes = [v.name for v in self.md.modelVariables if v.name.startswith("theta_") and v.causality ==
-                      "output" and v.name not in ("theta_cm", "theta_cs")]
+                      "output" and v.name not in ("theta_cm", "theta_cs", "theta_friction")]   # the nodes only
         self.kelvin = [v.name for v in self.md.modelVariables if v.unit == "K" and v.causality == "output"]
         self.log: list[tuple[int, str]] = []
         self.why: list[str] = []

@@ -150,9 +150,11 @@ class Geometry(Checked):
 
     def _profile_problems(self) -> Iterable[str]:
         s, z = self.profile_s, self.profile_z
-        if len(s) < 3 or len(s) != len(z):
-            yield (f"geometry.profile_s / profile_z: need equal lengths >= 3, got {len(s)} "
-                   f"and {len(z)}")
+        if len(s) < 3:
+            yield f"geometry.profile_s: needs at least 3 values, got {len(s)}"
+            return
+        if len(s) != len(z):
+            yield f"geometry.profile_z: needs one value per profile_s ({len(s)}), got {len(z)}"
             return
         bad = [range_problem(f"geometry.profile_s[{i}]", v, 0.0, 1.0) for i, v in enumerate(s)]
         bad += [range_problem(f"geometry.profile_z[{i}]", v, 0.0, 1.0) for i, v in enumerate(z)]
@@ -263,9 +265,11 @@ class Material(Checked):
             "reference_temperature_degC": (-273.15, 1500.0, True),
         })
         temps, moduli = self.temperatures_degC, self.youngs_modulus_Pa
-        if len(temps) == 0 or len(temps) != len(moduli):
-            yield (f"material.temperatures_degC / youngs_modulus_Pa: need equal, non-zero "
-                   f"lengths, got {len(temps)} and {len(moduli)}")
+        if len(temps) == 0:
+            yield "material.temperatures_degC: needs at least one temperature, got none"
+        elif len(temps) != len(moduli):
+            yield (f"material.youngs_modulus_Pa: needs one value per temperatures_degC ({len(temps)}), "
+                   f"got {len(moduli)}")
         for i, t in enumerate(temps):
             msg = range_problem(f"material.temperatures_degC[{i}]", t, -273.15, 1500.0, True)
             if msg:
@@ -285,8 +289,9 @@ class Material(Checked):
             bad = [msg for i, a in enumerate(alphas)
                    if (msg := range_problem(f"material.expansion_coefficients_per_K[{i}]", a, 0.0, 1e-3))]
             yield from bad
-            if not bad and all(isinstance(t, (int, float)) for t in temps) and \
-                    isinstance(self.expansion_coefficient_per_K, (int, float)):
+            if not bad and all(is_finite_number(t) for t in temps) and \
+                    is_finite_number(self.expansion_coefficient_per_K) and \
+                    is_finite_number(self.reference_temperature_degC):
                 at_ref = self.expansion_coefficient(self.reference_temperature_degC)
                 if abs(at_ref - self.expansion_coefficient_per_K) > 1e-9 * abs(at_ref):
                     yield (f"material.expansion_coefficient_per_K = {self.expansion_coefficient_per_K!r}: must equal "

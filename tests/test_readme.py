@@ -73,6 +73,7 @@ def test_readme_python_block_runs(code, tmp_path, monkeypatch):
     if "CushionClutch.fmu" in code:                          # what `cushion-clutch build-fmu` wrote before
         build_fmu(DEFAULT_TABLES, tmp_path / "CushionClutch.fmu")
     monkeypatch.chdir(tmp_path)
+    plt.close("all")                    # a reader's fresh session: no figure left open by an earlier test
     exec(compile(code, str(README), "exec"), {"__name__": "readme_example"})
     plt.close("all")
     png = tmp_path / FIGURE.name

@@ -91,7 +91,8 @@ REPLAY_VRS = {"x_to": 0, "theta_cm": 1, "omega_slip": 17, "torque": 2, "theta_cs
 def record_launch(fmu: Path, launches: int = 2, tcu: str = "naive") -> dict[str, np.ndarray]:
     """The inputs the launch simulation gives the clutch FMU, step by step, and the outputs it gets back.
 
-    The shipped ``default`` scenario cut to its first ``launches`` launches (moderate and hard pedal alternating,
+    The shipped ``default`` scenario (with the FMU's default cushion-spring heat path) cut to its first
+    ``launches`` launches (moderate and hard pedal alternating,
     each a 60 s slot: prefill, 8 s of pedal, then braked standstill with the clutch open), with 1 ms steps
     throughout (``quiet_steps`` off: a fixed-step host's pattern; the launch loop's quiet periods would step
     10 ms) and the Python plant loop (the compiled one calls the FMU from C), through ``fmu`` (a native FMU with
@@ -129,7 +130,10 @@ def record_launch(fmu: Path, launches: int = 2, tcu: str = "naive") -> dict[str,
             return step
 
     sc = load_scenario()
-    sc = dataclasses.replace(sc, run=dataclasses.replace(sc.run, launches=launches, quiet_steps=False))
+    # the clutch FMU's own start values for the cushion spring's heat path (the paper's U, H, C: a C host that
+    # replays the pattern sets no parameter), not the scenario's FE set
+    sc = dataclasses.replace(sc, run=dataclasses.replace(sc.run, launches=launches, quiet_steps=False),
+                             clutch=dataclasses.replace(sc.clutch, spring_thermal="paper"))
     with mock.patch.object(simulate, "ClutchFmu", Recording):
         simulate.simulate_launches(fmu, sc, load_table(), tcu, record_every=1000, plant="python")
     if len(steps) != 1:

@@ -509,6 +509,7 @@ def _tolerance(args: argparse.Namespace) -> int:
 
     from .fe.params import load_params
     from .fe.studies.tolerance_report import RANK_BY, tolerance_study
+    from .fmu.build import build_fmu
 
     if not args.verbose:
         import distributed  # noqa: F401 - its import sets its loggers' levels; quieten them after
@@ -532,7 +533,8 @@ def _tolerance(args: argparse.Namespace) -> int:
         res = tolerance_study(params, samples=args.samples, temperatures=tuple(args.temperatures), out=out,
                               method=args.method, seed=args.seed, rank_by=args.rank_by,
                               cache_dir=Path(args.cache), scheduler=args.scheduler, workers=args.workers,
-                              progress=progress, band_fmu=args.fmu)
+                              progress=progress,
+                              build_band=(lambda folders: build_fmu(folders, Path(args.fmu))) if args.fmu else None)
     b = res.bands
     print(f"{res.cases} FE cases ({res.cases_from_cache} from the cache) in {res.wall_time_s:.1f} s")
     print(f"{'theta [degC]':>12} {'delta_kiss P5/P50/P95 [mm]':>28} "

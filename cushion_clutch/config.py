@@ -17,7 +17,7 @@ from pathlib import Path
 from typing import Any, Iterable
 
 from .errors import ParameterError
-from .model.number_check import is_finite_number, is_number
+from .number_check import is_finite_number, is_number
 
 
 def range_problem(key: str, value: Any, lo: float | None, hi: float | None,

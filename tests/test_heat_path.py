@@ -11,7 +11,8 @@ import pytest
 from cushion_clutch.fe.heat_deck import Phase, Schedule, write_deck, parse_temperatures
 from cushion_clutch.fe.heat_mesh import HeatMesh, sector_mesh
 from cushion_clutch.fe.heat_params import STEEL_C_RANGE_J_PER_KG_K, HeatPathParams
-from cushion_clutch.fe.heat_path import first_order, schedule_for
+from cushion_clutch.fe.heat_fit import first_order
+from cushion_clutch.fe.heat_path import schedule_for
 from cushion_clutch.fe.params import load_params
 
 

@@ -144,7 +144,7 @@ def test_arbitrary_text(text, kind, tmp_path):
 def _numeric_keys(top_cls) -> list[tuple[str, str, object]]:
     """(section, key, default) of every number-valued key of a document class (top-level keys: section "")."""
     import dataclasses
-    from cushion_clutch.model.number_check import is_number
+    from cushion_clutch.number_check import is_number
     out = []
     for f in dataclasses.fields(top_cls):
         if f.default_factory is not dataclasses.MISSING:

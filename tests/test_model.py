@@ -287,7 +287,7 @@ def test_parameter_range_bounds_are_open_or_closed_as_documented(name):
                            "must be > 0"], got
             continue
         assert got == ([f"{name} = {v!r} is out of range {text}"] if is_open else []), (name, v, got)
-    from cushion_clutch.model.number_check import unit_hint
+    from cushion_clutch.number_check import unit_hint
     unit = next(u for n, _, u, _ in VARIABLES if n == name)
     for v in (lo - 1e-3 * (hi - lo), hi + 1e-3 * (hi - lo)):
         hint = unit_hint(v, unit, lo, hi)          # e.g. theta_a = 199.4: "did you mean 472.55 K (199.4 degC)?"

@@ -31,6 +31,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from .ccx import ccx_version, run_ccx
+from .heat_fit import PAPER, first_order, two_lags
 from .heat_deck import Schedule, launch_schedule, parse_temperatures, write_deck
 from .heat_mesh import HeatMesh, sector_mesh
 from .heat_params import STEEL_C_RANGE_J_PER_KG_K, UNCERTAIN, HeatPathParams
@@ -47,8 +48,6 @@ DT_S = 0.5
 COARSE_DT_S = 1.0
 #: bars of the checks (issue 37): C within 10 % of the steel's mass x c (c in STEEL_C_RANGE), energy, mesh
 BAR_C_FRACTION, BAR_ENERGY, BAR_TAU_MESH = 0.10, 0.01, 0.05
-#: the paper's cushion-spring parameters (eq. 2): U W/K, H W/K, C J/K
-PAPER = {"U_W_per_K": 0.1, "H_W_per_K": 0.04, "C_J_per_K": 1.0}
 
 
 @dataclass(frozen=True)
@@ -163,31 +162,6 @@ def solve_case(spring: SpringParams, hp: HeatPathParams, element_size_m: float, 
     for suffix in (".dat", ".frd", ".cvg", ".sta"):
         (workdir / f"heat{suffix}").unlink(missing_ok=True)
     return reduce_case(mesh, hp, sched, times, temps, time.perf_counter() - start)
-
-
-def first_order(theta_cm: np.ndarray, dt: np.ndarray, theta_a: float, tau_s: float, gain: float) -> np.ndarray:
-    """theta_cs of eq. 4 integrated as the FE integrates (backward Euler on the same increments), degC."""
-    out = np.empty_like(theta_cm)
-    x = theta_a
-    for n in range(len(theta_cm)):
-        a = tau_s / dt[n]
-        x = (a * x + gain * theta_cm[n] + (1.0 - gain) * theta_a) / (a + 1.0)
-        out[n] = x
-    return out
-
-
-def two_lags(theta_cm: np.ndarray, dt: np.ndarray, theta_a: float, k1: float, tau1: float, k2: float,
-             tau2: float) -> np.ndarray:
-    """theta_cs as two parallel first-order lags of theta_cm - theta_a (gains k1, k2), degC."""
-    u = theta_cm - theta_a
-    out = np.empty_like(u)
-    x1 = x2 = 0.0
-    for n in range(len(u)):
-        a1, a2 = tau1 / dt[n], tau2 / dt[n]
-        x1 = (a1 * x1 + k1 * u[n]) / (a1 + 1.0)
-        x2 = (a2 * x2 + k2 * u[n]) / (a2 + 1.0)
-        out[n] = x1 + x2
-    return out + theta_a
 
 
 def identify(case: CaseResult, hp: HeatPathParams) -> dict:

@@ -6,11 +6,11 @@ from pathlib import Path
 import numpy as np
 
 from ..plotting import plt
+from .heat_fit import PAPER, first_order, two_lags
 
 
 def plot_heat_path(case, ident: dict, hp, path: Path) -> None:
     """theta_cm, theta_cs (FE), the fitted first-order ODE, the two-lag fit and the paper's ODE, with errors."""
-    from .heat_path import PAPER, first_order, two_lags
     t, th_a = case.t_s, hp.ambient_degC
     fit = first_order(case.theta_cm_degC, case.dt_s, th_a, ident["tau_s"], ident["gain"])
     tl = ident["two_lags"]

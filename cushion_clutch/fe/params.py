@@ -13,7 +13,7 @@ from pathlib import Path
 from typing import Any, Iterable
 
 from ..config import Checked, build_checked, load_toml, range_problem
-from ..model.number_check import is_finite_number, is_number
+from ..number_check import is_finite_number, is_number
 from ..data import DEFAULT_SPRING
 from .surface import load_surface
 

@@ -16,12 +16,14 @@ SLAVE = "CushionClutch"
 FMU_SRC = fmu_sources()
 #: folder of the numpy-only model modules (:mod:`cushion_clutch.model`)
 MODEL_SRC = Path(clutch_model.__file__).parent
+#: the package's ground floor (:mod:`cushion_clutch.number_check`, which the model and the loaders share)
+PACKAGE_SRC = MODEL_SRC.parent
 #: the modules the pythonfmu slave imports (siblings inside the FMU): the slave class (from ``FMU_SRC``)
-#: and the numpy-only model (from ``MODEL_SRC``)
+#: and the numpy-only model (from ``MODEL_SRC``, its number check from ``PACKAGE_SRC``)
 SLAVE_MODULES = {"cushion_slave.py": FMU_SRC, "slave_table_sets.py": FMU_SRC, "clutch_model.py": MODEL_SRC,
                  "spring_table.py": MODEL_SRC,
                  "friction.py": MODEL_SRC, "table_format.py": MODEL_SRC, "cover.py": MODEL_SRC,
-                 "number_check.py": MODEL_SRC}
+                 "number_check.py": PACKAGE_SRC}
 
 #: the native model core (shared) and the front end of each FMI version, as shipped in sources/
 CORE_HEADERS = ("clutch_core.h", "clutch_tables.h", "clutch_cover.h", "resource_uri.h")

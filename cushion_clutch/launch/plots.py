@@ -18,7 +18,7 @@ from ..model import KELVIN
 from .simulate import LaunchResult
 
 if TYPE_CHECKING:
-    from .report import Provenance
+    from .provenance import Provenance
 
 STYLE = {"naive": "-", "aware": "--", "aware_estimated": "-.", "adaptive": ":", "adaptive_aware_estimated": (0, (5, 1, 1, 1, 1, 1)),
          "production": (0, (3, 1, 1, 1))}
@@ -105,7 +105,7 @@ def plot_launches(results: dict[str, LaunchResult], out: Path,
     temperature plot shades where θ_cs leaves it and where θ_cm passes the facings' damage limit.
     ``provenance``: the scenario, version and command written on every figure (None: "unnamed").
     """
-    from .report import Provenance
+    from .provenance import Provenance
     prov = provenance or Provenance("unnamed")
     return [_plot_last(results, out, prov), _plot_temperatures(results, out, table_range_degC or _default_table_range(),
                                                                prov),

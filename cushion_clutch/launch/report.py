@@ -4,7 +4,6 @@ from __future__ import annotations
 import csv
 import math
 import textwrap
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Iterable
 
@@ -15,40 +14,12 @@ from .metrics import METRIC_COLUMNS, SUMMARY, add_temperature_metrics, summarise
 from .scenario import Scenario
 from .simulate import COLUMNS, LaunchResult, simulate_launches
 from .tcu import VARIANTS
+from .provenance import Provenance
 
 #: the summary's groups of launches: (name, selector)
 GROUPS = (("hot", lambda r: r["hot"] and r["phase"] == "repeated"),
           ("cool-down", lambda r: r["phase"] == "cool-down"),
           ("all", lambda r: True))
-
-
-@dataclass(frozen=True)
-class Provenance:
-    """What made a launch study's outputs: written on every plot and into the output set's manifest."""
-
-    scenario: str
-    """the scenario's ``name``"""
-    command: str = ""
-    """the command line that ran it (empty: not from the command line)"""
-    hot_degC: float | None = None
-    """the scenario's ``run.hot_degC``: a launch is hot when theta_cs at its start is at least this, degC
-    (None: not known, the plots say "the scenario's hot threshold")"""
-    version: str = ""
-    """cushion-clutch's version (empty: the installed package's)"""
-
-    def line(self) -> str:
-        """One line for a plot's footer: scenario, version and command."""
-        return (f"scenario '{self.scenario}' · cushion-clutch {self.version or _version()}"
-                + (f" · {self.command}" if self.command else ""))
-
-    def as_dict(self) -> dict:
-        """The manifest's entries."""
-        return {"scenario": self.scenario, "version": self.version or _version(), "command": self.command}
-
-
-def _version() -> str:
-    from .. import __version__
-    return __version__
 
 
 def lockup_counts(res: LaunchResult) -> dict:

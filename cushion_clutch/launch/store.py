@@ -16,7 +16,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from ..errors import ParameterError
-from ..model.number_check import is_finite_number, is_number
+from ..number_check import is_finite_number, is_number
 
 #: format version of the file
 VERSION = 1

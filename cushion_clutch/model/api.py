@@ -12,7 +12,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from .clutch_model import ClutchParameters, SpringTable, outputs
-from .number_check import is_finite_number
+from ..number_check import is_finite_number
 
 __all__ = ["load_table", "torque", "thermal_system"]
 

@@ -29,7 +29,7 @@ from functools import lru_cache
 try:                                    # inside the pythonfmu FMU the modules are siblings
     from .cover import CoverMap, CoverParameters, hold_problem, range_problems, wear_limit
     from .friction import FrictionTable
-    from .number_check import any_bool, is_finite_number, is_number, unit_hint
+    from ..number_check import any_bool, is_finite_number, is_number, unit_hint
     from .spring_table import KELVIN, Curve, SpringTable, pchip_slopes
     from .table_format import load_csv
 except ImportError:

@@ -99,7 +99,7 @@ import math
 from dataclasses import dataclass, fields
 
 try:                                    # inside the pythonfmu FMU the modules are siblings
-    from .number_check import is_finite_number, unit_hint
+    from ..number_check import is_finite_number, unit_hint
 except ImportError:
     from number_check import is_finite_number, unit_hint
 

@@ -17,7 +17,7 @@ from dataclasses import fields
 from pathlib import Path
 
 from .cover import CoverParameters
-from .number_check import is_number
+from ..number_check import is_number
 
 __all__ = ["load_cover", "cover_from_dict"]
 

@@ -29,12 +29,13 @@ import numpy as np
 
 try:                                    # inside the pythonfmu FMU the modules are siblings
     from .friction import FrictionTable
+    from ..number_check import KELVIN
     from .table_format import COLUMNS, FORCE_DEFLECTION, FRICTION, KISS_POINT, load_csv
 except ImportError:
     from friction import FrictionTable
+    from number_check import KELVIN
     from table_format import COLUMNS, FORCE_DEFLECTION, FRICTION, KISS_POINT, load_csv
 
-KELVIN = 273.15
 #: brackets (blended curves) a table keeps, by exact temperature
 BRACKETS_KEPT = 64
 #: largest accepted table force, N (a clutch clamp load is kN; larger values are corrupt tables)

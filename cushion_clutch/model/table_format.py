@@ -86,7 +86,7 @@ def table_set_x_kiss_ref(folder: str | Path) -> float | None:
     if not path.exists():
         return None
     try:                            # imported here: number_check imports spring_table, which imports this module
-        from .number_check import is_finite_number
+        from ..number_check import is_finite_number
     except ImportError:
         from number_check import is_finite_number
     value = json.loads(path.read_text()).get("tolerance_study", {}).get("x_kiss_ref_m")

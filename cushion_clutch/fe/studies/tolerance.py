@@ -21,7 +21,7 @@ import numpy as np
 from scipy.stats import norm, qmc
 
 from ...errors import ParameterError, StudyError
-from ...model.number_check import is_number
+from ...number_check import is_number
 from ..cases import DEFAULT_CACHE, Case, CaseOutcome, run_cases
 from ..params import TOLERANCE_KEYS, SpringParams, Tolerances
 

@@ -262,13 +262,14 @@ class StudyResult:
 def tolerance_study(params, *, samples: int, temperatures: tuple, out: Path, method: str = "lhs",
                     seed: int = 0, rank_by: str = "torque", cache_dir: Path | None = None,
                     scheduler=None, workers: int | None = None, progress=None,
-                    band_fmu: Path | None = None) -> StudyResult:
+                    build_band=None) -> StudyResult:
     """Run a whole study: draw, solve (Dask, cached), summarize, bands, plot, P5/P95 table sets.
 
     Writes ``<out>/<name>_tolerance/`` (samples.csv, *_bands.csv, tolerance_bands.png,
-    samples/s###/) and the table sets ``<out>/<name>_p05/`` and ``<out>/<name>_p95/``. With ``band_fmu``
-    (a ``.fmu`` path) also ``<out>/<name>_nominal/`` and one native FMU carrying the nominal, P5 and P95 sets,
-    chosen by its parameter ``spring`` (:mod:`cushion_clutch.fmu.table_sets`).
+    samples/s###/) and the table sets ``<out>/<name>_p05/`` and ``<out>/<name>_p95/``. With ``build_band``
+    (a function of the table folders nominal, P5, P95 that builds one FMU carrying them and returns its path:
+    the command line passes :func:`cushion_clutch.fmu.build.build_fmu`; the FE stage knows no FMU) also
+    ``<out>/<name>_nominal/`` and that FMU, its sets chosen by its parameter ``spring``.
     """
     import time
 
@@ -307,9 +308,8 @@ def tolerance_study(params, *, samples: int, temperatures: tuple, out: Path, met
         "cases": len(drawn) * len(temperatures), "cases_from_cache": n_cached, "wall_time_s": wall,
         "warnings": warnings}, indent=2) + "\n")
     fmu = None
-    if band_fmu is not None:
-        from ...fmu.build import build_fmu
+    if build_band is not None:
         nominal = write_nominal_set(summ, outcomes, Path(out) / f"{params.name}_nominal")
-        fmu = build_fmu([nominal, *(sets[q] for q in sorted(sets))], Path(band_fmu))
+        fmu = build_band([nominal, *(sets[q] for q in sorted(sets))])
     return StudyResult(study_dir, bands, summ, picks, sets, files, warnings, len(drawn) * len(temperatures),
                        n_cached, wall, fmu)

@@ -12,10 +12,8 @@ import math
 
 __all__ = ["is_number", "is_finite_number", "any_bool", "unit_hint"]
 
-try:                                    # inside the pythonfmu FMU the modules are siblings
-    from .spring_table import KELVIN
-except ImportError:
-    from spring_table import KELVIN
+#: 0 degC in K: the one kelvin offset of the model (spring_table and the rest take it from here)
+KELVIN = 273.15
 
 
 def is_number(value: object) -> bool:

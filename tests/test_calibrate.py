@@ -94,6 +94,11 @@ def test_calibrated_toml_reads_back_unchanged(tmp_path):
 
 
 @pytest.mark.ccx
+@pytest.mark.xfail(strict=True, reason=(
+    "known regression of the -40..350 degC re-sweep (issue 37, open): with the carrier clearance at 0.02 mm the "
+    "20 degC curve hardly depends on the wave height (d ln F / d ln p about -0.1) and the fit misses it by +2.7 % "
+    "at the 3 mm mesh (2.9 of its own 1-sigma) and by +13.7 % at 2 mm; the thickness is recovered within 0.1 %. "
+    "Strict: the day it passes again, this mark must go"))
 def test_parameter_recovery_from_noisy_fe_measurement(tmp_path):
     """wave height +8 %, thickness -5 %, 1.5 % noise fitted as measured (no running maximum): within 2 %."""
     base = load_params().replace(**RECOVERY)
@@ -110,12 +115,7 @@ def test_parameter_recovery_from_noisy_fe_measurement(tmp_path):
     cal = calibrate(base, Measured(u, f, "pair"), ["wave_height_m", "thickness_m"],
                     cache_dir=tmp_path / "cache", jobs=2)
     err = cal.values / true - 1
-    # within 2 % or, for a weakly identified parameter, within twice the fit's own 1-sigma: the truth must lie
-    # inside the uncertainty the calibration reports (with the 0.02 mm carrier clearance the wave height moves
-    # the force little, d ln F / d ln p about -0.1, so 1.5 % noise leaves it a few % uncertain)
-    assert np.all(np.abs(cal.values - true) <= np.maximum(0.02 * true, 2.0 * cal.std)), (cal.values, true, err,
-                                                                                        cal.std)
-    assert abs(err[1]) < 0.02, (cal.values, true, err)                # the thickness, well identified
+    assert np.all(np.abs(err) < 0.02), (cal.values, true, err)
     assert cal.rms_pct < 2.0
     assert not any("bound" in w for w in cal.warnings()), cal.warnings()
     from cushion_clutch.fe.studies.calibration_report import report_text

@@ -111,11 +111,12 @@ for name in sys.argv[1:]:
         mod = importlib.import_module(name)
     except ModuleNotFoundError as exc:
         # the pythonfmu slave scripts import their siblings and the model top-level, as pythonfmu
-        # loads them from the FMU's resources (the build copies cushion_clutch.model there): import
-        # them so, from the wheel's folders
+        # loads them from the FMU's resources (the build copies cushion_clutch.model and the ground
+        # floor's number_check there: fmu.constants.SLAVE_MODULES): import them so, from the wheel's folders
         pkg, _, base = name.rpartition(".")
         folders = [importlib.import_module(pkg).__path__[0],
-                   importlib.import_module("cushion_clutch.model").__path__[0]]
+                   importlib.import_module("cushion_clutch.model").__path__[0],
+                   importlib.import_module("cushion_clutch").__path__[0]]
         sys.path[:0] = folders
         try:
             mod = importlib.import_module(base)

@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 import atexit
-import csv
 import shutil
 import tempfile
 from functools import lru_cache
@@ -10,18 +9,12 @@ from pathlib import Path
 
 from cushion_clutch.data import DEFAULT_TABLES
 from cushion_clutch.fmu.build import build_fmu
-from cushion_clutch.model.table_format import FORCE_DEFLECTION
 
 
 def scaled_tables(dst: Path, factor: float, src: Path = DEFAULT_TABLES) -> Path:
     """A copy of the table set ``src`` in ``dst`` with every force_N multiplied by ``factor`` (the issue's DIR2)."""
-    shutil.copytree(src, dst)
-    with (src / FORCE_DEFLECTION).open(newline="") as f:
-        rows = list(csv.reader(f))
-    with (dst / FORCE_DEFLECTION).open("w", newline="") as f:
-        csv.writer(f, lineterminator="\n").writerows([rows[0], *([t, u, repr(float(F) * factor)]
-                                                                 for t, u, F in rows[1:])])
-    return dst
+    from cushion_clutch.fmu.ssp_doc import scaled_copy
+    return scaled_copy(dst, factor, src)
 
 
 @lru_cache(maxsize=None)

@@ -24,22 +24,31 @@ X_TO_M, THETA_K = (0.008, 0.014), 293.15
 SCALE = 0.9
 
 
+def scaled_copy(dest: Path, factor: float, src: Path | None = None) -> Path:
+    """A copy of the table set ``src`` (default: the shipped one) in ``dest`` with every ``force_N`` times
+    ``factor`` (the issue's DIR2; the tests make theirs with it too)."""
+    from ..data import DEFAULT_TABLES
+    from ..model.table_format import FORCE_DEFLECTION
+    src = Path(src or DEFAULT_TABLES)
+    shutil.copytree(src, dest)
+    with (src / FORCE_DEFLECTION).open(newline="") as f:
+        rows = list(csv.reader(f))
+    with (dest / FORCE_DEFLECTION).open("w", newline="") as f:
+        csv.writer(f, lineterminator="\n").writerows([rows[0], *([t, u, repr(float(F) * factor)]
+                                                                 for t, u, F in rows[1:])])
+    return dest
+
+
 def soft_copy(dest: Path) -> Path:
     """The default table set with every force x :data:`SCALE`, in ``dest`` (a folder named ``soft``)."""
     import json
 
-    from ..data import DEFAULT_TABLES
-    from ..model.table_format import FORCE_DEFLECTION, METADATA
-    shutil.copytree(DEFAULT_TABLES, dest)
+    from ..model.table_format import METADATA
+    scaled_copy(dest, SCALE)
     meta = json.loads((dest / METADATA).read_text())
     meta["spring"]["description"] = (f"the default spring's tables with every force x {SCALE} (an example set made "
                                      "by scaling, not by the FE)")
     (dest / METADATA).write_text(json.dumps(meta, indent=2) + "\n")
-    with (DEFAULT_TABLES / FORCE_DEFLECTION).open(newline="") as f:
-        rows = list(csv.reader(f))
-    with (dest / FORCE_DEFLECTION).open("w", newline="") as f:
-        csv.writer(f, lineterminator="\n").writerows([rows[0], *([t, u, repr(float(F) * SCALE)]
-                                                                 for t, u, F in rows[1:])])
     return dest
 
 

@@ -72,12 +72,9 @@ def _slave(fmu):
     return s, {v.name: v.valueReference for v in md.modelVariables}
 
 
-def test_the_set_is_refused_out_of_range_and_after_initialisation(capfd):
-    s, vr = _slave(two_set_fmu(2))
-    s.instantiate(loggingOn=False)
-    with pytest.raises(FMICallException):
-        s.setInteger([vr["spring"]], [3])
-    assert "spring = 3: allowed 1..2" in capfd.readouterr().out
+def _set_two_then_refuse_a_change(s, vr, capfd) -> None:
+    """Choose set 2, initialise, and check that a change of ``spring`` afterwards is refused with its message
+    and leaves set 2 chosen."""
     s.setInteger([vr["spring"]], [2])
     s.setupExperiment(startTime=0.0)
     s.enterInitializationMode()
@@ -87,6 +84,15 @@ def test_the_set_is_refused_out_of_range_and_after_initialisation(capfd):
         s.setInteger([vr["spring"]], [1])
     assert "parameter spring (the table set) is fixed after initialization" in capfd.readouterr().out
     assert s.getInteger([vr["spring"]]) == [2]
+
+
+def test_the_set_is_refused_out_of_range_and_after_initialisation(capfd):
+    s, vr = _slave(two_set_fmu(2))
+    s.instantiate(loggingOn=False)
+    with pytest.raises(FMICallException):
+        s.setInteger([vr["spring"]], [3])
+    assert "spring = 3: allowed 1..2" in capfd.readouterr().out
+    _set_two_then_refuse_a_change(s, vr, capfd)
     s.setReal([vr["x_to"], vr["theta_cm"]], [0.008, 293.15])
     s.doStep(0.0, 0.1)
     state = s.getFMUstate()
@@ -188,14 +194,6 @@ def test_the_pythonfmu_backend_carries_the_sets_too(capfd):
         assert abs(chosen - _torque(two_set_fmu(2), x_to, theta, {"spring": 2})) <= 1e-9
     s, vr = _slave(two)
     s.instantiate(loggingOn=True)
-    s.setInteger([vr["spring"]], [2])
-    s.setupExperiment(startTime=0.0)
-    s.enterInitializationMode()
-    s.exitInitializationMode()
-    assert s.getInteger([vr["spring"]]) == [2]
-    with pytest.raises(FMICallException):
-        s.setInteger([vr["spring"]], [1])
-    assert "parameter spring (the table set) is fixed after initialization" in capfd.readouterr().out
-    assert s.getInteger([vr["spring"]]) == [2]
+    _set_two_then_refuse_a_change(s, vr, capfd)
     s.terminate()
     s.freeInstance()

@@ -610,17 +610,22 @@ def _force(p: argparse.ArgumentParser) -> None:
 def build_parser() -> argparse.ArgumentParser:
     """The ``cushion-clutch`` argument parser (also what the documentation's CLI reference is generated from)."""
     from . import __version__
-    from .fmu.build import add_backend, add_build_arguments
-    from .fe.params import DEFAULT_SPRING
-    from .launch.scenario import DEFAULT_SCENARIO
-    from .launch.tcu import VARIANTS
-    from .fe.cases import DEFAULT_CACHE
-
     parser = argparse.ArgumentParser(prog="cushion-clutch", description=DESCRIPTION, epilog=EPILOG,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--version", action="version", version=f"cushion-clutch {__version__}")
     _global_options(parser, False)
     sub = parser.add_subparsers(dest="job", required=True, metavar="<command>")
+    _simulation_commands(sub)
+    _fmu_commands(sub)
+    _fe_commands(sub)
+    return parser
+
+
+def _simulation_commands(sub) -> None:
+    """``launch``, ``fleet`` and ``simulate``: the commands that run the clutch FMU."""
+    from .fmu.build import add_backend
+    from .launch.scenario import DEFAULT_SCENARIO
+    from .launch.tcu import VARIANTS
 
     la = _command(sub, "launch", _launch, f"repeated launches with the {len(VARIANTS)} TCU variants (main job)",
                   f"Build the clutch FMU from --tables (or take --fmu), run a launch scenario with each of the "
@@ -681,6 +686,11 @@ def build_parser() -> argparse.ArgumentParser:
     sm.add_argument("--engagements", type=int, default=12, help="number of engagements (60 s apart)")
     sm.add_argument("--step", type=float, default=0.1, help="communication step [s]")
 
+
+def _fmu_commands(sub) -> None:
+    """``build-fmu``, ``export-ssp`` and ``export``: the commands that package the tables for a host."""
+    from .fmu.build import add_build_arguments
+
     bf = _command(sub, "build-fmu", _build_fmu, "build the clutch FMU from a table set (native C by default)",
                   "Build CushionClutch.fmu with the table set in its resources: the native C FMU (FMI 2.0 "
                   "or 3.0, Co-Simulation and Model Exchange, binaries for Linux, Windows and macOS) or the "
@@ -713,6 +723,13 @@ def build_parser() -> argparse.ArgumentParser:
     ex.add_argument("--tables", default=DEFAULT_TABLES, help="table folder")
     _out(ex, "output folder (default: out)", default="out")
     _force(ex)
+
+
+def _fe_commands(sub) -> None:
+    """``sweep``, ``check-spring``, ``calibrate``, ``import-scan``, ``heat-path`` and ``tolerance``: the
+    commands of the FE stage (CalculiX)."""
+    from .fe.cases import DEFAULT_CACHE
+    from .fe.params import DEFAULT_SPRING
 
     sw = _command(sub, "sweep", _sweep, "run the CalculiX temperature sweep and write lookup tables",
                   "Solve the spring's paddle pair with CalculiX at every sweep temperature (one ccx job per "
@@ -815,7 +832,7 @@ def build_parser() -> argparse.ArgumentParser:
     to.add_argument("--cache", default=DEFAULT_CACHE, help="case cache folder (shared with sweep)")
     to.add_argument("--fmu", type=Path, help="also write one native FMU (.fmu) carrying the nominal, P5 and P95 table "
                                              "sets, chosen by its parameter spring")
-    return parser
+
 
 
 def main(argv: list[str] | None = None) -> int:

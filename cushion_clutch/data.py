@@ -3,7 +3,10 @@
 The wheel carries the shipped table sets (``cushion_clutch.lookup_tables``,
 the repository's ``lookup_tables/``), the spring and scenario files, and the
 FMU sources (``cushion_clutch.fmu_src``, the repository's ``fmu_src/``, a data
-folder that nothing imports: the C model, the pythonfmu slave and the test hosts).
+folder that nothing imports), one folder per role: ``core/`` (the C model, the twin of
+:mod:`cushion_clutch.model`), ``fmi/`` (the FMI 2.0 and 3.0 front ends), ``hosts/`` (the launch plant's and the
+production TCU's host libraries), ``pythonfmu/`` (the pythonfmu slave and its guard library) and ``bench/`` (the
+C hosts the shipped benchmarks compile).
 """
 from __future__ import annotations
 
@@ -27,8 +30,27 @@ def shipped_tables(name: str = "default") -> Path:
 
 
 def fmu_sources() -> Path:
-    """Folder of the FMU sources: the C model (``clutch_core.c``, ...), ``CushionClutch.py``, ``cushion_slave.py``."""
+    """Folder of the FMU sources, one sub-folder per role (:data:`FMU_ROLES`)."""
     return _folder("cushion_clutch.fmu_src")
+
+
+#: the role folders of the FMU sources (``fmu_src/<role>/``); a file name is unique across them
+FMU_ROLES = ("core", "fmi", "hosts", "pythonfmu", "bench")
+
+
+def fmu_source(name: str) -> Path:
+    """The FMU source file ``name`` (``clutch_core.c``, ``launch_plant.h``, ...) in its role folder.
+
+    Raises
+    ------
+    FileNotFoundError
+        If no role folder holds ``name``.
+    """
+    root = fmu_sources()
+    for role in FMU_ROLES:
+        if (root / role / name).is_file():
+            return root / role / name
+    raise FileNotFoundError(f"{name}: not an FMU source (looked in {', '.join(FMU_ROLES)} of {root})")
 
 
 #: the default spring parameter file

@@ -8,7 +8,7 @@ the issue, per backend:
 - native rows are written to the spec (state machine, GUID, checked states,
   tables in any order, overflow, GetBooleanStatus after Discard);
 - pythonfmu rows: the native FMU's statuses (the guard library in front of the
-  wrapper, ``fmu_src/pythonfmu_guard.c``, returns the fmi2Error and fmi2Warning
+  wrapper, ``fmu_src/pythonfmu/pythonfmu_guard.c``, returns the fmi2Error and fmi2Warning
   the slave sends, which the wrapper alone cannot return; issue 31); the guard
   also refuses NULL or wrong resource locations and a wrong GUID before the
   wrapper sees them, so no row crashes the host.
@@ -257,7 +257,7 @@ def test_native_catalogue_under_asan(fmus, tmp_path):
 
 
 # ---------------------------------------------------------------------------------------------
-# The native FMU through our C host (fmu_src/hosts/fault_host.c): the same rows and expectations,
+# The native FMU through our C host (tests/c_hosts/fault_host.c): the same rows and expectations,
 # with a printf-style logger as C masters have; and the same host under valgrind memcheck.
 C_HOST_CASES = ("step_before_init", "step_after_terminate", "exit_init_after_steps", "set_output",
                 "set_fixed_param_after_init", "set_partially_bad", "set_unknown_vr", "negative_step",
@@ -270,7 +270,6 @@ EXPECT = {case: nat for case, _, nat, _ in CATALOGUE}
 @pytest.fixture(scope="module")
 def c_host(fmus, tmp_path_factory):
     """The compiled fault host and the native FMU unpacked (plus a copy with a '%s%n' table cell)."""
-    from cushion_clutch.data import fmu_sources
     from cushion_clutch.fmu.native import fmi2_header_dir
     gcc = shutil.which("gcc")
     if gcc is None:
@@ -278,7 +277,7 @@ def c_host(fmus, tmp_path_factory):
     work = tmp_path_factory.mktemp("c_host")
     exe = work / "fault_host"
     subprocess.run([gcc, "-std=c99", "-D_POSIX_C_SOURCE=200809L", "-O1", "-g", "-Wall", "-Wextra",
-                    f"-I{fmi2_header_dir()}", str(fmu_sources() / "hosts" / "fault_host.c"), "-o", str(exe),
+                    f"-I{fmi2_header_dir()}", str(Path(__file__).parent / "c_hosts" / "fault_host.c"), "-o", str(exe),
                     "-ldl", "-lpthread", "-lm"], check=True)
     unzip = work / "fmu"
     with zipfile.ZipFile(fmus["native"]) as z:

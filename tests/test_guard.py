@@ -1,4 +1,4 @@
-"""The pythonfmu FMU's guard (fmu_src/pythonfmu_guard.c, cushion_clutch/fmu/guard.py): it exports the
+"""The pythonfmu FMU's guard (fmu_src/pythonfmu/pythonfmu_guard.c, cushion_clutch/fmu/guard.py): it exports the
 FMI 2.0 Co-Simulation API, and refuses what would kill the host in pythonfmu's wrapper, with a
 message through the host's logger, on Linux (fmpy) and on Windows (our C host under Wine)."""
 import json

@@ -1,4 +1,4 @@
-"""The compiled plant steps (launch/plant_block.py, fmu_src/launch_plant.c) against the Python loop, the reference.
+"""The compiled plant steps (launch/plant_block.py, fmu_src/hosts/launch_plant.c) against the Python loop, the reference.
 
 Both paths must give the same time series, per-launch metrics, energy terms, lock events and TCU estimates
 (the plant's thermal network steps in C too, in the blocks and in the quiet periods: its temperatures are in

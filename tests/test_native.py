@@ -11,7 +11,7 @@ from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import FMU2Slave
 from fmpy.validation import validate_fmu
 
-from cushion_clutch.data import DEFAULT_TABLES, fmu_sources
+from cushion_clutch.data import DEFAULT_TABLES, fmu_source
 from cushion_clutch.fmu.build import build_fmu
 from cushion_clutch.fmu.descriptions import sources
 from cushion_clutch.fmu.native import fmi2_header_dir
@@ -20,7 +20,7 @@ from native_builds import assert_final_matches_model
 
 pytestmark = pytest.mark.fmu
 
-HOST_SRC = fmu_sources() / "hosts" / "fmi2_host.c"
+HOST_SRC = fmu_source("fmi2_host.c")
 OUT = ["torque", "force", "theta_cs", "u_f", "x_kiss", "clamp_force", "bearing_force"]
 
 

@@ -15,7 +15,7 @@ from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import FMU2Slave, fmi2LastSuccessfulTime, fmi2Terminated
 from fmpy.fmi3 import FMU3Slave
 
-from cushion_clutch.data import fmu_sources
+from cushion_clutch.data import fmu_source
 from cushion_clutch.model import VARIABLES, ClutchParameters, load_table, outputs, thermal_step
 from native_builds import native_fmus
 
@@ -397,9 +397,9 @@ URIS = [  # (windows, uri, expected)
 
 def test_resource_uri_forms(tmp_path):
     exe = tmp_path / "uri_driver"
-    src = fmu_sources()
-    subprocess.run([shutil.which("gcc"), "-std=c99", "-Wall", "-I", str(src), str(Path(__file__).parent / "c/uri_driver.c"),
-                    str(src / "resource_uri.c"), "-o", str(exe), "-lm"], check=True)
+    src = fmu_source("resource_uri.c")
+    subprocess.run([shutil.which("gcc"), "-std=c99", "-Wall", "-I", str(src.parent), str(Path(__file__).parent / "c/uri_driver.c"),
+                    str(src), "-o", str(exe), "-lm"], check=True)
     for windows in (0, 1):
         cases = [c for c in URIS if c[0] == windows]
         out = subprocess.run([str(exe), str(windows), *[c[1] for c in cases]], capture_output=True, check=True)

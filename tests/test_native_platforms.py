@@ -5,12 +5,13 @@ import shutil
 import subprocess
 import sys
 import zipfile
+from pathlib import Path
 
 import lief
 import pytest
 from fmpy import read_model_description
 
-from cushion_clutch.data import fmu_sources
+from cushion_clutch.data import fmu_source
 from cushion_clutch.fmu.descriptions import sources
 from cushion_clutch.fmu.native import fmi_header_dir
 from conftest import WINE
@@ -66,10 +67,16 @@ def test_every_binary_has_its_architecture_and_exports_exactly_the_fmi_api(tmp_p
     assert len(fmi_functions(2)) == 44 and len(fmi_functions(3)) > 70
 
 
+#: the C hosts: FMI 2.0's is the benchmarks' (fmu_src/bench), FMI 3.0's the tests' own (tests/c_hosts)
+HOST_SOURCES = {2: fmu_source("fmi2_host.c"), 3: Path(__file__).parent / "c_hosts" / "fmi3_host.c"}
+#: the folder of host_platform.h, which both hosts include
+HOST_INCLUDE = f"-I{fmu_source('host_platform.h').parent}"
+
+
 def _windows_host(tmp_path, version):
     host = tmp_path / f"fmi{version}_host.exe"
     subprocess.run([sys.executable, "-m", "ziglang", "cc", "-target", "x86_64-windows-gnu", "-std=c99", "-O2",
-                    f"-I{fmi_header_dir()}", str(fmu_sources() / "hosts" / f"fmi{version}_host.c"), "-o", str(host)],
+                    f"-I{fmi_header_dir()}", HOST_INCLUDE, str(HOST_SOURCES[version]), "-o", str(host)],
                    check=True, capture_output=True)
     return host
 
@@ -122,7 +129,7 @@ def test_fmi3_c_host_under_address_sanitizer_matches_the_model(tmp_path):
                     *(str(srcs / f) for f in sources(3)), "-o", str(lib), "-lm"], check=True)
     host = tmp_path / "fmi3_host"
     subprocess.run([cc, "-std=c99", "-D_POSIX_C_SOURCE=199309L", *flags, f"-I{fmi_header_dir()}",
-                    str(fmu_sources() / "hosts" / "fmi3_host.c"), "-o", str(host), "-ldl"], check=True)
+                    HOST_INCLUDE, str(HOST_SOURCES[3]), "-o", str(host), "-ldl"], check=True)
     res = subprocess.run([str(host), str(lib), str(unzip / "resources") + "/", read_model_description(str(fmu)).guid,
                           "3000", "0.01"], capture_output=True, text=True,
                          env={"ASAN_OPTIONS": "detect_leaks=1", "UBSAN_OPTIONS": "halt_on_error=1",

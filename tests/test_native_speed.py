@@ -1,5 +1,5 @@
 """The native step's caches are exact: the branch-free interval search, the table-interval hint, the Newton hints and the
-frame memo of the cover (fmu_src/clutch_tables.c, clutch_cover.c) give the same bits as the plain searches and
+frame memo of the cover (fmu_src/core/clutch_tables.c, clutch_cover.c) give the same bits as the plain searches and
 a freshly prepared cover, over random sequences (a C driver over the shipped default tables).
 
 Their speed is measured by ``python -m cushion_clutch.benchmarks.fmu`` (the C host's time per step) and with
@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 from fmpy import read_model_description
 
-from cushion_clutch.data import DEFAULT_TABLES, fmu_sources
+from cushion_clutch.data import DEFAULT_TABLES, fmu_source
 from cushion_clutch.fmu.build import build_fmu
 from cushion_clutch.fmu.native import fmi2_header_dir, stage_sources
 from cushion_clutch.model.table_format import table_set_x_kiss_ref
@@ -195,7 +195,7 @@ def test_c_host_checksum_is_deterministic_and_independent_of_the_compiler(tmp_pa
     zipfile.ZipFile(fmu).extractall(unzip)
     host = tmp_path / "host"
     subprocess.run([cc, "-std=c99", "-D_POSIX_C_SOURCE=199309L", "-O2", f"-I{fmi2_header_dir()}",
-                    str(fmu_sources() / "hosts" / "fmi2_host.c"), "-o", str(host), "-ldl"], check=True)
+                    str(fmu_source("fmi2_host.c")), "-o", str(host), "-ldl"], check=True)
     gcc_lib = tmp_path / "gcc.so"
     files = [str(p) for p in sorted((unzip / "sources").glob("*.c"))]
     subprocess.run([cc, "-std=c99", "-O2", "-fPIC", "-shared", "-fvisibility=hidden", f"-I{unzip / 'sources'}",
@@ -353,7 +353,7 @@ extern long cc_count_evals, cc_count_open; /* clutch_cover.c built with -DCC_COU
 
 /* the inputs of step k: pattern 0 a launch's (1 ms steps: the bearing closes over 0.8 s, holds, opens; theta_cs
    drifts over and beyond the tables, theta_cm is held for 10 ms, facing wear 0 or 0.8 mm per engagement);
-   pattern 1 the C host's (fmu_src/hosts/fmi2_host.c: jumps of 0.4 mm and more every step); pattern 2 a braked
+   pattern 1 the C host's (fmu_src/bench/fmi2_host.c: jumps of 0.4 mm and more every step); pattern 2 a braked
    standstill's (the bearing opening from 4.5 mm and decaying exponentially, 2 ms, through subnormal numbers to 0, as
    the launch loop's actuator lag does; theta_cs cooling every step, 3 K above theta_cm with a time constant of
    600 s, about 5 uK per step as in the recorded launch's standstill; theta_cm held for 50 ms) */

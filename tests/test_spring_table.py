@@ -1,4 +1,4 @@
-"""The FMUs' table reader (fmu_src/spring_table.py): rows in any order, against hand-written tables."""
+"""The FMUs' table reader (model/spring_table.py): rows in any order, against hand-written tables."""
 import dataclasses
 import shutil
 

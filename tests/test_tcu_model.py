@@ -1,5 +1,5 @@
 """The production TCU's clutch model torque through the native clutch model (cushion_clutch/launch/tcu_model.py,
-fmu_src/tcu_model.c) against the Python model, the reference: the same torque to round-off over a scan of the
+fmu_src/hosts/tcu_model.c) against the Python model, the reference: the same torque to round-off over a scan of the
 bearing position and both temperatures, the same inverse (bearing position for a torque) within its tolerance over
 a scan of torque and both temperatures, the round trip torque(x(T)) = T, the same errors outside the ranges, a
 logged fallback, and the same figures of a production launch run."""

@@ -49,17 +49,34 @@ def _dependency_venv() -> Path:
 
 
 @pytest.fixture(scope="module")
-def installed(tmp_path_factory):
-    """(python, cushion-clutch script, environment) of an isolated venv: dependencies from pip, the project
-    only from the built wheel."""
+def wheel(tmp_path_factory):
+    """The wheel, built from a clean copy of the sources (a stale build/ folder in the checkout would put
+    modules into the wheel that the sources no longer package: setuptools reuses build/lib)."""
     root = tmp_path_factory.mktemp("wheel")
     dist = root / "dist"
-    # built from a clean copy of the sources: a stale build/ folder in the checkout would put modules
-    # into the wheel that the sources no longer package (setuptools reuses build/lib)
     src = scratch_copy(REPO, root / "src")
     subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps", "-q",
                     "-w", str(dist), str(src)], check=True, capture_output=True)
-    wheel = next(dist.glob("cushion_clutch-*.whl"))
+    return next(dist.glob("cushion_clutch-*.whl"))
+
+
+def test_wheel_carries_every_fmu_source_and_no_test_host(wheel):
+    """Every file of fmu_src's role folders is in the wheel (the FMU builds and host libraries read them there);
+    the C hosts only the tests compile (tests/c_hosts) are not."""
+    import zipfile
+    names = set(zipfile.ZipFile(wheel).namelist())
+    shipped = {f"cushion_clutch/fmu_src/{p.relative_to(REPO / 'fmu_src').as_posix()}"
+               for p in (REPO / "fmu_src").rglob("*") if p.is_file() and "__pycache__" not in p.parts}
+    assert shipped - names == set()
+    assert {n for n in names if n.startswith("cushion_clutch/fmu_src/")} == shipped
+    test_hosts = {p.name for p in (REPO / "tests" / "c_hosts").glob("*.c")}
+    assert test_hosts and not {n for n in names if n.rsplit("/", 1)[-1] in test_hosts}
+
+
+@pytest.fixture(scope="module")
+def installed(wheel):
+    """(python, cushion-clutch script, environment) of an isolated venv: dependencies from pip, the project
+    only from the built wheel."""
     env_dir = _dependency_venv()
     py = env_dir / "bin" / "python"
     pip = [sys.executable, "-m", "pip", "--python", str(py)]

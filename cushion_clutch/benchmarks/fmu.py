@@ -1,7 +1,7 @@
 """Benchmark: time per step of the CushionClutch FMUs (pythonfmu and native C), and the native build time.
 
 Through fmpy (FMU2Slave: set 2 inputs, doStep, get 5 outputs), in our small C
-host (fmu_src/hosts/fmi2_host.c, dlopen; with valgrind also the native step's instructions, callgrind, which
+host (fmu_src/bench/fmi2_host.c, dlopen; with valgrind also the native step's instructions, callgrind, which
 do not depend on the machine's load), and the Python model alone; the time
 to build the native FMU with the binaries of every platform (FMI 2.0: 3, FMI 3.0: 5),
 with zig's cache warm, and with ``--cold`` also from an empty zig cache.
@@ -9,7 +9,7 @@ with zig's cache warm, and with ``--cold`` also from an empty zig cache.
     python -m cushion_clutch.benchmarks.fmu [--steps 200000] [--cold] [--thermal-only] [--ab REF]
 
 The thermal FMU (``build-fmu --thermal``) against the plain one, both native in the C host
-``fmu_src/hosts/fmi2_duty_host.c`` on the same bearing sweep with 100 rad/s of slip (the plain FMU
+``fmu_src/bench/fmi2_duty_host.c`` on the same bearing sweep with 100 rad/s of slip (the plain FMU
 also gets a theta_cm sweep, the thermal one an engine speed): median of 5 alternating runs and the ratio
 (target: at most 3x). ``--thermal-only`` runs only this comparison.
 
@@ -74,17 +74,17 @@ def time_fmpy(fmu: Path, n: int, h: float = 1e-3) -> tuple[float, float]:
 
 
 def compile_host(dest: Path) -> Path:
-    from cushion_clutch.data import fmu_sources
+    from cushion_clutch.data import fmu_source
     from cushion_clutch.fmu.native import fmi2_header_dir
     subprocess.run([shutil.which("gcc") or "cc", "-std=c99", "-D_POSIX_C_SOURCE=199309L", "-O2",
-                    f"-I{fmi2_header_dir()}", str(fmu_sources() / "hosts" / "fmi2_host.c"), "-o", str(dest), "-ldl"], check=True)
+                    f"-I{fmi2_header_dir()}", str(fmu_source("fmi2_host.c")), "-o", str(dest), "-ldl"], check=True)
     return dest
 
 
 #: the C host's input patterns for the native FMU: name -> what it stands for
 PATTERNS = {"jump": "every step a cold solve", "launch": "what a time-stepping host feeds"}
 
-#: value references the C host's replay pattern uses (fmu_src/hosts/fmi2_host.c): set, then read
+#: value references the C host's replay pattern uses (fmu_src/bench/fmi2_host.c): set, then read
 REPLAY_VRS = {"x_to": 0, "theta_cm": 1, "omega_slip": 17, "torque": 2, "theta_cs": 4, "x_kiss": 6}
 
 
@@ -247,13 +247,13 @@ def time_thermal(tmp: Path, n: int, repeats: int = 5) -> tuple[float, float]:
 
     from fmpy import read_model_description
 
-    from cushion_clutch.data import DEFAULT_TABLES, fmu_sources
+    from cushion_clutch.data import DEFAULT_TABLES, fmu_source
     from cushion_clutch.fmu.build import build_fmu
     from cushion_clutch.fmu.native import fmi2_header_dir
 
     host = tmp / "duty_host"
     subprocess.run([shutil.which("gcc") or "cc", "-std=c99", "-D_POSIX_C_SOURCE=199309L", "-O2",
-                    f"-I{fmi2_header_dir()}", str(fmu_sources() / "hosts" / "fmi2_duty_host.c"), "-o", str(host),
+                    f"-I{fmi2_header_dir()}", str(fmu_source("fmi2_duty_host.c")), "-o", str(host),
                     "-ldl"], check=True)
     runs = {}
     for label, thermal in (("plain", False), ("thermal", True)):
@@ -297,7 +297,7 @@ def time_ab(tmp: Path, ref: str, n: int, repeats: int = 9, launches: int = 2) ->
 
     from fmpy import read_model_description
 
-    from cushion_clutch.data import DEFAULT_TABLES, fmu_sources
+    from cushion_clutch.data import DEFAULT_TABLES, fmu_source, fmu_sources
     from cushion_clutch.fmu.constants import CORE_HEADERS
     from cushion_clutch.fmu.crossbuild import HOST, compile_command
     from cushion_clutch.fmu.native import build_native_fmu, sources
@@ -317,8 +317,12 @@ def time_ab(tmp: Path, ref: str, n: int, repeats: int = 9, launches: int = 2) ->
         shutil.copytree(unzip / "sources", src)
         if label == ref:                 # the ref's model sources over the generated headers of this checkout
             for name in (*files, *CORE_HEADERS):
-                got = subprocess.run(["git", "-C", str(fmu_sources()), "show", f"{ref}:fmu_src/{name}"],
-                                     capture_output=True, text=True)
+                role = fmu_source(name).parent.name         # a ref before the role folders has it in fmu_src/
+                for path in (f"fmu_src/{role}/{name}", f"fmu_src/{name}"):
+                    got = subprocess.run(["git", "-C", str(fmu_sources()), "show", f"{ref}:{path}"],
+                                         capture_output=True, text=True)
+                    if got.returncode == 0:
+                        break
                 if got.returncode and name in CORE_HEADERS:   # a header the ref did not have yet: unused there
                     continue
                 got.check_returncode()
@@ -416,7 +420,7 @@ def time_builds(tmp: Path, cold: bool) -> None:
 
 #: the results page's intro
 PAGE_INTRO = ("Cost of one FMU step (set inputs, doStep, get outputs; 1 ms communication step) for the native and "
-              "the pythonfmu FMU, through fmpy and in our C host (`fmu_src/hosts/fmi2_host.c`), the Python model "
+              "the pythonfmu FMU, through fmpy and in our C host (`fmu_src/bench/fmi2_host.c`), the Python model "
               "alone, and the time to build the native FMU for every platform. The native FMU runs in the C host "
               "in two input patterns: the host's jump pattern (every step a cold solve) and a launch pattern "
               "(the inputs a launch of the default scenario gives the FMU, set only when they change: what a "

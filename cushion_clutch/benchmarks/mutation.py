@@ -4,7 +4,7 @@ Two parts, both on a temporary copy of the checkout (the checkout itself is neve
 
 ``hand``
     Our own list of mutants (:data:`MUTANTS`): sign flips, off-by-one and status changes in the
-    C core (``fmu_src/*.c``), and the Python mutants that survived every test on c5f3d16 (issue 21).
+    C core (``fmu_src/core/*.c``), and the Python mutants that survived every test on c5f3d16 (issue 21).
     Each is applied alone and the tests named for it run; the mutant is *killed* when they fail.
 ``mutmut``
     `mutmut <https://pypi.org/project/mutmut/>`_ (``pip install -e .[mutation]``) over the Python
@@ -49,46 +49,46 @@ class Mutant:
 
 MUTANTS = (
     # ---- C core: sign flips
-    Mutant("c-der-sign", "fmu_src/clutch_core.c",
+    Mutant("c-der-sign", "fmu_src/core/clutch_core.c",
            "r[CC_VR_DER_THETA_CS] = (r[VR_U] * r[VR_THETA_CM] + r[VR_H] * r[VR_THETA_A] - g * r[VR_THETA_CS]) / r[VR_C];",
            "r[CC_VR_DER_THETA_CS] = -(r[VR_U] * r[VR_THETA_CM] + r[VR_H] * r[VR_THETA_A] - g * r[VR_THETA_CS]) / r[VR_C];",
            NATIVE_TESTS, "exposed der(theta_cs) output with the wrong sign (survived on c5f3d16)"),
-    Mutant("c-kiss-sign", "fmu_src/clutch_cover.c",
+    Mutant("c-kiss-sign", "fmu_src/core/clutch_cover.c",
            "stack = (w == 0.0 ? tb->delta[i] : (1.0 - w) * tb->delta[i] + w * tb->delta[i + 1]) +",
            "stack = -(w == 0.0 ? tb->delta[i] : (1.0 - w) * tb->delta[i] + w * tb->delta[i + 1]) +",
            NATIVE_TESTS, "kiss point moves the wrong way when hot"),
-    Mutant("c-step-decay-sign", "fmu_src/clutch_core.c",
+    Mutant("c-step-decay-sign", "fmu_src/core/clutch_core.c",
            "exp(-h * g / r[VR_C])", "exp(h * g / r[VR_C])", NATIVE_TESTS, "CS thermal step grows instead of decays"),
-    Mutant("c-me-der-sign", "fmu_src/clutch_core.c",
+    Mutant("c-me-der-sign", "fmu_src/core/clutch_core.c",
            "*der = (r[VR_U] * r[VR_THETA_CM] + r[VR_H] * r[VR_THETA_A] - (r[VR_U] + r[VR_H]) * theta) / r[VR_C];",
            "*der = (r[VR_U] * r[VR_THETA_CM] - r[VR_H] * r[VR_THETA_A] - (r[VR_U] + r[VR_H]) * theta) / r[VR_C];",
            NATIVE_TESTS, "ME derivative with the ambient term's sign flipped"),
-    Mutant("c-uf-clip", "fmu_src/clutch_core.c",
+    Mutant("c-uf-clip", "fmu_src/core/clutch_core.c",
            "r[VR_U_F] = st.u > 0.0 ? st.u : 0.0;", "r[VR_U_F] = st.u;", NATIVE_TESTS, "u_f not clipped at the kiss point"),
     # ---- C tables: off-by-one
-    Mutant("c-bracket-off-by-one", "fmu_src/clutch_tables.c",
+    Mutant("c-bracket-off-by-one", "fmu_src/core/clutch_tables.c",
            "if (v >= g[n - 1]) { *i = n - 2; *w = 1.0; return; }",
            "if (v >= g[n - 1]) { *i = n - 2; *w = 0.0; return; }",
            NATIVE_TESTS, "above the hottest table, the second hottest curve is used"),
-    Mutant("c-delta-weight", "fmu_src/clutch_tables.c",
+    Mutant("c-delta-weight", "fmu_src/core/clutch_tables.c",
            "(1.0 - w) * tb->delta[i] + w * tb->delta[i + 1]", "(1.0 - w) * tb->delta[i] + w * tb->delta[i]",
            NATIVE_TESTS, "kiss shift not interpolated towards the next temperature"),
-    Mutant("c-hermite-end", "fmu_src/clutch_tables.c",
+    Mutant("c-hermite-end", "fmu_src/core/clutch_tables.c",
            "if (u >= c->x[c->n - 1]) return c->y[c->n - 1];", "if (u >= c->x[c->n - 1]) return c->y[c->n - 2];",
            NATIVE_TESTS, "force beyond full compression is the second to last row"),
     # ---- C front ends: status changes
-    Mutant("c-discard-terminates", "fmu_src/clutch_core.c",
+    Mutant("c-discard-terminates", "fmu_src/core/clutch_core.c",
            'log_inputs(m, CC_DISCARD, t, "step refused");\n        return CC_DISCARD;',
            'log_inputs(m, CC_DISCARD, t, "step refused");\n        m->terminated = 1;\n        return CC_DISCARD;',
            NATIVE_TESTS, "a recoverable Discard sets fmi2Terminated / terminateSimulation (issue 39)"),
-    Mutant("c-discard-ok", "fmu_src/clutch_core.c",
+    Mutant("c-discard-ok", "fmu_src/core/clutch_core.c",
            'log_inputs(m, CC_DISCARD, t, "step refused");\n        return CC_DISCARD;',
            'log_inputs(m, CC_DISCARD, t, "step refused");\n        return CC_OK;',
            NATIVE_TESTS, "a step with bad inputs returns OK"),
-    Mutant("c-stale-read-ok", "fmu_src/clutch_core.c",
+    Mutant("c-stale-read-ok", "fmu_src/core/clutch_core.c",
            "if (m->dirty && refresh(m, fn) != CC_OK) {", "if (m->dirty && refresh(m, fn) != CC_OK && m->me) {",
            NATIVE_TESTS, "Co-Simulation reads stale outputs with OK after a refused input (issue 39)"),
-    Mutant("c-param-after-init", "fmu_src/clutch_core.c",
+    Mutant("c-param-after-init", "fmu_src/core/clutch_core.c",
            "if (is_parameter(vr[k]) && after_init) {", "if (is_parameter(vr[k]) && !after_init && 0) {",
            NATIVE_TESTS, "parameters can be changed while stepping"),
     # ---- Python: the mutants that survived on c5f3d16 (issue 21) and two the ccx tests alone caught

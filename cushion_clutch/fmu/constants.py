@@ -12,20 +12,24 @@ from ..model import clutch_model
 
 #: the FMUs' model identifier and modelName
 SLAVE = "CushionClutch"
-#: folder of the FMU sources (C model, front ends, the pythonfmu slave, the guard, test hosts)
+#: folder of the FMU sources, one sub-folder per role (:data:`cushion_clutch.data.FMU_ROLES`; a file's path:
+#: :func:`cushion_clutch.data.fmu_source`)
 FMU_SRC = fmu_sources()
+#: the pythonfmu backend's sources (the slave, its table-set reader, the guard library)
+PYTHONFMU_SRC = FMU_SRC / "pythonfmu"
 #: folder of the numpy-only model modules (:mod:`cushion_clutch.model`)
 MODEL_SRC = Path(clutch_model.__file__).parent
 #: the package's ground floor (:mod:`cushion_clutch.number_check`, which the model and the loaders share)
 PACKAGE_SRC = MODEL_SRC.parent
-#: the modules the pythonfmu slave imports (siblings inside the FMU): the slave class (from ``FMU_SRC``)
+#: the modules the pythonfmu slave imports (siblings inside the FMU): the slave class (from ``PYTHONFMU_SRC``)
 #: and the numpy-only model (from ``MODEL_SRC``, its number check from ``PACKAGE_SRC``)
-SLAVE_MODULES = {"cushion_slave.py": FMU_SRC, "slave_table_sets.py": FMU_SRC, "clutch_model.py": MODEL_SRC,
+SLAVE_MODULES = {"cushion_slave.py": PYTHONFMU_SRC, "slave_table_sets.py": PYTHONFMU_SRC, "clutch_model.py": MODEL_SRC,
                  "spring_table.py": MODEL_SRC,
                  "friction.py": MODEL_SRC, "table_format.py": MODEL_SRC, "cover.py": MODEL_SRC,
                  "number_check.py": PACKAGE_SRC}
 
-#: the native model core (shared) and the front end of each FMI version, as shipped in sources/
+#: the native model core (shared) and the front end of each FMI version, as shipped in sources/ (flat there: the
+#: role folders of ``FMU_SRC`` are a layout of the package only; :func:`cushion_clutch.data.fmu_source` finds each)
 CORE_HEADERS = ("clutch_core.h", "clutch_tables.h", "clutch_cover.h", "resource_uri.h")
 CORE_SOURCES = ("clutch_core.c", "clutch_tables.c", "clutch_cover.c", "resource_uri.c")
 FRONT_ENDS = {2: "fmi2_frontend.c", 3: "fmi3_frontend.c"}

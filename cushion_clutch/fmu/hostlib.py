@@ -1,4 +1,4 @@
-"""C sources of ``fmu_src`` compiled for the machine Python runs on and cached by their hash.
+"""C sources of ``fmu_src`` (its role folders) compiled for the machine Python runs on and cached by their hash.
 
 The launch loop's compiled parts (:mod:`cushion_clutch.launch.plant_block`) load such a library with cffi. It
 is built once per source version with the FMU's compiler (:func:`.crossbuild.compile_command` with no
@@ -14,9 +14,11 @@ import sys
 import tempfile
 from pathlib import Path
 
-from ..data import fmu_sources
+from ..data import fmu_source, fmu_sources
 from .crossbuild import compile_command
 
+#: the role folders of ``fmu_src`` a host library compiles against (each on the include path)
+LIBRARY_ROLES = ("core", "hosts")
 #: exact IEEE arithmetic as Python's: no contraction into FMAs, no builtin rewriting of ``pow``
 EXACT_FLAGS = ("-ffp-contract=off", "-fno-builtin")
 
@@ -35,7 +37,9 @@ def host_library(name: str, files: tuple[str, ...], headers: tuple[str, ...],
     name : str
         The library's file name stem (``launch_plant``); the cached file is ``{name}_{hash}.so``.
     files, headers : tuple of str
-        Sources compiled and headers they include, names in ``fmu_src``.
+        Sources compiled and headers they include, file names in ``fmu_src``'s role folders
+        (:func:`cushion_clutch.data.fmu_source`); the folders of :data:`LIBRARY_ROLES` are on the include path
+        and every header there is hashed too.
     extra_flags : tuple of str
         Compiler flags after the FMU's (default: :data:`EXACT_FLAGS`).
 
@@ -46,8 +50,13 @@ def host_library(name: str, files: tuple[str, ...], headers: tuple[str, ...],
         writable.
     """
     src = fmu_sources()
-    blob = b"".join((src / f).read_bytes() for f in (*files, *headers))
-    cmd = " ".join(compile_command(None, 2, Path("."), files, Path("lib"), extra_flags=extra_flags))
+    rel = tuple(fmu_source(f).relative_to(src).as_posix() for f in files)
+    folders = [src / role for role in LIBRARY_ROLES]
+    every_header = sorted(h for folder in folders for h in folder.glob("*.h"))   # a changed header rebuilds too
+    blob = b"".join(p.read_bytes() for p in (*(fmu_source(f) for f in (*files, *headers)), *every_header))
+    includes = tuple(f"-I{folder}" for folder in folders)
+    cmd = " ".join(compile_command(None, 2, Path("."), rel, Path("lib"),
+                                   extra_flags=(*(f"-I{role}" for role in LIBRARY_ROLES), *extra_flags)))
     digest = hashlib.sha256(blob + cmd.encode()).hexdigest()[:16]
     suffix = ".dll" if sys.platform == "win32" else (".dylib" if sys.platform == "darwin" else ".so")
     for folder in (_cache_dir(), Path(tempfile.gettempdir()) / "cushion_clutch"):
@@ -59,7 +68,7 @@ def host_library(name: str, files: tuple[str, ...], headers: tuple[str, ...],
         except OSError:
             continue
         tmp = out.with_name(f"{out.stem}.{os.getpid()}{suffix}")
-        proc = subprocess.run(compile_command(None, 2, src, files, tmp, extra_flags=extra_flags),
+        proc = subprocess.run(compile_command(None, 2, src, rel, tmp, extra_flags=(*includes, *extra_flags)),
                               capture_output=True, text=True)
         if proc.returncode != 0 or not tmp.exists():
             tmp.unlink(missing_ok=True)
@@ -77,7 +86,8 @@ class HostLibrary:
     name : str
         The library's file name stem (see :func:`host_library`).
     files, headers : tuple of str
-        Sources compiled and headers they include, names in ``fmu_src``; ``headers[0]`` declares the API
+        Sources compiled and headers they include, file names in ``fmu_src``'s role folders; ``headers[0]``
+        declares the API
         (``cffi.FFI.cdef``).
     """
 
@@ -94,6 +104,6 @@ class HostLibrary:
         if self._loaded is None:
             import cffi
             ffi = cffi.FFI()
-            ffi.cdef((fmu_sources() / self.headers[0]).read_text())
+            ffi.cdef(fmu_source(self.headers[0]).read_text())
             self._loaded = (ffi, ffi.dlopen(str(self.path())))
         return self._loaded

@@ -17,7 +17,7 @@ from xml.etree import ElementTree as ET
 
 from ..model import clutch_model
 from ..model.table_format import FMU_FILES
-from .constants import BASE_UNITS, FMU_SRC, SLAVE, SLAVE_MODULES
+from .constants import BASE_UNITS, PYTHONFMU_SRC, SLAVE, SLAVE_MODULES
 from .descriptions import add_display_unit, bounds_attributes, display_unit
 from .guard import guard_fmu
 
@@ -90,7 +90,7 @@ def build_python_fmu(tables: Path, output: Path, more_tables: tuple = ()) -> Pat
     sets = carried_sets([tables, *more_tables]) if more_tables else ()
     with tempfile.TemporaryDirectory(prefix="cushion_fmu_") as tmp:
         stage = Path(tmp)
-        shutil.copy(FMU_SRC / f"{SLAVE}.py", stage / f"{SLAVE}.py")
+        shutil.copy(PYTHONFMU_SRC / f"{SLAVE}.py", stage / f"{SLAVE}.py")
         for module, folder in SLAVE_MODULES.items():
             shutil.copy(folder / module, stage / module)
         (stage / "tables").mkdir()

@@ -4,7 +4,7 @@ An FMU built from more than one table folder (``build-fmu --tables A --tables B 
 ``resources/tables`` (where a one-set FMU has its only set, so a one-set FMU is unchanged), set k >= 2 in
 ``resources/tables_<k>``, and ``resources/table_sets.json`` (the sets' names, descriptions, source folders and
 own kiss points). The model core loads every set at instantiation (``cc_table_sets_load`` in
-``fmu_src/clutch_tables.c``) and the parameter ``spring`` (``clutch_model.TABLE_SET_VARIABLE``; an
+``fmu_src/core/clutch_tables.c``) and the parameter ``spring`` (``clutch_model.TABLE_SET_VARIABLE``; an
 enumeration with one item per set, FMI 2.0 ``SimpleType/Enumeration``, FMI 3.0 ``EnumerationType``; value
 reference after FMI 3's ``time``) picks one until initialisation ends; a change after that is refused with a
 message. The GUID (instantiationToken) hashes every set carried (:func:`hash_sets`).

@@ -1,4 +1,4 @@
-"""The launch loop's plant steps between two TCU cycles in one compiled call (``fmu_src/launch_plant.c``).
+"""The launch loop's plant steps between two TCU cycles in one compiled call (``fmu_src/hosts/launch_plant.c``).
 
 The Python loop of :func:`.simulate.simulate_launches` is the reference; with ``plant="native"`` the steps
 from a TCU cycle to the next (ten 1 ms steps at the shipped 10 ms period) run in C: the actuator, the

@@ -1,4 +1,4 @@
-"""The production TCU's clutch model torque, evaluated by the native clutch model (``fmu_src/tcu_model.c``).
+"""The production TCU's clutch model torque, evaluated by the native clutch model (``fmu_src/hosts/tcu_model.c``).
 
 The EKF (:mod:`.ekf`) asks its characteristic ``T(x_to, theta_cs, theta_cm)`` about 13,000 times in a
 four-minute run, each time at other temperatures (its estimate moves), so the Python model recomputes its

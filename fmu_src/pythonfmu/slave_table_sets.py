@@ -1,5 +1,5 @@
 # Table sets of the pythonfmu slave (issue 42): the sets after the first (resources/tables_2, tables_3, ...) with
-# their kiss-point offsets, as the native core's cc_table_sets_load reads them (fmu_src/clutch_tables.c).
+# their kiss-point offsets, as the native core's cc_table_sets_load reads them (fmu_src/core/clutch_tables.c).
 # Copied into the FMU next to cushion_slave.py (cushion_clutch.fmu.constants.SLAVE_MODULES). Comments, not
 # docstrings: pythonfmu's wrapper re-imports sibling modules per instance (see CushionClutch.py).
 from __future__ import annotations

@@ -1,5 +1,5 @@
 /* Test driver of cc_uri_to_path: uri_driver WINDOWS URI... prints one line per URI:
-   "ok <path>" or "error <reason>". Built with gcc against fmu_src/resource_uri.c. */
+   "ok <path>" or "error <reason>". Built with gcc against fmu_src/core/resource_uri.c. */
 #include <stdio.h>
 #include <stdlib.h>
 

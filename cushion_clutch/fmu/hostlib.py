@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import hashlib
 import os
+import re
 import subprocess
 import sys
 import tempfile
@@ -78,6 +79,23 @@ def host_library(name: str, files: tuple[str, ...], headers: tuple[str, ...],
     raise RuntimeError(f"no writable cache folder for the native {name} library")
 
 
+def declarations(header: str, seen: set | None = None) -> str:
+    """The plain C declarations of ``header`` (a file name in ``fmu_src``'s role folders) for ``cffi.FFI.cdef``:
+    its quoted includes of other such headers inlined (each once), every other preprocessor line (the include
+    guards, system includes) dropped."""
+    seen = set() if seen is None else seen
+    seen.add(header)
+    out = []
+    for line in fmu_source(header).read_text().splitlines():
+        included = re.match(r'\s*#\s*include\s+"([^"]+)"', line)
+        if included:
+            if included.group(1) not in seen:
+                out.append(declarations(included.group(1), seen))
+        elif not line.lstrip().startswith("#"):
+            out.append(line)
+    return "\n".join(out)
+
+
 class HostLibrary:
     """One ``fmu_src`` library for this machine, compiled on first use and loaded once with cffi.
 
@@ -87,23 +105,25 @@ class HostLibrary:
         The library's file name stem (see :func:`host_library`).
     files, headers : tuple of str
         Sources compiled and headers they include, file names in ``fmu_src``'s role folders; ``headers[0]``
-        declares the API
-        (``cffi.FFI.cdef``).
+        declares the API (``cffi.FFI.cdef`` of :func:`declarations`).
+    extra_flags : tuple of str
+        Compiler flags after the FMU's (default: :data:`EXACT_FLAGS`).
     """
 
-    def __init__(self, name: str, files: tuple[str, ...], headers: tuple[str, ...]):
-        self.name, self.files, self.headers = name, files, headers
+    def __init__(self, name: str, files: tuple[str, ...], headers: tuple[str, ...],
+                 extra_flags: tuple[str, ...] = EXACT_FLAGS):
+        self.name, self.files, self.headers, self.extra_flags = name, files, headers, extra_flags
         self._loaded = None
 
     def path(self) -> Path:
         """The compiled library (:func:`host_library`; raises ``RuntimeError`` as it does)."""
-        return host_library(self.name, self.files, self.headers)
+        return host_library(self.name, self.files, self.headers, self.extra_flags)
 
     def load(self):
         """``(ffi, lib)``: the API of ``headers[0]`` and the opened library (opened once per process)."""
         if self._loaded is None:
             import cffi
             ffi = cffi.FFI()
-            ffi.cdef(fmu_source(self.headers[0]).read_text())
+            ffi.cdef(declarations(self.headers[0]))
             self._loaded = (ffi, ffi.dlopen(str(self.path())))
         return self._loaded

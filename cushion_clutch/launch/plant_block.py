@@ -38,7 +38,7 @@ MAX_FRICTION = 16
 
 
 #: the compiled plant step (built on first use, cached by the sources' hash)
-LIBRARY = HostLibrary("launch_plant", (SOURCE,), (HEADER, "host_export.h"))
+LIBRARY = HostLibrary("launch_plant", (SOURCE, "thermal_step.c"), (HEADER, "thermal_step.h", "host_export.h"))
 
 
 class NativePlant:

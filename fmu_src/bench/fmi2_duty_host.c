@@ -14,7 +14,7 @@
 
 #include "host_platform.h" /* LIB, OPEN, SYM, CLOSE, LOAD, now_s() */
 #include "fmi2Functions.h"
-#include "host_fmi2.h"          /* logger, LOAD_FMI2_CS, host_fmi2_start() */
+#include "host_fmi2.h"          /* host_logger, LOAD_FMI2_CS, host_fmi2_start() */
 
 int main(int argc, char **argv) {
     LIB lib;

@@ -29,7 +29,7 @@
 #include "host_platform.h" /* LIB, OPEN, SYM, CLOSE, LOAD, now_s() */
 
 #include "fmi2Functions.h"
-#include "host_fmi2.h"          /* logger, LOAD_FMI2_CS, host_fmi2_start() */
+#include "host_fmi2.h"          /* host_logger, LOAD_FMI2_CS, host_fmi2_start() */
 
 /* FNV-1a 64 of n doubles' bytes, continuing from hash */
 static unsigned long long fnv1a(unsigned long long hash, const double *v, size_t n) {

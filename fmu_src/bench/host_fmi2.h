@@ -9,8 +9,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-static void logger(fmi2ComponentEnvironment env, fmi2String name, fmi2Status status,
-                   fmi2String category, fmi2String message, ...) {
+static void host_logger(fmi2ComponentEnvironment env, fmi2String name, fmi2Status status,
+                        fmi2String category, fmi2String message, ...) {
     va_list ap;
     (void)env;
     va_start(ap, message);
@@ -31,7 +31,7 @@ static void logger(fmi2ComponentEnvironment env, fmi2String name, fmi2Status sta
 static fmi2Component host_fmi2_start(fmi2InstantiateTYPE *instantiate, fmi2SetupExperimentTYPE *setup,
                                      fmi2EnterInitializationModeTYPE *enter, fmi2ExitInitializationModeTYPE *exit_,
                                      const char *guid, const char *uri) {
-    static const fmi2CallbackFunctions cb = {logger, calloc, free, NULL, NULL};
+    static const fmi2CallbackFunctions cb = {host_logger, calloc, free, NULL, NULL};
     fmi2Component c = instantiate("host", fmi2CoSimulation, guid, uri, &cb, fmi2False, fmi2False);
     if (!c) {
         fprintf(stderr, "fmi2Instantiate failed\n");

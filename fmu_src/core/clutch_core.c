@@ -249,7 +249,7 @@ static int check_parameters(CcModel *m, const double *r, const char *fn) {
         ok = 0;
     }
 #if CC_THERMAL
-    if (!cc_net_parameters_ok(m, r, fn)) ok = 0; /* the network's own rules (clutch_thermal.c) */
+    if (!CC_HOOKS->parameters_ok(m, r, fn)) ok = 0; /* the network's own rules (the variant's hooks) */
 #endif
     if (ok && !cover_consistent(m, r, fn)) ok = 0;
     if (ok && !(r[VR_U] + r[VR_H] > 0.0)) {
@@ -345,7 +345,7 @@ static int update_outputs(CcModel *m) {
     r[VR_CLAMP_FORCE] = st.clamp;
     r[VR_BEARING_FORCE] = st.bearing;
 #if CC_THERMAL
-    if (cc_net_outputs(m) != CC_OK) return CC_DISCARD; /* slip_power, the nodes' derivatives (clutch_thermal.c) */
+    if (CC_HOOKS->outputs(m) != CC_OK) return CC_DISCARD; /* slip_power, the nodes' derivatives (the variant's hooks) */
 #endif
     m->dirty = 0;
     {
@@ -440,7 +440,7 @@ static int set_real_checked(CcModel *m, const unsigned int vr[], size_t n, const
         if (is_parameter(vr[k])) { m->cover_ok = 0; m->warm.x = m->decay_h = NAN; }
     }
 #if CC_THERMAL
-    if (!after_init) cc_net_start(m->r); /* the nodes at theta_network_start until initialisation ends */
+    if (!after_init) CC_HOOKS->start(m->r); /* the nodes at theta_network_start until initialisation ends */
 #endif
     if (n) m->dirty = 1;
     return CC_OK;
@@ -479,7 +479,7 @@ static int get_real_checked(CcModel *m, const unsigned int vr[], size_t n, doubl
             v[k] = m->r[vr[k]];
             if ((CC_VARIABLES[vr[k]].causality == CC_OUTPUT && vr[k] != VR_THETA_CS
 #if CC_THERMAL
-                 && !cc_net_state_output(vr[k]) /* the nodes and their facing mean are states too */
+                 && !CC_HOOKS->state_output(vr[k]) /* the nodes and their facing mean are states too */
 #endif
                  ) || vr[k] == CC_VR_DER_THETA_CS)
                 status = CC_DISCARD;
@@ -535,7 +535,7 @@ typedef struct {
 static void step_start_save(CcModel *m, CcStepStart *s) {
     s->theta_cs = m->r[VR_THETA_CS];
     s->time = m->time;
-    cc_net_get_states(m, s->nodes);
+    CC_HOOKS->get_states(m, s->nodes);
     s->warm = m->warm;
     s->range_warned = m->range_warned;
 }
@@ -543,10 +543,10 @@ static void step_start_save(CcModel *m, CcStepStart *s) {
 static int step_refused(CcModel *m, const CcStepStart *s) {
     m->r[VR_THETA_CS] = s->theta_cs;
     m->time = s->time;
-    cc_net_set_states(m, s->nodes); /* the nodes and theta_cm; dirty: outputs and derivatives at the next read */
+    CC_HOOKS->set_states(m, s->nodes); /* the nodes and theta_cm; dirty: outputs and derivatives at the next read */
     m->warm = s->warm;
     m->range_warned = s->range_warned;
-    cc_net_restore(m);
+    CC_HOOKS->restore(m);
     return CC_DISCARD;
 }
 #endif
@@ -567,7 +567,7 @@ int cc_do_step(CcModel *m, double t, double h, const char *fn) {
         return CC_DISCARD;
     }
 #if CC_THERMAL
-    if (!cc_net_begin_step(m, t, "step refused")) return CC_DISCARD;
+    if (!CC_HOOKS->begin_step(m, t, "step refused")) return CC_DISCARD;
     step_start_save(m, &start);
 #endif
     if (fabs(t - m->time) > 1e-9 * (1.0 + fabs(t))) {
@@ -596,10 +596,10 @@ int cc_do_step(CcModel *m, double t, double h, const char *fn) {
     }
 #if CC_THERMAL
     /* the launch plant's order: the torque just computed (new theta_cs, held theta_cm) heats the network, then
-       the outputs at the step's end (clutch_thermal.c); a refused network step rolls everything back */
+       the outputs at the step's end (the variant's hooks); a refused network step rolls everything back */
     (void)theta_old;
     m->time = t;
-    if (cc_net_step(m, h, fn, update_outputs) != CC_OK) return step_refused(m, &start);
+    if (CC_HOOKS->step(m, h, fn, update_outputs) != CC_OK) return step_refused(m, &start);
 #endif
     m->time = t + h;
     return status;
@@ -621,7 +621,7 @@ int cc_derivative(CcModel *m, double *der, const char *fn) {
         int status = m->dirty ? refresh(m, fn) : CC_OK;
         if (status != CC_OK) return status;
         theta = r[VR_THETA_CS];
-        cc_net_get_derivatives(m, der + 1);
+        CC_HOOKS->get_derivatives(m, der + 1);
     }
 #endif
     *der = (r[VR_U] * r[VR_THETA_CM] + r[VR_H] * r[VR_THETA_A] - (r[VR_U] + r[VR_H]) * theta) / r[VR_C];
@@ -660,11 +660,11 @@ int cc_set_states(CcModel *m, const double *x, const char *fn) {
     int status;
 #if CC_THERMAL
     if (!cc_allowed(m, PH_CONT, fn)) return CC_ERROR;
-    if (!cc_net_states_ok(m, x + 1, CC_DISCARD, fn, "states not set")) return CC_DISCARD; /* as a refused CS step */
+    if (!CC_HOOKS->states_ok(m, x + 1, CC_DISCARD, fn, "states not set")) return CC_DISCARD; /* as a refused CS step */
 #endif
     status = cc_set_state_value(m, x[0], fn);
 #if CC_THERMAL
-    if (status == CC_OK) cc_net_set_states(m, x + 1);
+    if (status == CC_OK) CC_HOOKS->set_states(m, x + 1);
 #endif
     return status;
 }
@@ -672,7 +672,7 @@ int cc_set_states(CcModel *m, const double *x, const char *fn) {
 int cc_get_states(CcModel *m, double *x, const char *fn) {
     int status = cc_get_state_value(m, x, fn);
 #if CC_THERMAL
-    if (status == CC_OK) cc_net_get_states(m, x + 1);
+    if (status == CC_OK) CC_HOOKS->get_states(m, x + 1);
 #endif
     return status;
 }
@@ -746,7 +746,7 @@ int cc_state_check(CcModel *m, const void *bytes, size_t size, const char *fn) {
     if (s.phase != PH_INSTANTIATED && s.phase != PH_INIT && s.phase != PH_ERROR && !check_parameters(m, s.r, fn))
         return 0;
 #if CC_THERMAL
-    if (s.phase != PH_INSTANTIATED && s.phase != PH_INIT && s.phase != PH_ERROR && !cc_net_saved_ok(m, s.r, fn))
+    if (s.phase != PH_INSTANTIATED && s.phase != PH_INIT && s.phase != PH_ERROR && !CC_HOOKS->saved_ok(m, s.r, fn))
         return 0; /* the nodes in their declared ranges, as every step and ME state */
 #endif
     return 1;
@@ -764,6 +764,6 @@ void cc_state_load(CcModel *m, const CcState *s) {
     m->dirty = 1;
     m->cover_ok = 0;
 #if CC_THERMAL
-    if (m->phase != PH_INSTANTIATED && m->phase != PH_INIT && m->phase != PH_ERROR) cc_net_restore(m);
+    if (m->phase != PH_INSTANTIATED && m->phase != PH_INIT && m->phase != PH_ERROR) CC_HOOKS->restore(m);
 #endif
 }

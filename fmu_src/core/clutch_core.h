@@ -132,24 +132,38 @@ void cc_state_save(const CcModel *m, CcState *s);
 int cc_state_check(CcModel *m, const void *bytes, size_t size, const char *fn);
 void cc_state_load(CcModel *m, const CcState *s);
 
+/* ---- a variant's hooks: the interface, owned by the core, through which a variant of the model plugs in. The
+   thermal variant (CushionClutchThermal: clutch_thermal.c over thermal_network.c) fills in one table and its
+   generated cushion_variables.h names it (#define CC_HOOKS_TABLE cc_thermal_hooks, cushion_clutch.fmu.thermal_chain);
+   the core calls the hooks where CC_THERMAL is set and knows no name of the variant */
+typedef struct {
+    /* the nodes at theta_network_start (until initialisation ends) */
+    void (*start)(double *r);
+    /* the network's own parameter rules, every problem logged (Error); 1 if they hold */
+    int (*parameters_ok)(CcModel *m, const double *r, const char *fn);
+    /* before a Co-Simulation step: the variant's inputs, logged (Discard, what: what happens) and 0 if bad */
+    int (*begin_step)(CcModel *m, double t, const char *what);
+    /* every output update, after the clutch's outputs: slip_power and the nodes' derivatives */
+    int (*outputs)(CcModel *m);
+    /* the network over the step h after the clutch's step; outputs recomputes the clutch's outputs at its end */
+    int (*step)(CcModel *m, double h, const char *fn, int (*outputs)(CcModel *));
+    /* the nodes x (ME states) in their declared ranges, or every problem logged with status and 0 */
+    int (*states_ok)(CcModel *m, const double *x, int status, const char *fn, const char *what);
+    /* the nodes of a saved variable vector r in their declared ranges, or logged (Error) and 0 */
+    int (*saved_ok)(CcModel *m, const double *r, const char *fn);
+    /* after a rollback or a state load: theta_cm from the nodes, the next output update computes the derivatives */
+    void (*restore)(CcModel *m);
+    /* 1 if vr is a node temperature, theta_cm or theta_friction (states and their means, not computed from inputs) */
+    int (*state_output)(unsigned int vr);
+    /* the variant's states after theta_cs (the nodes, K), their derivatives (K/s) */
+    void (*set_states)(CcModel *m, const double *x);
+    void (*get_states)(CcModel *m, double *x);
+    void (*get_derivatives)(CcModel *m, double *der);
+} CcHooks;
+
 #if CC_THERMAL
-/* ---- the thermal variant's network in the model (clutch_thermal.c, over thermal_network.c) */
-void cc_net_start(double *r);
-int cc_net_parameters_ok(CcModel *m, const double *r, const char *fn);
-int cc_net_begin_step(CcModel *m, double t, const char *what);
-int cc_net_outputs(CcModel *m);
-int cc_net_step(CcModel *m, double h, const char *fn, int (*outputs)(CcModel *));
-/* the nodes x (ME states) in their declared ranges, or every problem logged with status and 0 */
-int cc_net_states_ok(CcModel *m, const double *x, int status, const char *fn, const char *what);
-/* the nodes of a saved variable vector r in their declared ranges, or logged (Error) and 0 */
-int cc_net_saved_ok(CcModel *m, const double *r, const char *fn);
-/* after a rollback or a state load: theta_cm from the nodes, the next output update computes the derivatives */
-void cc_net_restore(CcModel *m);
-/* 1 if vr is a node temperature, theta_cm or theta_friction (states and their means, not computed from the inputs) */
-int cc_net_state_output(unsigned int vr);
-void cc_net_set_states(CcModel *m, const double *x);
-void cc_net_get_states(CcModel *m, double *x);
-void cc_net_get_derivatives(CcModel *m, double *der);
+extern const CcHooks CC_HOOKS_TABLE;
+#define CC_HOOKS (&CC_HOOKS_TABLE)
 #endif
 
 #endif

@@ -1,6 +1,6 @@
 /*
  * The chain of lumped thermal nodes (thermal_network.h): conductances, the exact-exponential
- * Gauss-Seidel step (Co-Simulation) and the derivative (Model Exchange).
+ * Gauss-Seidel step (Co-Simulation: the nodes' constants for thermal_step.c) and the derivative (Model Exchange).
  */
 #include "thermal_network.h"
 
@@ -29,9 +29,11 @@ void tn_operating(const TnParams *p, double w_engine, double w_disc, int clamped
         /* the first call filled both entries: they are valid from now on */
         memo->ready |= 1;
     }
+    op->h[TN_ENGINE] = p->h_still + p->h_rot * x[TN_ENGINE];
+    op->h[TN_DISC] = p->h_still + p->h_rot * x[TN_DISC];
     tn_links(p, clamped, op);
     for (i = 0; i < p->n; ++i) {
-        double conv = p->area[i] > 0.0 ? p->area[i] * (p->h_still + p->h_rot * x[p->speed[i]]) : 0.0;
+        double conv = p->area[i] > 0.0 ? p->area[i] * op->h[p->speed[i]] : 0.0;
         double g = conv + p->g_engine[i];
         op->sink_g[i] = g;
         op->sink_t[i] = g > 0.0 ? (p->g_engine[i] * p->theta_engine + conv * p->theta_a) / g : p->theta_a;
@@ -46,23 +48,30 @@ static double exp_node(double a, int i, TnMemo *memo) {
     return memo->exp_out[i] = exp(a);
 }
 
+/* the nodes' constants of the step (ThermalNetwork._prepare's, in its order) and the one step (thermal_step.c) */
 void tn_step(const TnParams *p, const TnOperating *op, double *th, double dt, double power, TnMemo *memo) {
-    const double *link = op->link, *sg = op->sink_g, *st = op->sink_t;
+    TnNode nodes[TN_MAX];
     int i, n = p->n;
     for (i = 0; i < n; ++i) {
-        double gl = i > 0 ? link[i - 1] : 0.0, gr = i < n - 1 ? link[i] : 0.0;
-        double gs = gl + gr + sg[i];
-        double flow = p->share[i] * power + sg[i] * st[i] + (i > 0 ? gl * th[i - 1] : 0.0) +
-                      (i < n - 1 ? gr * th[i + 1] : 0.0);
-        if (gs > 0.0) {
-            double inf = flow / gs;
-            th[i] = inf + (th[i] - inf) * exp_node(-dt * gs / p->cap[i], i, memo);
+        TnNode *q = nodes + i;
+        q->cap = p->cap[i];
+        q->gl = i > 0 ? op->link[i - 1] : 0.0;
+        q->gr = i < n - 1 ? op->link[i] : 0.0;
+        q->area = p->area[i];
+        q->on_disc = p->speed[i] == TN_DISC ? 1.0 : 0.0;
+        q->ge_te = p->g_engine[i] * p->theta_engine;
+        q->gfix = q->gl + q->gr + p->g_engine[i];
+        q->share = p->share[i];
+        q->fixed = q->area == 0.0 && q->gfix > 0.0 ? 1.0 : 0.0;
+        if (q->fixed != 0.0) {
+            q->decay = exp_node(-dt * q->gfix / q->cap, i, memo);
         } else {
-            th[i] += flow * dt / p->cap[i];
+            q->decay = 0.0;
             if (memo) memo->exp_in[i] = NAN; /* no entry for this node: the next call computes it */
         }
     }
     if (memo) memo->ready |= 2;
+    tn_chain_step(nodes, n, th, dt, power, op->h[TN_ENGINE], op->h[TN_DISC], p->theta_a);
 }
 
 void tn_derivative(const TnParams *p, const TnOperating *op, const double *th, double power, double *der) {

@@ -8,13 +8,15 @@
  *                    block at theta_engine (W/K);
  *   heat input:      q_i = share[i] * P  (P the slip power, W).
  * Co-Simulation: tn_step advances node by node (0 first) with the exact exponential solution for the node's
- * neighbours held, the same Gauss-Seidel exponential splitting as the Python plant
- * (cushion_clutch.model.thermal_network.ThermalNetwork.step); Model Exchange: tn_derivative.
+ * neighbours held: the one step of the launch plant's network too (thermal_step.c, the operations of the Python
+ * plant's cushion_clutch.model.thermal_network.ThermalNetwork.step in its order); Model Exchange: tn_derivative.
  * The structure (n, speed sources, mean weights) and the parameters' value references are generated from
  * Python into cushion_variables.h (cushion_clutch.fmu.thermal_chain); this file knows no node by name.
  */
 #ifndef THERMAL_NETWORK_H
 #define THERMAL_NETWORK_H
+
+#include "thermal_step.h" /* TnNode, tn_chain_step */
 
 #define TN_MAX 32
 enum { TN_ENGINE = 0, TN_DISC = 1 };
@@ -27,9 +29,11 @@ typedef struct {
     double theta_engine, theta_a, h_still, h_rot, w_ref; /* K, K, W/(m2 K), W/(m2 K), rad/s */
 } TnParams;
 
-/* the network at one operating point: links (n-1) and the nodes' sink conductances and temperatures */
+/* the network at one operating point: links (n-1), the nodes' sink conductances and temperatures, and the
+   convection coefficient h_still + h_rot (|w| / w_ref)^0.8 at the engine's and the disc's speed (TN_ENGINE, TN_DISC) */
 typedef struct {
     double link[TN_MAX], sink_g[TN_MAX], sink_t[TN_MAX]; /* W/K, W/K, K */
+    double h[2];                                         /* W/(m2 K) */
 } TnOperating;
 
 /* the last arguments of the network's transcendental calls and their values, kept by the caller between steps:
@@ -38,7 +42,7 @@ typedef struct {
 typedef struct {
     int ready;
     double pow_in[2], pow_out[2]; /* |w| / w_ref of the engine and the disc, and its power 0.8 */
-    double exp_in[TN_MAX], exp_out[TN_MAX]; /* -dt g_i / C_i of each node, and its exponential */
+    double exp_in[TN_MAX], exp_out[TN_MAX]; /* -dt gfix_i / C_i of each node without convection, and its exponential */
 } TnMemo;
 
 /* the operating point at the given speeds (rad/s) and clamp state (memo: NULL or the caller's TnMemo) */

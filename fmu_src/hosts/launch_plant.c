@@ -208,7 +208,7 @@ static double friction_mu(const lp_consts *c, double theta_degC, double omega)
 static void net_step(lp_consts *c, double *th, double dt, double p_slip, double w_engine, double w_disc,
                      int clamped)
 {
-    lp_net_node *nodes = c->net[clamped];
+    TnNode *nodes = c->net[clamped];
     int i, n = c->net_n_nodes;
     if (dt != c->net_dt[clamped]) {
         for (i = 0; i < n; i++)
@@ -218,31 +218,7 @@ static void net_step(lp_consts *c, double *th, double dt, double p_slip, double 
     }
     double h_engine = c->net_h0 + c->net_hr * pow(fabs(w_engine) / c->net_wr, 0.8);
     double h_disc = c->net_h0 + c->net_hr * pow(fabs(w_disc) / c->net_wr, 0.8);
-    double ta = c->net_ta, left = 0.0;
-    for (i = 0; i < n; i++) {
-        const lp_net_node *q = nodes + i;
-        double flow = q->share * p_slip + q->ge_te;
-        if (q->gl != 0.0)
-            flow += q->gl * left;
-        if (q->gr != 0.0)
-            flow += q->gr * th[i + 1];
-        double gs, decay = q->decay;
-        if (q->fixed == 0.0) {
-            double conv = q->area * (q->on_disc != 0.0 ? h_disc : h_engine);
-            gs = q->gfix + conv;
-            flow += conv * ta;
-            if (gs > 0.0)
-                decay = exp(-dt * gs / q->cap);
-        } else {
-            gs = q->gfix;
-        }
-        if (gs > 0.0) {
-            double inf = flow / gs;
-            left = th[i] = inf + (th[i] - inf) * decay;
-        } else {
-            left = th[i] = th[i] + flow * dt / q->cap;
-        }
-    }
+    tn_chain_step(nodes, n, th, dt, p_slip, h_engine, h_disc, c->net_ta); /* the one step (core/thermal_step.c) */
 }
 
 /* the network is due after a step (simulate.py: after the driveline, with its speeds): step it with the slip

@@ -1,18 +1,13 @@
 /* The launch simulation's plant steps between two TCU cycles, compiled (cushion_clutch/launch/plant_block.py).
- * This header is also the cffi declaration (plain C declarations only: no macros, no includes).
+ * This header is also the cffi declaration (plain C declarations, no macros; cushion_clutch.fmu.hostlib inlines
+ * its one include, the network's node, and drops the include and guard lines).
  * Units SI: rad/s, m/s, N.m, J, W, K, m, s. */
 
 typedef int (*lp_set_real)(void *c, const unsigned int vr[], size_t nvr, const double value[]);
 typedef int (*lp_get_real)(void *c, const unsigned int vr[], size_t nvr, double value[]);
 typedef int (*lp_do_step)(void *c, double t, double h, int no_set_prior);
 
-/* one node of the plant's thermal network for one clamp state: the per-node constants of
- * model.thermal_network.ThermalNetwork.step (ThermalNetwork._prepare), flags as 0/1 */
-typedef struct {
-    double cap, gl, gr, area, on_disc, ge_te, gfix, share; /* J/K, W/K, W/K, m2, 1, W, W/K, 1 */
-    double fixed;                   /* 1: no convection and gfix > 0, the decay factor is a constant of the step */
-    double decay;                   /* exp(-dt gfix / cap) at the step net_dt of its clamp state (fixed nodes) */
-} lp_net_node;
+#include "thermal_step.h" /* TnNode: one node of the plant's thermal network for one clamp state */
 
 /* constants of a run */
 typedef struct {
@@ -39,7 +34,7 @@ typedef struct {
     int net_surface[2];             /* the two metal friction surfaces: the series' theta_surface is the hotter */
     double net_h0, net_hr, net_wr, net_ta; /* still air, rotating W/(m2 K), its reference speed rad/s, air K */
     double net_dt[2];               /* the step the fixed nodes' decay factors are for, per clamp state, s */
-    lp_net_node net[2][16];
+    TnNode net[2][16];              /* the nodes per clamp state (decay: at the step net_dt of its clamp state) */
     /* mu at the friction surface (simulate.py, issue 37): with mu_surface != 0 the torque is
      * n_surfaces mu(theta_fs, |omega_slip|) r_eq clamp_force, mu from this table (model.friction.FrictionTable:
      * bilinear, clamped; f_mu row-major, f_nt temperatures degC x f_nw slip speeds rad/s) */

@@ -210,3 +210,100 @@ def test_facing_wear_declares_what_initialisation_accepts():
     finally:
         shutil.rmtree(unzip, ignore_errors=True)
     assert math.isclose(top, clutch_model.facing_wear_max(clutch_model.SpringTable.from_dir(DEFAULT_TABLES)))
+
+
+#: the value references of the model's variables as released (clutch_model.VARIABLES' order): a new variable is
+#: appended, so none of these may move (hosts and SSP files store them)
+PINNED_VRS = {
+    "x_to": 0, "theta_cm": 1, "torque": 2, "force": 3, "theta_cs": 4, "u_f": 5, "x_kiss": 6, "n_surfaces": 7,
+    "mu": 8, "R_eq": 9, "U": 10, "H": 11, "C": 12, "theta_a": 13, "theta_cs_start": 14, "x_kiss_ref": 15,
+    "lever_ratio": 16, "omega_slip": 17, "clamp_force": 18, "bearing_force": 19, "facing_wear": 20,
+    "diaphragm_outer_radius_m": 21, "diaphragm_inner_radius_m": 22, "diaphragm_thickness_m": 23,
+    "diaphragm_cone_height_m": 24, "diaphragm_youngs_modulus_Pa": 25, "diaphragm_modulus_drop_per_K": 26,
+    "diaphragm_poisson_ratio": 27, "pressure_plate_radius_m": 28, "fulcrum_radius_m": 29,
+    "installed_deflection_m": 30, "release_compliance_m_per_N": 31, "facing_thickness_m": 32,
+    "facing_expansion_per_K": 33, "pressure_plate_thickness_m": 34, "pressure_plate_expansion_per_K": 35,
+    "flywheel_length_m": 36, "flywheel_expansion_per_K": 37, "reference_temperature_K": 38,
+    "facing_damage_temperature_K": 39, "validity": 40,
+}
+#: the cover's parameter enum as released (cushion_cover.h, CoverParameters' field order)
+PINNED_CV = ["diaphragm_outer_radius_m", "diaphragm_inner_radius_m", "diaphragm_thickness_m",
+             "diaphragm_cone_height_m", "diaphragm_youngs_modulus_Pa", "diaphragm_modulus_drop_per_K",
+             "diaphragm_poisson_ratio", "pressure_plate_radius_m", "fulcrum_radius_m", "installed_deflection_m",
+             "release_compliance_m_per_N", "facing_thickness_m", "facing_expansion_per_K",
+             "pressure_plate_thickness_m", "pressure_plate_expansion_per_K", "flywheel_length_m",
+             "flywheel_expansion_per_K", "reference_temperature_K"]
+COVER_EXTRA = ("k_cover_extra", "parameter", "1", "a cover parameter appended at the end for this test")
+
+
+def _enum(text: str, first: str) -> list[str]:
+    """The constants of the C enum of ``text`` that begins with ``first``."""
+    body = text[text.index(first):]
+    return [c.strip() for c in body[:body.index("}")].split(",") if c.strip()]
+
+
+def _value_references(text: str) -> dict[str, int]:
+    return {name: k for k, name in enumerate(_enum(text, enum_name("x_to")))}
+
+
+def _cover_vrs(text: str) -> list[str]:
+    line = next(line for line in text.splitlines() if line.startswith("static const int CC_COVER_VR[]"))
+    return [c.strip() for c in line[line.index("{") + 1:line.index("}")].split(",")]
+
+
+def test_released_value_references_and_cover_numbers_do_not_move():
+    """Every variable keeps its released value reference (the FMU's and the thermal FMU's, whose own follow),
+    the cover's enum keeps its numbers, and CC_COVER_VR maps each cover parameter to its variable."""
+    from cushion_clutch.fmu.thermal_chain import chain_of, thermal_header
+    from cushion_clutch.fmu.variable_table import cover_enum_name, cover_header
+    for text in (variable_header(), thermal_header(chain_of())):
+        vrs = _value_references(text)
+        assert {n: vrs[enum_name(n)] for n in PINNED_VRS} == PINNED_VRS
+        assert _cover_vrs(text) == [enum_name(n) for n in PINNED_CV]
+    assert _enum(cover_header(), "CV_") == [*(cover_enum_name(n) for n in PINNED_CV), "CV_NPAR"]
+
+
+@pytest.fixture
+def cover_extended(monkeypatch):
+    """The model with one cover parameter appended: to CoverParameters (with a range) and to VARIABLES."""
+    ext = dataclasses.make_dataclass("CoverParameters", [(COVER_EXTRA[0], float, 1.0)],
+                                     bases=(clutch_model.CoverParameters,), frozen=True)
+    starts = clutch_model.start_values()                 # the released model's, before the patch
+    monkeypatch.setattr(clutch_model, "CoverParameters", ext)
+    monkeypatch.setattr(clutch_model, "VARIABLES", clutch_model.VARIABLES + (COVER_EXTRA,))
+    monkeypatch.setattr(clutch_model.ClutchParameters, "RANGES",
+                        dict(clutch_model.ClutchParameters.RANGES, **{COVER_EXTRA[0]: (0.0, 2.0, False, False)}))
+    monkeypatch.setattr(clutch_model, "start_values", lambda p=None: {**starts, COVER_EXTRA[0]: 1.0})
+
+
+def test_an_appended_cover_parameter_moves_no_number_and_the_core_compiles(cover_extended, tmp_path):
+    """A cover parameter appended to the dataclass and to VARIABLES: every released value reference and cover
+    number stays, the new one is the last of each, CC_COVER_VR names its variable, and the C core (which reads the
+    cover through CC_COVER_VR) compiles against the generated headers."""
+    from cushion_clutch.data import fmu_source
+    from cushion_clutch.fmu.variable_table import COVER_HEADER, HEADER, cover_enum_name, cover_header
+    text, cover = variable_header(), cover_header()
+    vrs = _value_references(text)
+    assert {n: vrs[enum_name(n)] for n in PINNED_VRS} == PINNED_VRS
+    assert vrs[enum_name(COVER_EXTRA[0])] == len(PINNED_VRS)
+    assert _cover_vrs(text) == [*(enum_name(n) for n in PINNED_CV), enum_name(COVER_EXTRA[0])]
+    assert _enum(cover, "CV_") == [*(cover_enum_name(n) for n in (*PINNED_CV, COVER_EXTRA[0])), "CV_NPAR"]
+    for name in (*constants.CORE_HEADERS, *constants.CORE_SOURCES):
+        shutil.copy(fmu_source(name), tmp_path / name)
+    (tmp_path / HEADER).write_text(text)
+    (tmp_path / COVER_HEADER).write_text(cover)
+    gcc = shutil.which("gcc")
+    if gcc is None:
+        pytest.skip("gcc is not available")
+    res = subprocess.run([gcc, "-std=c99", "-Wall", "-Werror", "-c", f"-I{tmp_path}",
+                          *(str(tmp_path / f) for f in constants.CORE_SOURCES)], cwd=tmp_path, capture_output=True,
+                         text=True)
+    assert res.returncode == 0, res.stderr
+
+
+def test_a_cover_parameter_missing_from_variables_is_refused(monkeypatch):
+    ext = dataclasses.make_dataclass("CoverParameters", [(COVER_EXTRA[0], float, 1.0)],
+                                     bases=(clutch_model.CoverParameters,), frozen=True)
+    monkeypatch.setattr(clutch_model, "CoverParameters", ext)
+    with pytest.raises(ValueError, match="cover parameter k_cover_extra: not a parameter of VARIABLES"):
+        variable_header()

@@ -17,9 +17,12 @@ from pathlib import Path
 
 from ..data import fmu_source, fmu_sources
 from .crossbuild import compile_command
+from .variable_table import COVER_HEADER, cover_header
 
 #: the role folders of ``fmu_src`` a host library compiles against (each on the include path)
 LIBRARY_ROLES = ("core", "hosts")
+#: the headers a host library's build generates (name -> text): the cover's parameter enum
+GENERATED = {COVER_HEADER: cover_header}
 #: exact IEEE arithmetic as Python's: no contraction into FMAs, no builtin rewriting of ``pow``
 EXACT_FLAGS = ("-ffp-contract=off", "-fno-builtin")
 
@@ -39,8 +42,8 @@ def host_library(name: str, files: tuple[str, ...], headers: tuple[str, ...],
         The library's file name stem (``launch_plant``); the cached file is ``{name}_{hash}.so``.
     files, headers : tuple of str
         Sources compiled and headers they include, file names in ``fmu_src``'s role folders
-        (:func:`cushion_clutch.data.fmu_source`); the folders of :data:`LIBRARY_ROLES` are on the include path
-        and every header there is hashed too.
+        (:func:`cushion_clutch.data.fmu_source`); the folders of :data:`LIBRARY_ROLES` and the headers the
+        build generates (:data:`GENERATED`) are on the include path, and every header there is hashed too.
     extra_flags : tuple of str
         Compiler flags after the FMU's (default: :data:`EXACT_FLAGS`).
 
@@ -54,10 +57,13 @@ def host_library(name: str, files: tuple[str, ...], headers: tuple[str, ...],
     rel = tuple(fmu_source(f).relative_to(src).as_posix() for f in files)
     folders = [src / role for role in LIBRARY_ROLES]
     every_header = sorted(h for folder in folders for h in folder.glob("*.h"))   # a changed header rebuilds too
+    generated = {name: make() for name, make in GENERATED.items()}
     blob = b"".join(p.read_bytes() for p in (*(fmu_source(f) for f in (*files, *headers)), *every_header))
+    blob += "".join(generated.values()).encode()
     includes = tuple(f"-I{folder}" for folder in folders)
     cmd = " ".join(compile_command(None, 2, Path("."), rel, Path("lib"),
-                                   extra_flags=(*(f"-I{role}" for role in LIBRARY_ROLES), *extra_flags)))
+                                   extra_flags=(*(f"-I{role}" for role in LIBRARY_ROLES), "-Igenerated",
+                                                *extra_flags)))
     digest = hashlib.sha256(blob + cmd.encode()).hexdigest()[:16]
     suffix = ".dll" if sys.platform == "win32" else (".dylib" if sys.platform == "darwin" else ".so")
     for folder in (_cache_dir(), Path(tempfile.gettempdir()) / "cushion_clutch"):
@@ -69,8 +75,12 @@ def host_library(name: str, files: tuple[str, ...], headers: tuple[str, ...],
         except OSError:
             continue
         tmp = out.with_name(f"{out.stem}.{os.getpid()}{suffix}")
-        proc = subprocess.run(compile_command(None, 2, src, rel, tmp, extra_flags=(*includes, *extra_flags)),
-                              capture_output=True, text=True)
+        with tempfile.TemporaryDirectory(prefix="cushion_generated_") as gen:
+            for gen_name, text in generated.items():
+                (Path(gen) / gen_name).write_text(text)
+            proc = subprocess.run(compile_command(None, 2, src, rel, tmp, extra_flags=(*includes, f"-I{gen}",
+                                                                                       *extra_flags)),
+                                  capture_output=True, text=True)
         if proc.returncode != 0 or not tmp.exists():
             tmp.unlink(missing_ok=True)
             raise RuntimeError(f"building the native {name} library failed:\n{proc.stderr}")

@@ -71,7 +71,8 @@ VARIABLES = (
     ("bearing_force", "output", "N", "release-bearing force F_to on the diaphragm fingers (0: lifted off)"),
     ("facing_wear", "parameter", "m", "axial wear of both facings since new (moves the kiss point and the "
                                       "diaphragm's installed deflection)"),
-    # the cover (cover.CoverParameters, in its field order: the native core reads them as one block)
+    # the cover (cover.CoverParameters, in its field order; the native core finds each through CC_COVER_VR, so a new
+    # cover parameter is appended at the end of this table like any other)
     ("diaphragm_outer_radius_m", "parameter", "m", "diaphragm spring outer radius a"),
     ("diaphragm_inner_radius_m", "parameter", "m", "diaphragm spring inner radius b (finger roots)"),
     ("diaphragm_thickness_m", "parameter", "m", "diaphragm spring sheet thickness t"),

@@ -30,9 +30,8 @@ static void set_starts(double *r) {
     for (k = 0; k < CC_NVARS; ++k) r[k] = CC_VARIABLES[k].start;
 }
 
-/* the cover's parameters are one block of variables in CV_* order (clutch_model.VARIABLES lists them so) */
-typedef char cover_block_is_contiguous[(VR_REFERENCE_TEMPERATURE_K - VR_DIAPHRAGM_OUTER_RADIUS_M == CV_NPAR - 1 &&
-                                        VR_FULCRUM_RADIUS_M - VR_DIAPHRAGM_OUTER_RADIUS_M == CV_RF) ? 1 : -1];
+/* the cover's parameters as variables: one value reference per CV_* (generated, cushion_variables.h) */
+typedef char cover_vr_per_parameter[sizeof CC_COVER_VR / sizeof CC_COVER_VR[0] == CV_NPAR ? 1 : -1];
 
 static const char *phase_name(int phase) {
     switch (phase) {
@@ -178,38 +177,46 @@ static const char *unit_hint(char *buf, size_t n, int k, double v) {
     return buf;
 }
 
-/* the cover parameters of a variable vector (CV_* order) */
-static const double *cover_params(const double *r) { return r + VR_DIAPHRAGM_OUTER_RADIUS_M; }
+/* the cover parameters c (CV_* order) of a variable vector r; returns c */
+static const double *cover_params(const double *r, double *c) {
+    int k;
+    for (k = 0; k < CV_NPAR; ++k) c[k] = r[CC_COVER_VR[k]];
+    return c;
+}
 
 /* the cover's consistency rules of cover.CoverParameters.problems (ranges are checked before);
    logs each problem when m is not NULL; returns 1 if the cover is consistent */
 static int cover_consistent(CcModel *m, const double *r, const char *fn) {
-    const double *c = cover_params(r);
+    double par[CV_NPAR];
+    const double *c = cover_params(r, par);
+    const double a = c[CV_DIAPHRAGM_OUTER_RADIUS_M], b = c[CV_DIAPHRAGM_INNER_RADIUS_M];
+    const double r_f = c[CV_FULCRUM_RADIUS_M], r_pp = c[CV_PRESSURE_PLATE_RADIUS_M];
+    const double t = c[CV_DIAPHRAGM_THICKNESS_M], h = c[CV_DIAPHRAGM_CONE_HEIGHT_M];
     double lever = r[VR_LEVER_RATIO];
     int ok = 1;
-    if (!(c[CV_B] < c[CV_RF] && c[CV_RF] < c[CV_RPP] && c[CV_RPP] <= c[CV_A])) {
+    if (!(b < r_f && r_f < r_pp && r_pp <= a)) {
         if (m) cc_log(m, CC_ERROR, "%s: radii must satisfy diaphragm_inner_radius_m < fulcrum_radius_m < "
-                      "pressure_plate_radius_m <= diaphragm_outer_radius_m (got %.17g < %.17g < %.17g <= %.17g)", fn, c[CV_B],
-                      c[CV_RF], c[CV_RPP], c[CV_A]);
+                      "pressure_plate_radius_m <= diaphragm_outer_radius_m (got %.17g < %.17g < %.17g <= %.17g)", fn, b,
+                      r_f, r_pp, a);
         ok = 0;
     }
-    if (!(c[CV_H] < 2.0 * sqrt(2.0) * c[CV_T])) {
+    if (!(h < 2.0 * sqrt(2.0) * t)) {
         if (m) cc_log(m, CC_ERROR, "%s: diaphragm_cone_height_m / diaphragm_thickness_m = %.17g must be < 2 sqrt(2) "
-                      "(above, the diaphragm's valley force is negative: it snaps through)", fn, c[CV_H] / c[CV_T]);
+                      "(above, the diaphragm's valley force is negative: it snaps through)", fn, h / t);
         ok = 0;
     }
-    if (!(c[CV_SINST] <= 2.0 * c[CV_H])) {
-        if (m) cc_log(m, CC_ERROR, "%s: installed_deflection_m = %.17g must be <= 2 diaphragm_cone_height_m = %.17g m (past "
-                      "that the diaphragm is turned inside out)", fn, c[CV_SINST], 2.0 * c[CV_H]);
+    if (!(c[CV_INSTALLED_DEFLECTION_M] <= 2.0 * h)) {
+        if (m) cc_log(m, CC_ERROR, "%s: installed_deflection_m = %.17g must be <= 2 diaphragm_cone_height_m = %.17g m "
+                      "(past that the diaphragm is turned inside out)", fn, c[CV_INSTALLED_DEFLECTION_M], 2.0 * h);
         ok = 0;
     }
-    if (!(c[CV_KE] * (2000.0 - c[CV_TREF]) < 1.0)) {
+    if (!(c[CV_DIAPHRAGM_MODULUS_DROP_PER_K] * (2000.0 - c[CV_REFERENCE_TEMPERATURE_K]) < 1.0)) {
         if (m) cc_log(m, CC_ERROR, "%s: diaphragm_modulus_drop_per_K: E(theta) must stay > 0 up to 2000 K", fn);
         ok = 0;
     }
-    if (ok && !(lever * (c[CV_RPP] - c[CV_RF]) < c[CV_RF])) {
+    if (ok && !(lever * (r_pp - r_f) < r_f)) {
         if (m) cc_log(m, CC_ERROR, "%s: lever_ratio = %.17g puts the bearing at r_b = r_f - i (r_pp - r_f) = %g m; "
-                      "must be > 0", fn, lever, c[CV_RF] - lever * (c[CV_RPP] - c[CV_RF]));
+                      "must be > 0", fn, lever, r_f - lever * (r_pp - r_f));
         ok = 0;
     }
     if (ok && m) {
@@ -217,7 +224,7 @@ static int cover_consistent(CcModel *m, const double *r, const char *fn) {
         cc_cover_prepare(&cv, c, lever, kiss_ref(m, r), &m->table);
         if (!(cc_cover_slope_bound(&cv) > 0.0)) {
             cc_log(m, CC_ERROR, "%s: release_compliance_m_per_N = %.17g: the release snaps through (x_to(s) not "
-                   "monotone on the diaphragm's falling branch); reduce it", fn, c[CV_C]);
+                   "monotone on the diaphragm's falling branch); reduce it", fn, c[CV_RELEASE_COMPLIANCE_M_PER_N]);
             ok = 0;
         }
     }
@@ -260,8 +267,8 @@ static int check_parameters(CcModel *m, const double *r, const char *fn) {
         /* the diaphragm must hold the cushion at this wear at every temperature in range (about 1 ms: the
            parameters that passed are kept, so restoring states of the same instance does not repeat it) */
         CcCover cv;
-        double fto = 0.0, t_cs = 0.0, t_cm = 0.0;
-        cc_cover_prepare(&cv, cover_params(r), r[VR_LEVER_RATIO], kiss_ref(m, r), &m->table);
+        double fto = 0.0, t_cs = 0.0, t_cm = 0.0, par[CV_NPAR];
+        cc_cover_prepare(&cv, cover_params(r, par), r[VR_LEVER_RATIO], kiss_ref(m, r), &m->table);
         if (!cc_cover_holds(&cv, &m->table, r[VR_FACING_WEAR], THETA_MIN_K, THETA_MAX_K, &fto, &t_cs, &t_cm)) {
             double limit = cc_cover_wear_limit(&cv, &m->table, THETA_MIN_K, THETA_MAX_K);
             char where[120];
@@ -326,7 +333,8 @@ static int update_outputs(CcModel *m) {
     double mu = tb->f_mu ? cc_table_mu(tb, r[CC_VR_THETA_MU] - KELVIN, r[VR_OMEGA_SLIP]) : r[VR_MU];
     double g = r[VR_U] + r[VR_H];
     if (!m->cover_ok) {
-        cc_cover_prepare(&m->cover, cover_params(r), r[VR_LEVER_RATIO], kiss_ref(m, r), tb);
+        double par[CV_NPAR];
+        cc_cover_prepare(&m->cover, cover_params(r, par), r[VR_LEVER_RATIO], kiss_ref(m, r), tb);
         m->cover_ok = 1;
     }
     r[CC_VR_DER_THETA_CS] = (r[VR_U] * r[VR_THETA_CM] + r[VR_H] * r[VR_THETA_A] - g * r[VR_THETA_CS]) / r[VR_C];

@@ -34,43 +34,49 @@ static double k1(double a, double b) {
 
 /* M(s) = F_AL(s) e (E folded into fal) and dM/ds */
 static double moment(const CcCover *cv, double s, double e_mod) {
-    double t = cv->p[CV_T], h = cv->p[CV_H];
+    double t = cv->p[CV_DIAPHRAGM_THICKNESS_M], h = cv->p[CV_DIAPHRAGM_CONE_HEIGHT_M];
     return cv->fal * e_mod * (s / t) * ((h - s) * (h - 0.5 * s) / cv->tt + 1.0) * cv->e;
 }
 
 static double moment_slope(const CcCover *cv, double s, double e_mod) {
-    double t = cv->p[CV_T], h = cv->p[CV_H];
+    double t = cv->p[CV_DIAPHRAGM_THICKNESS_M], h = cv->p[CV_DIAPHRAGM_CONE_HEIGHT_M];
     return cv->fal * e_mod / t * ((h - s) * (h - 0.5 * s) / (t * t) + 1.0 - s * (1.5 * h - s) / (t * t)) * cv->e;
 }
 
 static double youngs(const CcCover *cv, double theta_K) {
-    return cv->p[CV_E] * (1.0 - cv->p[CV_KE] * (theta_K - cv->p[CV_TREF]));
+    return cv->p[CV_DIAPHRAGM_YOUNGS_MODULUS_PA] *
+           (1.0 - cv->p[CV_DIAPHRAGM_MODULUS_DROP_PER_K] * (theta_K - cv->p[CV_REFERENCE_TEMPERATURE_K]));
 }
 
 void cc_cover_prepare(CcCover *cv, const double *par, double lever_ratio, double x_kiss_ref, const Table *tb) {
     double s_k0, f_to, th_ref;
     memcpy(cv->p, par, sizeof cv->p);
-    cv->e = par[CV_A] - par[CV_B];
-    cv->L_pp = par[CV_RPP] - par[CV_RF];
+    cv->e = par[CV_DIAPHRAGM_OUTER_RADIUS_M] - par[CV_DIAPHRAGM_INNER_RADIUS_M];
+    cv->L_pp = par[CV_PRESSURE_PLATE_RADIUS_M] - par[CV_FULCRUM_RADIUS_M];
     cv->L_b = lever_ratio * cv->L_pp;
     cv->kb = cv->L_b / cv->e;
     cv->kp = cv->L_pp / cv->e;
-    cv->fal = 4.0 / (1.0 - par[CV_NU] * par[CV_NU]) * pow(par[CV_T], 4) / (k1(par[CV_A], par[CV_B]) * 4.0 *
-                                                                             par[CV_A] * par[CV_A]);
+    cv->fal = 4.0 / (1.0 - par[CV_DIAPHRAGM_POISSON_RATIO] * par[CV_DIAPHRAGM_POISSON_RATIO]) *
+              pow(par[CV_DIAPHRAGM_THICKNESS_M], 4) /
+              (k1(par[CV_DIAPHRAGM_OUTER_RADIUS_M], par[CV_DIAPHRAGM_INNER_RADIUS_M]) * 4.0 *
+               par[CV_DIAPHRAGM_OUTER_RADIUS_M] * par[CV_DIAPHRAGM_OUTER_RADIUS_M]);
     /* the frame's parameter-only subexpressions, each evaluated as the frame had it (the same bits) */
-    cv->tt = par[CV_T] * par[CV_T];
-    cv->dstack = par[CV_TF] * par[CV_AF] + par[CV_TPP] * par[CV_APP] + par[CV_LFW] * par[CV_AFW];
-    th_ref = par[CV_TREF] - KELVIN;
+    cv->tt = par[CV_DIAPHRAGM_THICKNESS_M] * par[CV_DIAPHRAGM_THICKNESS_M];
+    cv->dstack = par[CV_FACING_THICKNESS_M] * par[CV_FACING_EXPANSION_PER_K] +
+                 par[CV_PRESSURE_PLATE_THICKNESS_M] * par[CV_PRESSURE_PLATE_EXPANSION_PER_K] +
+                 par[CV_FLYWHEEL_LENGTH_M] * par[CV_FLYWHEEL_EXPANSION_PER_K];
+    th_ref = par[CV_REFERENCE_TEMPERATURE_K] - KELVIN;
     cv->u_full_ref = cc_table_full(tb, th_ref);
-    s_k0 = par[CV_SINST] + cv->u_full_ref / cv->kp;
-    f_to = (moment(cv, s_k0, par[CV_E]) - cc_table_force(tb, 0.0, th_ref) * cv->L_pp) / cv->L_b;
-    cv->xc = x_kiss_ref + cv->kb * s_k0 + par[CV_C] * f_to;
+    s_k0 = par[CV_INSTALLED_DEFLECTION_M] + cv->u_full_ref / cv->kp;
+    f_to = (moment(cv, s_k0, par[CV_DIAPHRAGM_YOUNGS_MODULUS_PA]) - cc_table_force(tb, 0.0, th_ref) * cv->L_pp) /
+           cv->L_b;
+    cv->xc = x_kiss_ref + cv->kb * s_k0 + par[CV_RELEASE_COMPLIANCE_M_PER_N] * f_to;
     /* the solver's residual: ck = c / L_b and its products (see cc_cover_state) */
-    cv->ck = par[CV_C] / cv->L_b;
+    cv->ck = par[CV_RELEASE_COMPLIANCE_M_PER_N] / cv->L_b;
     cv->ckl = cv->ck * cv->L_pp;
     cv->ckp = cv->ckl * cv->kp;
     cv->ck_fal = cv->ck * cv->fal;
-    cv->p1h = 1.0 + par[CV_H] * par[CV_H] / cv->tt;
+    cv->p1h = 1.0 + par[CV_DIAPHRAGM_CONE_HEIGHT_M] * par[CV_DIAPHRAGM_CONE_HEIGHT_M] / cv->tt;
     cv->f_theta_cs = NAN; /* no frame yet */
     cv->hint = cv->hint_k = cv->hint_t = 0;
     /* the open solve's shortcut (cc_cover_solve) needs every CurvePair's cell 0 to be the clamped constant:
@@ -95,8 +101,10 @@ void cc_cover_prepare(CcCover *cv, const double *par, double lever_ratio, double
 
 /* -(dx_to/ds) at its smallest (open phase, s = h) at the largest E: > 0 means no snap-through */
 double cc_cover_slope_bound(const CcCover *cv) {
-    double e_max = cv->p[CV_E] * (1.0 + cv->p[CV_KE] * cv->p[CV_TREF]);
-    return cv->kb + cv->p[CV_C] * moment_slope(cv, cv->p[CV_H], e_max) / cv->L_b;
+    double e_max = cv->p[CV_DIAPHRAGM_YOUNGS_MODULUS_PA] *
+                   (1.0 + cv->p[CV_DIAPHRAGM_MODULUS_DROP_PER_K] * cv->p[CV_REFERENCE_TEMPERATURE_K]);
+    return cv->kb +
+           cv->p[CV_RELEASE_COMPLIANCE_M_PER_N] * moment_slope(cv, cv->p[CV_DIAPHRAGM_CONE_HEIGHT_M], e_max) / cv->L_b;
 }
 
 /* the solver's curve functions are inlined (the loop's constants stay in registers) */
@@ -125,15 +133,15 @@ static double cushion_value(const TBracket *b, double u, int *hint) {
 /* the frame: everything that depends on temperature and wear, not on x_to */
 static void frame(CcCover *cv, const Table *tb, double theta_cs, double theta_cm, double wear) {
     const double *p = cv->p;
-    double kb = cv->kb, kp = cv->kp, comp = p[CV_C];
+    double kb = cv->kb, kp = cv->kp, comp = p[CV_RELEASE_COMPLIANCE_M_PER_N];
     double stack, m_solid, e_mod, fk;
     TBracket b;
     e_mod = youngs(cv, theta_cs);
     stack = cc_table_bracket_hint(tb, theta_cs - KELVIN, &b, &cv->hint_t) +
-            cv->dstack * (theta_cm - p[CV_TREF]);
+            cv->dstack * (theta_cm - p[CV_REFERENCE_TEMPERATURE_K]);
     cv->f_e = e_mod;
     cv->f_br = b;
-    cv->s_kiss = p[CV_SINST] + (cv->u_full_ref + stack - wear) / kp;
+    cv->s_kiss = p[CV_INSTALLED_DEFLECTION_M] + (cv->u_full_ref + stack - wear) / kp;
     cv->s_solid = cv->s_kiss - b.full / kp;
     /* the full compression: each curve at its last row, (1 - w) y0 + w y1 (Bracket.force there up to the
        rounding of u_full and the curves' argument, an ulp or two of u, where dF/du is finite) */
@@ -150,7 +158,8 @@ static void frame(CcCover *cv, const Table *tb, double theta_cs, double theta_cm
     cv->x_kiss = cv->xc - kb * cv->s_kiss - comp * cv->fto_kiss;
     {   /* P(s)'s coefficients (operation for operation as the solver had them: the same root to the last bit
            where it matters, e.g. at the cushion's first contact, where F has a kink) */
-        const double t = p[CV_T], h = p[CV_H], tt = cv->tt, km = cv->ck_fal * e_mod * cv->e / t;
+        const double t = p[CV_DIAPHRAGM_THICKNESS_M], h = p[CV_DIAPHRAGM_CONE_HEIGHT_M], tt = cv->tt,
+                     km = cv->ck_fal * e_mod * cv->e / t;
         cv->p1 = -kb - km * cv->p1h;
         cv->p2 = km * 1.5 * h / tt;
         cv->p3 = -km * 0.5 / tt;
@@ -185,7 +194,7 @@ long cc_count_evals, cc_count_open;
 int cc_cover_solve(CcCover *cv, const Table *tb, double x_to, double theta_cs, double theta_cm, double wear,
                    CcWarm *w, CcCoverState *out) {
     const double *p = cv->p;
-    double kb = cv->kb, kp = cv->kp, comp = p[CV_C];
+    double kb = cv->kb, kp = cv->kp, comp = p[CV_RELEASE_COMPLIANCE_M_PER_N];
     double lo, hi, s, r, fc, fto, dfc, d2fc, slope = 0.0;
     CellPt pt;
     int k;
@@ -339,11 +348,13 @@ int cc_cover_grid(const Table *tb, double lo, double hi, double *g) {
 static double holds(const CcCover *cv, const Table *tb, double wear, double theta_cs, double theta_cm) {
     const double *p = cv->p;
     double th = theta_cs - KELVIN, e_mod = youngs(cv, theta_cs), worst = INFINITY, s_kiss, u_full;
-    double d = theta_cm - p[CV_TREF];
-    double stack = cc_table_delta(tb, th) + (p[CV_TF] * p[CV_AF] * d + p[CV_TPP] * p[CV_APP] * d +
-                                             p[CV_LFW] * p[CV_AFW] * d);
+    double d = theta_cm - p[CV_REFERENCE_TEMPERATURE_K];
+    double stack = cc_table_delta(tb, th) +
+                   (p[CV_FACING_THICKNESS_M] * p[CV_FACING_EXPANSION_PER_K] * d +
+                    p[CV_PRESSURE_PLATE_THICKNESS_M] * p[CV_PRESSURE_PLATE_EXPANSION_PER_K] * d +
+                    p[CV_FLYWHEEL_LENGTH_M] * p[CV_FLYWHEEL_EXPANSION_PER_K] * d);
     int k;
-    s_kiss = p[CV_SINST] + (cv->u_full_ref + stack - wear) / cv->kp;
+    s_kiss = p[CV_INSTALLED_DEFLECTION_M] + (cv->u_full_ref + stack - wear) / cv->kp;
     u_full = cc_table_full(tb, th);
     for (k = 0; k < 9; ++k) {
         double u = u_full * (9 - k) / 9;

@@ -8,11 +8,9 @@
 
 #include "clutch_tables.h"
 
-/* cover parameters, in the order of cover.CoverParameters' fields (cushion_clutch/model/cover.py) */
-enum {
-    CV_A, CV_B, CV_T, CV_H, CV_E, CV_KE, CV_NU, CV_RPP, CV_RF, CV_SINST, CV_C, CV_TF, CV_AF, CV_TPP, CV_APP,
-    CV_LFW, CV_AFW, CV_TREF, CV_NPAR
-};
+/* the cover's parameters CV_<FIELD> and CV_NPAR, in the order of cover.CoverParameters' fields (cushion_clutch/model/
+   cover.py): generated from the dataclass by the build (cushion_clutch.fmu.variable_table.cover_header) */
+#include "cushion_cover.h"
 
 /* the cover's force balance, prepared once per parameter set (clutch_cover.c) */
 typedef struct {

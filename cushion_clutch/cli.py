@@ -50,7 +50,7 @@ def _sweep(args: argparse.Namespace) -> int:
     from .fe.params import load_params
     from .fe.plots import plot_force_deflection, plot_kiss_shift
     from .fe.sweep import build_tables, run_sweep
-    from .fe.tables import read_tables
+    from .model.table_format import read_tables
 
     params = load_params(args.spring)
     if args.mesh_size is not None:
@@ -345,7 +345,7 @@ def fleet_terminal_table(summary: list[dict]) -> str:
 def _export(args: argparse.Namespace) -> int:
     from .fe.exports import build, export_mat, export_modelica
 
-    from .fe.tables import read_tables
+    from .model.table_format import read_tables
     from .outputs import OutputSet
 
     out = _guard_out(Path(args.out), args.force)

@@ -16,7 +16,7 @@ from cushion_clutch.fmu.build import build_fmu
 from cushion_clutch.data import DEFAULT_TABLES
 from cushion_clutch.model import load_table
 from cushion_clutch.model.cover import CoverMap, CoverParameters
-from cushion_clutch.fe.tables import read_tables
+from cushion_clutch.model.table_format import read_tables
 
 pytestmark = pytest.mark.fmu
 

@@ -9,7 +9,7 @@ from scipy.interpolate import PchipInterpolator
 from cushion_clutch.data import DEFAULT_TABLES
 from cushion_clutch.model import (KELVIN, ClutchParameters, CoverParameters, load_table, outputs, thermal_step, thermal_system,
                                   VARIABLES, x_to_for_torque)
-from cushion_clutch.fe.tables import read_tables
+from cushion_clutch.model.table_format import read_tables
 
 P = ClutchParameters()
 

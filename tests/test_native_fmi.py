@@ -572,7 +572,7 @@ def test_force_beyond_full_compression_is_the_table_s_last_row():
 
     Stiff release system (compliance 0): the paper's lever, u = (x_to - 4 mm) / 3."""
     from cushion_clutch.data import DEFAULT_TABLES
-    from cushion_clutch.fe.tables import read_tables
+    from cushion_clutch.model.table_format import read_tables
     tables = read_tables(DEFAULT_TABLES)
     full_20 = tables.force_N[list(tables.theta_degC).index(20.0)][-1]       # the tables start at -40 degC
     s, vr = _stepping(2, "full", start={"release_compliance_m_per_N": 0.0})

@@ -106,7 +106,8 @@ def test_committed_table_figures_are_the_readme_s():
     import numpy as np
 
     from cushion_clutch.data import DEFAULT_TABLES
-    from cushion_clutch.fe.tables import progressivity, read_tables
+    from cushion_clutch.fe.tables import progressivity
+    from cushion_clutch.model.table_format import read_tables
 
     t = read_tables(DEFAULT_TABLES)
     crest = dict(np.loadtxt(DEFAULT_TABLES / "crest_growth.csv", delimiter=",", skiprows=1))

@@ -5,7 +5,8 @@ import pytest
 from cushion_clutch.errors import ConvergenceError, SweepError
 from cushion_clutch.fe.cases import solve_case
 from cushion_clutch.fe.sweep import build_tables, run_sweep
-from cushion_clutch.fe.tables import curve_from_case, progressivity, read_tables
+from cushion_clutch.fe.tables import curve_from_case, progressivity
+from cushion_clutch.model.table_format import read_tables
 
 pytestmark = pytest.mark.ccx
 

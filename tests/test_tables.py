@@ -4,7 +4,8 @@ import pytest
 
 from cushion_clutch.errors import ResultError, TableError
 from cushion_clutch.fe.results import CaseResult
-from cushion_clutch.fe.tables import curve_from_case, read_tables, write_tables
+from cushion_clutch.fe.tables import curve_from_case, write_tables
+from cushion_clutch.model.table_format import read_tables
 
 
 def case(theta, travel, force):

@@ -72,7 +72,7 @@ def test_study_on_a_local_cluster_equals_one_by_one_and_resumes(coarse, tmp_path
 
     from cushion_clutch.cli import main
     from cushion_clutch.fe.sweep import run_sweep
-    from cushion_clutch.fe.tables import read_tables
+    from cushion_clutch.model.table_format import read_tables
     from cushion_clutch.fe.studies.tolerance import run_study
     from cushion_clutch.fmu.build import build_fmu
 

@@ -96,9 +96,9 @@ MUTANTS = (
            "wm_e, wm_d, wm_v = 0.5 * (w_e + w_e_new), 0.5 * (w_d + w_d_new), 0.5 * (w_v + w_v_new)",
            "wm_e, wm_d, wm_v = w_e_new, w_d_new, w_v_new",
            ("tests/test_launch.py",), "energy bookkeeping with end-of-step speeds"),
-    Mutant("py-kiss-row-order", "cushion_clutch/model/spring_table.py",
-           "        kp = kp[np.argsort(kp[:, 0])]\n", "",
-           ("tests/test_spring_table.py",), "pythonfmu loader ignores the row order of kiss_point.csv"),
+    Mutant("py-kiss-row-order", "cushion_clutch/model/table_format.py",
+           "    order = np.argsort(kp[:, 0])\n", "    order = np.arange(len(kp))\n",
+           ("tests/test_spring_table.py",), "the table reader ignores the row order of kiss_point.csv"),
     Mutant("py-api-parameters", "cushion_clutch/model/clutch_model.py",
            "            and (theta_cm is None or THETA_MIN_K <= theta_cm <= THETA_MAX_K) and _clutch_ok(p)):\n"
            "        raise _argument_error({\"x_to\"",

@@ -49,7 +49,7 @@ def _model(text: str) -> tuple[float, str, int | None]:
 
 def _sweep(params, cache, jobs):
     from cushion_clutch.fe.sweep import build_tables, run_sweep
-    from cushion_clutch.fe.tables import read_tables
+    from cushion_clutch.model.table_format import read_tables
     t0 = time.perf_counter()
     outcomes = run_sweep(params, cache_dir=cache, jobs=jobs)
     wall = time.perf_counter() - t0

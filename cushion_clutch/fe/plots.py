@@ -6,7 +6,7 @@ from pathlib import Path
 import numpy as np
 
 from ..plotting import finish_figure, plt
-from .tables import TableSet
+from ..model.table_format import TableSet
 
 
 def plot_force_deflection(tables: TableSet, path: Path, title: str = "") -> Path:

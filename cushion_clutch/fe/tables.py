@@ -1,7 +1,7 @@
 """From FE case results to lookup tables, written atomically.
 
 The table-set format (file names, columns, units) is
-:mod:`cushion_clutch.model.table_format`'s; this module writes and checks sets.
+:mod:`cushion_clutch.model.table_format`'s, and so is its one reader (``read_tables``); this module writes sets.
 """
 from __future__ import annotations
 
@@ -15,8 +15,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import ResultError, TableError
-from ..model.table_format import COLUMNS, CREST_GROWTH, FORCE_DEFLECTION, KISS_POINT, METADATA, load_csv
+from ..errors import ResultError
+from ..model.table_format import COLUMNS, CREST_GROWTH, FORCE_DEFLECTION, KISS_POINT, METADATA
 from .results import CaseResult
 
 #: relative force decrease (of the case's largest force) treated as solver noise
@@ -155,62 +155,6 @@ def _jsonable(obj):
     if isinstance(obj, Path):
         return str(obj)
     raise TypeError(f"not JSON serialisable: {type(obj)}")
-
-
-@dataclass(frozen=True)
-class TableSet:
-    """A table set read back: per-temperature curves and kiss shifts (SI)."""
-
-    theta_degC: np.ndarray
-    u_m: tuple[np.ndarray, ...]
-    force_N: tuple[np.ndarray, ...]
-    delta_kiss_m: np.ndarray
-    metadata: dict
-
-
-def read_tables(table_dir: Path) -> TableSet:
-    """Read and check a table set.
-
-    Raises
-    ------
-    TableError
-        Missing files, wrong columns, non-finite or non-monotone data.
-    """
-    table_dir = Path(table_dir)
-    if not table_dir.is_dir():
-        raise TableError(f"{table_dir}: table folder does not exist (it must hold force_deflection.csv "
-                         "and kiss_point.csv)")
-    fd = _read_csv(table_dir / FORCE_DEFLECTION)
-    kp = _read_csv(table_dir / KISS_POINT)
-    meta_path = table_dir / METADATA
-    try:
-        metadata = json.loads(meta_path.read_text(encoding="utf-8")) if meta_path.exists() else {}
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise TableError(f"{meta_path}: not a readable JSON file: {exc}") from exc
-    if not isinstance(metadata, dict):
-        raise TableError(f"{meta_path}: must hold a JSON object")
-    thetas = np.unique(fd[:, 0])
-    us, fs = [], []
-    for t in thetas:
-        rows = fd[fd[:, 0] == t]
-        if len(rows) < 2 or np.any(np.diff(rows[:, 1]) <= 0) or np.any(np.diff(rows[:, 2]) < 0):
-            raise TableError(f"{table_dir}/force_deflection.csv: theta = {t:g} needs >= 2 rows, "
-                             "u strictly increasing and force non-decreasing")
-        us.append(rows[:, 1])
-        fs.append(rows[:, 2])
-    order = np.argsort(kp[:, 0])
-    if not np.array_equal(np.sort(kp[:, 0]), thetas):
-        raise TableError(f"{table_dir}: kiss_point.csv temperatures {kp[order, 0]} differ from "
-                         f"force_deflection.csv temperatures {thetas}")
-    return TableSet(thetas, tuple(us), tuple(fs), kp[order, 1], metadata)
-
-
-def _read_csv(path: Path) -> np.ndarray:
-    """The model's own table reader (the one the FMU uses), errors as TableError."""
-    try:
-        return load_csv(path, COLUMNS[path.name])
-    except ValueError as exc:
-        raise TableError(str(exc)) from exc
 
 
 #: travel fractions (kiss point to full compression) at which progressivity is reported

@@ -10,8 +10,7 @@ import logging
 from pathlib import Path
 
 from ..errors import FmuError, ParameterError, TableError
-from ..fe.tables import read_tables
-from ..model.table_format import REQUIRED_FILES
+from ..model.table_format import REQUIRED_FILES, read_tables
 
 log = logging.getLogger(__name__)
 

@@ -19,14 +19,15 @@ FMU_SRC = fmu_sources()
 PYTHONFMU_SRC = FMU_SRC / "pythonfmu"
 #: folder of the numpy-only model modules (:mod:`cushion_clutch.model`)
 MODEL_SRC = Path(clutch_model.__file__).parent
-#: the package's ground floor (:mod:`cushion_clutch.number_check`, which the model and the loaders share)
+#: the package's ground floor (:mod:`cushion_clutch.number_check`, which the model and the loaders share, and
+#: :mod:`cushion_clutch.errors`, whose TableError the table reader raises)
 PACKAGE_SRC = MODEL_SRC.parent
 #: the modules the pythonfmu slave imports (siblings inside the FMU): the slave class (from ``PYTHONFMU_SRC``)
-#: and the numpy-only model (from ``MODEL_SRC``, its number check from ``PACKAGE_SRC``)
+#: and the numpy-only model (from ``MODEL_SRC``, its number check and errors from ``PACKAGE_SRC``)
 SLAVE_MODULES = {"cushion_slave.py": PYTHONFMU_SRC, "slave_table_sets.py": PYTHONFMU_SRC, "clutch_model.py": MODEL_SRC,
                  "spring_table.py": MODEL_SRC,
                  "friction.py": MODEL_SRC, "table_format.py": MODEL_SRC, "cover.py": MODEL_SRC,
-                 "number_check.py": PACKAGE_SRC}
+                 "number_check.py": PACKAGE_SRC, "errors.py": PACKAGE_SRC}
 
 #: the native model core (shared) and the front end of each FMI version, as shipped in sources/ (flat there: the
 #: role folders of ``FMU_SRC`` are a layout of the package only; :func:`cushion_clutch.data.fmu_source` finds each)

@@ -16,9 +16,9 @@ from pathlib import Path
 import numpy as np
 
 try:                                    # inside the pythonfmu FMU the modules are siblings
-    from .table_format import COLUMNS as TABLE_COLUMNS, FRICTION, load_csv
+    from .table_format import COLUMNS as TABLE_COLUMNS, FRICTION, TableError, load_csv
 except ImportError:
-    from table_format import COLUMNS as TABLE_COLUMNS, FRICTION, load_csv
+    from table_format import COLUMNS as TABLE_COLUMNS, FRICTION, TableError, load_csv
 
 COLUMNS = TABLE_COLUMNS[FRICTION]
 #: largest accepted friction coefficient in a table, 1
@@ -63,7 +63,7 @@ class FrictionTable:
         elif not np.all(np.isfinite(m)) or np.any(m < 0.0) or np.any(m > MU_LIMIT):
             problems.append(f"mu must be finite and in [0, {MU_LIMIT:g}]")
         if problems:
-            raise ValueError("friction table: " + "; ".join(problems))
+            raise TableError("friction table: " + "; ".join(problems))
         self.mu = [[float(v) for v in row] for row in m]
 
     @classmethod
@@ -72,22 +72,22 @@ class FrictionTable:
 
         Raises
         ------
-        ValueError
-            Naming the file, if it is malformed or not a full grid.
+        TableError
+            Naming the file, if it is malformed or not a full grid (a ``ValueError``).
         """
         data = load_csv(Path(path), COLUMNS)
         thetas, omegas = np.unique(data[:, 0]), np.unique(data[:, 1])
         if len(data) != len(thetas) * len(omegas):
-            raise ValueError(f"{path}: rows must form a full grid of {len(thetas)} temperatures x "
+            raise TableError(f"{path}: rows must form a full grid of {len(thetas)} temperatures x "
                              f"{len(omegas)} slip speeds, each once (got {len(data)} rows)")
         grid = np.full((len(thetas), len(omegas)), np.nan)
         grid[np.searchsorted(thetas, data[:, 0]), np.searchsorted(omegas, data[:, 1])] = data[:, 2]
         if np.isnan(grid).any():
-            raise ValueError(f"{path}: a (theta_degC, omega_slip_rad_s) pair appears twice")
+            raise TableError(f"{path}: a (theta_degC, omega_slip_rad_s) pair appears twice")
         try:
             return cls(thetas, omegas, grid)
         except ValueError as exc:
-            raise ValueError(f"{path}: {exc}") from exc
+            raise TableError(f"{path}: {exc}") from exc
 
     def __call__(self, theta_degC: float, omega_slip_rad_s: float) -> float:
         """mu at facing temperature ``theta_degC`` (degC) and slip speed ``|omega_slip_rad_s|`` (rad/s)."""

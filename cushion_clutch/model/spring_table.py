@@ -30,11 +30,11 @@ import numpy as np
 try:                                    # inside the pythonfmu FMU the modules are siblings
     from .friction import FrictionTable
     from ..number_check import KELVIN
-    from .table_format import COLUMNS, FORCE_DEFLECTION, FRICTION, KISS_POINT, load_csv
+    from .table_format import FORCE_DEFLECTION, FRICTION, TableError, read_tables
 except ImportError:
     from friction import FrictionTable
     from number_check import KELVIN
-    from table_format import COLUMNS, FORCE_DEFLECTION, FRICTION, KISS_POINT, load_csv
+    from table_format import FORCE_DEFLECTION, FRICTION, TableError, read_tables
 
 #: brackets (blended curves) a table keeps, by exact temperature
 BRACKETS_KEPT = 64
@@ -189,30 +189,20 @@ class SpringTable:
 
     @classmethod
     def from_dir(cls, folder: str | Path) -> "SpringTable":
-        """Read ``force_deflection.csv``, ``kiss_point.csv`` and the optional ``friction.csv``.
+        """The table set of ``folder`` (:func:`.table_format.read_tables`, the one reader) and its optional
+        ``friction.csv``.
 
         Raises
         ------
-        ValueError
-            With the file name, if a file is malformed.
+        TableError
+            With the file name, if a file is malformed (a ``ValueError``).
         """
         folder = Path(folder)
-        fd = load_csv(folder / FORCE_DEFLECTION, COLUMNS[FORCE_DEFLECTION])
-        kp = load_csv(folder / KISS_POINT, COLUMNS[KISS_POINT])
-        negative = np.flatnonzero(fd[:, 2] < 0.0)
-        if negative.size:
-            k = int(negative[0])
-            raise ValueError(f"{folder / FORCE_DEFLECTION}: row {k + 1} (line {k + 2}): force_N = {float(fd[k, 2])!r} "
-                             f"< 0 (a clamp force cannot be negative; {negative.size} such row(s))")
-        thetas = np.unique(fd[:, 0])
-        if not np.array_equal(np.sort(kp[:, 0]), thetas):
-            raise ValueError(f"{folder}: {KISS_POINT} and {FORCE_DEFLECTION} temperatures differ")
-        kp = kp[np.argsort(kp[:, 0])]
+        ts = read_tables(folder)
         try:
-            table = cls(thetas, [fd[fd[:, 0] == t, 1] for t in thetas],
-                        [fd[fd[:, 0] == t, 2] for t in thetas], kp[:, 1])
+            table = cls(ts.theta_degC, list(ts.u_m), list(ts.force_N), ts.delta_kiss_m)
         except ValueError as exc:
-            raise ValueError(f"{folder / FORCE_DEFLECTION}: {exc}") from exc
+            raise TableError(f"{folder / FORCE_DEFLECTION}: {exc}") from exc
         if (folder / FRICTION).exists():
             table.friction = FrictionTable.from_csv(folder / FRICTION)
         return table

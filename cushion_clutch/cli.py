@@ -343,7 +343,7 @@ def fleet_terminal_table(summary: list[dict]) -> str:
 
 
 def _export(args: argparse.Namespace) -> int:
-    from .fe.exports import build, export_mat, export_modelica
+    from .fmu.exports import build, export_mat, export_modelica
 
     from .model.table_format import read_tables
     from .outputs import OutputSet

@@ -12,7 +12,7 @@ from scipy.interpolate import RegularGridInterpolator
 from scipy.io import loadmat
 
 from cushion_clutch.data import DEFAULT_TABLES
-from cushion_clutch.fe.exports import build, export_mat, export_modelica, read_modelica
+from cushion_clutch.fmu.exports import build, export_mat, export_modelica, read_modelica
 from cushion_clutch.model.table_format import read_tables
 from cushion_clutch.model import KELVIN, ClutchParameters, load_table, outputs
 from native_builds import native_fmus

@@ -26,7 +26,7 @@ from xml.etree import ElementTree as ET
 
 from ..errors import ParameterError
 from ..model import clutch_model
-from ..model.table_format import FMU_FILES, METADATA, table_set_x_kiss_ref
+from ..model.table_format import FMU_FILES, read_metadata, table_set_x_kiss_ref
 
 #: the manifest of a multi-set FMU's resources
 MANIFEST = "table_sets.json"
@@ -75,8 +75,7 @@ def _item_name(folder: Path) -> str:
 
 
 def _description(folder: Path, kiss_offset_m: float) -> str:
-    meta_path = Path(folder) / METADATA
-    meta = json.loads(meta_path.read_text()) if meta_path.exists() else {}
+    meta = read_metadata(folder)
     spring = meta.get("spring", {}) if isinstance(meta.get("spring"), dict) else {}
     text = str(spring.get("description") or spring.get("name") or f"tables from {Path(folder).name}")
     scale = meta.get("force_scale")

@@ -208,6 +208,72 @@ def _sublayers(z0: float, thickness: float, n: int, grade: float = 1.0) -> list[
     return list(z0 + thickness * np.cumsum(w) / w.sum())
 
 
+def _properties(hp: HeatPathParams, parts_a: np.ndarray, cell_a: np.ndarray, h_iface: np.ndarray,
+                f_rivet: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Per element: conductivity (W/(m K)), density (kg/m3) and specific heat (J/(kg K)) by part (the contact
+    layers as thin layers of k = h t, the rivet columns mixed into the lower lining by their cell share
+    ``f_rivet``), and the mask of the lining elements that hold a rivet column."""
+    t_int = INTERFACE_THICKNESS_M
+    k = np.empty(len(parts_a))
+    rho = np.empty(len(parts_a))
+    c = np.empty(len(parts_a))
+    ci, cj = cell_a[:, 0], cell_a[:, 1]
+    steel = (parts_a == "CARRIER") | (parts_a == "PADDLE")
+    k[steel], rho[steel], c[steel] = hp.steel_conductivity_W_per_m_K, hp.steel_density_kg_m3, \
+        hp.steel_specific_heat_J_per_kg_K
+    joint = parts_a == "JOINT"
+    k[joint], rho[joint], c[joint] = hp.joint_contact_W_per_m2_K * t_int, _AIR_RHO, _AIR_C
+    iface = parts_a == "INTERFACE"
+    k[iface], rho[iface], c[iface] = h_iface[ci[iface], cj[iface]] * t_int, _AIR_RHO, _AIR_C
+    lining = (parts_a == "FACING_LOW") | (parts_a == "FACING_UP")
+    k[lining], rho[lining], c[lining] = hp.lining_conductivity_W_per_m_K, hp.lining_density_kg_m3, \
+        hp.lining_specific_heat_J_per_kg_K
+    col = (parts_a == "FACING_LOW") & (f_rivet[ci, cj] > 0)
+    f = f_rivet[ci[col], cj[col]]
+    k[col] = f * rivet_column_conductivity(hp) + (1 - f) * hp.lining_conductivity_W_per_m_K
+    rho_c = f * hp.rivet_density_kg_m3 * hp.rivet_specific_heat_J_per_kg_K + \
+        (1 - f) * hp.lining_density_kg_m3 * hp.lining_specific_heat_J_per_kg_K
+    rho[col] = f * hp.rivet_density_kg_m3 + (1 - f) * hp.lining_density_kg_m3
+    c[col] = rho_c / rho[col]
+    return k, rho, c, col
+
+
+def _exterior_faces(occ: np.ndarray, layer_a: np.ndarray, cell_a: np.ndarray,
+                    adiabatic_part: np.ndarray) -> dict[str, list[np.ndarray]]:
+    """The exterior faces (element, face number 1..6) found from the occupancy ``occ`` (layer, r cell, phi cell)
+    of the neighbours, grouped FRICTION (the top layer's tops), HUB (the inner rim) and CONVECTION (the rest);
+    none on the contact layers (``adiabatic_part``), the mirror plane z = 0 and the periodic cuts."""
+    nl, nr, nphi = occ.shape
+    ci, cj = cell_a[:, 0], cell_a[:, 1]
+    pad = np.zeros((nl + 2, nr + 2, nphi + 2), dtype=bool)
+    pad[1:-1, 1:-1, 1:-1] = occ
+    li, i, j = layer_a + 1, ci + 1, cj + 1
+    open_ = {1: ~pad[li - 1, i, j], 2: ~pad[li + 1, i, j], 3: ~pad[li, i, j - 1], 4: ~pad[li, i + 1, j],
+             5: ~pad[li, i, j + 1], 6: ~pad[li, i - 1, j]}
+    groups: dict[str, list[np.ndarray]] = {"FRICTION": [], "HUB": [], "CONVECTION": []}
+    eidx = np.arange(len(layer_a))
+    for face, is_open in open_.items():
+        ok = is_open & ~adiabatic_part
+        if face == 1:
+            ok &= layer_a > 0                                   # z = 0: mirror plane
+        if face == 3:
+            ok &= cj > 0                                        # phi = 0: periodic cut
+        if face == 5:
+            ok &= cj < nphi - 1                                 # phi = sector: periodic cut
+        sel = eidx[ok]
+        fn = np.full(len(sel), face)
+        if face == 2:
+            top = layer_a[sel] == nl - 1
+            groups["FRICTION"].append(np.stack([sel[top], fn[top]], axis=1))
+            sel, fn = sel[~top], fn[~top]
+        if face == 6:
+            hub = ci[sel] == 0
+            groups["HUB"].append(np.stack([sel[hub], fn[hub]], axis=1))
+            sel, fn = sel[~hub], fn[~hub]
+        groups["CONVECTION"].append(np.stack([sel, fn], axis=1))
+    return groups
+
+
 def sector_mesh(spring: SpringParams, hp: HeatPathParams, element_size_m: float) -> HeatMesh:
     """Mesh the sector (see the module docstring).
 
@@ -299,58 +365,11 @@ def sector_mesh(spring: SpringParams, hp: HeatPathParams, element_size_m: float)
     layer_a = np.concatenate(layer_of)
     cell_a = np.concatenate(cells)
 
-    # properties
-    k = np.empty(len(conn))
-    rho = np.empty(len(conn))
-    c = np.empty(len(conn))
-    ci, cj = cell_a[:, 0], cell_a[:, 1]
-    steel = (parts_a == "CARRIER") | (parts_a == "PADDLE")
-    k[steel], rho[steel], c[steel] = hp.steel_conductivity_W_per_m_K, hp.steel_density_kg_m3, \
-        hp.steel_specific_heat_J_per_kg_K
-    joint = parts_a == "JOINT"
-    k[joint], rho[joint], c[joint] = hp.joint_contact_W_per_m2_K * t_int, _AIR_RHO, _AIR_C
-    iface = parts_a == "INTERFACE"
-    k[iface], rho[iface], c[iface] = h_iface[ci[iface], cj[iface]] * t_int, _AIR_RHO, _AIR_C
+    k, rho, c, col = _properties(hp, parts_a, cell_a, h_iface, f_rivet)
+    joint, iface = parts_a == "JOINT", parts_a == "INTERFACE"
     lining = (parts_a == "FACING_LOW") | (parts_a == "FACING_UP")
-    k[lining], rho[lining], c[lining] = hp.lining_conductivity_W_per_m_K, hp.lining_density_kg_m3, \
-        hp.lining_specific_heat_J_per_kg_K
-    col = (parts_a == "FACING_LOW") & (f_rivet[ci, cj] > 0)
-    f = f_rivet[ci[col], cj[col]]
-    k[col] = f * rivet_column_conductivity(hp) + (1 - f) * hp.lining_conductivity_W_per_m_K
-    rho_c = f * hp.rivet_density_kg_m3 * hp.rivet_specific_heat_J_per_kg_K + \
-        (1 - f) * hp.lining_density_kg_m3 * hp.lining_specific_heat_J_per_kg_K
-    rho[col] = f * hp.rivet_density_kg_m3 + (1 - f) * hp.lining_density_kg_m3
-    c[col] = rho_c / rho[col]
-
-    # exterior faces from the occupancy of neighbours
-    nl = len(layers)
-    pad = np.zeros((nl + 2, nr + 2, nphi + 2), dtype=bool)
-    pad[1:-1, 1:-1, 1:-1] = occ
-    li, i, j = layer_a + 1, ci + 1, cj + 1
-    open_ = {1: ~pad[li - 1, i, j], 2: ~pad[li + 1, i, j], 3: ~pad[li, i, j - 1], 4: ~pad[li, i + 1, j],
-             5: ~pad[li, i, j + 1], 6: ~pad[li, i - 1, j]}
-    adiabatic_part = joint | iface
-    groups: dict[str, list[np.ndarray]] = {"FRICTION": [], "HUB": [], "CONVECTION": []}
+    groups = _exterior_faces(occ, layer_a, cell_a, joint | iface)
     eidx = np.arange(len(conn))
-    for face, is_open in open_.items():
-        ok = is_open & ~adiabatic_part
-        if face == 1:
-            ok &= layer_a > 0                                   # z = 0: mirror plane
-        if face == 3:
-            ok &= cj > 0                                        # phi = 0: periodic cut
-        if face == 5:
-            ok &= cj < nphi - 1                                 # phi = sector: periodic cut
-        sel = eidx[ok]
-        fn = np.full(len(sel), face)
-        if face == 2:
-            top = layer_a[sel] == nl - 1
-            groups["FRICTION"].append(np.stack([sel[top], fn[top]], axis=1))
-            sel, fn = sel[~top], fn[~top]
-        if face == 6:
-            hub = ci[sel] == 0
-            groups["HUB"].append(np.stack([sel[hub], fn[hub]], axis=1))
-            sel, fn = sel[~hub], fn[~hub]
-        groups["CONVECTION"].append(np.stack([sel, fn], axis=1))
 
     # drop unused nodes, renumber
     used = np.unique(conn)

@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from cushion_clutch.launch.driveline import Driveline, first_mode_hz
+from cushion_clutch.launch.plant.driveline import Driveline, first_mode_hz
 from cushion_clutch.launch.scenario import load_scenario, scenario_path
 
 

@@ -36,17 +36,17 @@ from typing import Callable
 import numpy as np
 
 from ..model import KELVIN, ClutchParameters, SpringTable
-from .driveline import Driveline, Energy
-from .engine import EngineGovernor
+from .plant.driveline import Driveline, Energy
+from .plant.engine import EngineGovernor
 from ..errors import FmuCallError
-from .fmu_client import ClutchFmu
-from .metrics import LaunchRecord, launch_possible
-from .observer import SpeedSensors
-from .scenario import Scenario
-from .engine import RPM
-from .production import KeyOn, ProductionTcu, key_off, key_on
-from .tcu import CLOSE, LAUNCH, OPEN, PREFILL, VARIANTS, TcuController
-from .thermal import FacingModel
+from .plant.fmu_client import ClutchFmu
+from .results.metrics import LaunchRecord, launch_possible
+from .tcu.observer import SpeedSensors
+from .scenario.load import Scenario
+from .plant.engine import RPM
+from .tcu.production import KeyOn, ProductionTcu, key_off, key_on
+from .tcu.controller import CLOSE, LAUNCH, OPEN, PREFILL, VARIANTS, TcuController
+from .plant.thermal import FacingModel
 from ..model.thermal_network import ThermalNetwork
 
 #: fmi2Discard: the status of a step the plant FMU refuses for an input outside its range
@@ -108,8 +108,8 @@ def _facing_profile(path: str) -> Callable[[float], float]:
 def _native_plant(clutch, engine, dl, net, h, act, w_lift, prefill, tcu_every, net_every, alpha, mu_surface=None,
                   n_surfaces=0.0, r_eq=0.0):
     """The compiled plant steps (:mod:`.plant_block`), or None (logged) if the library cannot be built."""
-    from .metrics import CREEP_NM
-    from .plant_block import NativePlant
+    from .results.metrics import CREEP_NM
+    from .plant.plant_block import NativePlant
     try:
         return NativePlant(clutch, engine, dl, net, h, act, w_lift, prefill, tcu_every, net_every, alpha, CREEP_NM,
                            mu_surface, n_surfaces, r_eq)

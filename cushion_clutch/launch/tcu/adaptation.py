@@ -17,7 +17,7 @@ value is used until the next adaptation.
 """
 from __future__ import annotations
 
-from .tcu_params import Adaptation
+from ..scenario.tcu_params import Adaptation
 
 
 class KissLearner:

@@ -52,8 +52,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Iterable
 
-from ..config import Checked
-from ..model import KELVIN
+from ...config import Checked
+from ...model import KELVIN
 
 OK, WARN, LIMIT, INHIBIT = 0, 1, 2, 3
 LEVEL_NAMES = ("ok", "warn", "limit", "inhibit")

@@ -7,8 +7,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Iterable
 
-from ..config import Checked
-from ..model.thermal_network import TcuNetworkBase
+from ...config import Checked
+from ...model.thermal_network import TcuNetworkBase
 
 
 @dataclass(frozen=True)

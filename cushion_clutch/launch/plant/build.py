@@ -10,8 +10,8 @@ from __future__ import annotations
 import shutil
 from pathlib import Path
 
-from ..model.table_format import FORCE_DEFLECTION, FRICTION, KISS_POINT, METADATA
-from .scenario import Scenario
+from ...model.table_format import FORCE_DEFLECTION, FRICTION, KISS_POINT, METADATA
+from ..scenario.load import Scenario
 
 SPRING_FILES = (FORCE_DEFLECTION, KISS_POINT, METADATA)
 
@@ -34,6 +34,6 @@ def plant_tables(tables: Path, sc: Scenario, work: Path) -> Path:
 
 def build_plant_fmu(tables: Path, sc: Scenario, out: Path, backend: str = "native") -> Path:
     """Build the plant FMU ``out`` for the scenario (see :func:`plant_tables`)."""
-    from ..fmu.build import build_fmu
+    from ...fmu.build import build_fmu
 
     return build_fmu(plant_tables(tables, sc, Path(out).parent), Path(out), backend=backend)

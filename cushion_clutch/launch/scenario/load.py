@@ -8,15 +8,15 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Iterable
 
-from ..config import Checked, build_checked, load_toml, range_problem
-from ..data import DEFAULT_SCENARIO
-from ..errors import ParameterError
-from .ekf import EkfParams, TcuNetworkParams
-from .mass_grade import MassGrade
-from .protection import Protection
-from .sensors import ProductionSensors
+from ...config import Checked, build_checked, load_toml, range_problem
+from ...data import DEFAULT_SCENARIO
+from ...errors import ParameterError
+from ..tcu.ekf import EkfParams, TcuNetworkParams
+from ..tcu.mass_grade import MassGrade
+from ..tcu.protection import Protection
+from ..plant.sensors import ProductionSensors
 from .tcu_params import Adaptation, Observer, Sensors, Standstill, TcuStore
-from ..model.thermal_network import PlantThermal
+from ...model.thermal_network import PlantThermal
 
 
 
@@ -459,7 +459,7 @@ def _blame(problem: str, origin: dict, top: Path) -> str:
 
 def _thermal_set(name: str, folder: str):
     """A thermal set by shipped name or a TOML file relative to ``folder``."""
-    from ..model.thermal_set import load_thermal_set
+    from ...model.thermal_set import load_thermal_set
     path = Path(name)
     if path.suffix and not path.is_absolute():
         path = Path(folder or ".") / path

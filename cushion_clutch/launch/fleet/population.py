@@ -44,13 +44,13 @@ from statistics import NormalDist
 
 import numpy as np
 
-from ..config import load_toml, range_problem
-from ..errors import ParameterError
-from .scenario import Scenario, load_scenario, scenario_path
+from ...config import load_toml, range_problem
+from ...errors import ParameterError
+from ..scenario.load import Scenario, load_scenario, scenario_path
 
 _PHI = NormalDist()
 #: the folder of the shipped populations
-POPULATIONS = Path(__file__).parent / "populations"
+POPULATIONS = Path(__file__).parent.parent / "populations"
 
 #: continuous draws: key -> (allowed low, allowed high) of the values
 CONTINUOUS = {"mass_kg": (300.0, 60000.0), "grade_percent": (-30.0, 30.0), "ambient_degC": (-50.0, 60.0),

@@ -32,8 +32,8 @@ from typing import Callable, Sequence
 
 import numpy as np
 
-from ..errors import ClusterError, ParameterError
-from .metrics import METRIC_COLUMNS, SUMMARY
+from ...errors import ClusterError, ParameterError
+from ..results.metrics import METRIC_COLUMNS, SUMMARY
 from .population import Population, draw, sample_scenario
 
 SAMPLES_FILE = "fleet_samples.parquet"
@@ -73,7 +73,7 @@ def sample_rows(pop: Population, seed: int, i: int, tcus: Sequence[str], fmus: d
 
     ``fmus`` and ``tables``: the plant FMU (path) and the TCUs' table (SpringTable) per spring set name.
     """
-    from .report import run_all
+    from ..report import run_all
 
     s = draw(pop, seed, i)
     sc = sample_scenario(pop, s)
@@ -141,7 +141,7 @@ class FleetRun:
 
 
 def _identity(pop: Population, seed: int, tcus: Sequence[str], tables: Path) -> dict:
-    from .. import __version__
+    from ... import __version__
     return {"population": pop.name, "population_sha256": hashlib.sha256(pop.source.encode()).hexdigest(),
             "scenario": pop.scenario.name, "seed": int(seed), "tcus": list(tcus), "tables": str(Path(tables).name),
             "version": __version__}
@@ -149,8 +149,8 @@ def _identity(pop: Population, seed: int, tcus: Sequence[str], tables: Path) -> 
 
 def build_inputs(pop: Population, tables: Path, stage: Path, backend: str = "native") -> tuple[dict, dict]:
     """Per spring set: the plant FMU (built into ``stage``) and the TCUs' table."""
-    from ..model import load_table
-    from .plant import build_plant_fmu
+    from ...model import load_table
+    from ..plant.build import build_plant_fmu
     from .population import Sample
 
     fmus, tcu_tables = {}, {}
@@ -179,7 +179,7 @@ def run_fleet(pop: Population, tables: Path, out: Path, samples: int, tcus: Sequ
     ClusterError
         Samples failed (each named with its worker) or every worker was lost; the finished ones are kept.
     """
-    from .tcu import VARIANTS
+    from ..tcu.controller import VARIANTS
 
     bad = [t for t in tcus if t not in VARIANTS]
     if bad or not tcus:
@@ -233,7 +233,7 @@ def run_fleet(pop: Population, tables: Path, out: Path, samples: int, tcus: Sequ
                 else:
                     keep(i, rows, None)
         else:
-            from ..fe.cluster import open_cluster, watch
+            from ...fe.cluster import open_cluster, watch
             with open_cluster(scheduler, jobs, need_ccx=False) as (client, info):
                 workers = info.slots
                 start = time.perf_counter()

@@ -28,7 +28,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from .scenario import Scenario
+from ..scenario.load import Scenario
 
 G = 9.81    #: gravity, m/s2
 

@@ -27,7 +27,7 @@ from typing import Iterable
 
 import numpy as np
 
-from ..config import Checked
+from ...config import Checked
 
 G = 9.81  #: gravity, m/s2
 

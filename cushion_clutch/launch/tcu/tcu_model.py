@@ -24,10 +24,10 @@ import shutil
 import tempfile
 from pathlib import Path
 
-from ..fmu.hostlib import HostLibrary
-from ..model import ClutchParameters, SpringTable, outputs, x_to_for_torque
-from ..model.clutch_model import THETA_MAX_K, THETA_MIN_K, X_TO_MAX, X_TO_MIN
-from ..model.table_format import COLUMNS, FORCE_DEFLECTION, KISS_POINT
+from ...fmu.hostlib import HostLibrary
+from ...model import ClutchParameters, SpringTable, outputs, x_to_for_torque
+from ...model.clutch_model import THETA_MAX_K, THETA_MIN_K, X_TO_MAX, X_TO_MIN
+from ...model.table_format import COLUMNS, FORCE_DEFLECTION, KISS_POINT
 
 log = logging.getLogger(__name__)
 

@@ -10,7 +10,7 @@ import math
 
 import numpy as np
 
-from ..model import KELVIN
+from ...model import KELVIN
 
 #: LuK 2006: damage of the friction system above 350-400 degC; the lower bound, degC
 DAMAGE_DEGC = 350.0

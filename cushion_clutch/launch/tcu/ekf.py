@@ -136,10 +136,10 @@ from typing import Iterable
 
 import numpy as np
 
-from ..config import Checked
-from ..model import ClutchParameters, SpringTable
-from ..model.clutch_model import hold_theta_cm
-from ..model.thermal_network import FACINGS, N_NODES, TcuNetworkBase, ThermalNetwork
+from ...config import Checked
+from ...model import ClutchParameters, SpringTable
+from ...model.clutch_model import hold_theta_cm
+from ...model.thermal_network import FACINGS, N_NODES, TcuNetworkBase, ThermalNetwork
 from .tcu_model import TcuClutchModel
 
 #: state indices: the network's nodes, then these

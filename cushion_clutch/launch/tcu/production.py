@@ -42,12 +42,12 @@ from dataclasses import dataclass
 from collections import deque
 from pathlib import Path
 
-from ..model import ClutchParameters, SpringTable
+from ...model import ClutchParameters, SpringTable
 from .ekf import IX_DX, ClutchEkf, EkfParams, TcuNetworkParams
 from .mass_grade import MassGrade, MassGradeEstimator
-from .sensors import ProductionSensors, TcuSensors
+from ..plant.sensors import ProductionSensors, TcuSensors
 from .store import AdaptedState, load_state, save_state
-from .tcu import LAUNCH, OPEN, TcuController, Variant, _memo
+from .controller import LAUNCH, OPEN, TcuController, Variant, _memo
 from .touchpoint import StandstillResult, learn_touch_point
 
 #: TCU periods over which speeds are differentiated

@@ -51,7 +51,7 @@ from __future__ import annotations
 
 import math
 
-from ..model import KELVIN
+from ...model import KELVIN
 
 METRIC_COLUMNS = ("tcu", "launch", "demand_level", "theta_cs_start_degC", "characteristic_error_rms_Nm",
                   "characteristic_error_max_Nm", "tracking_error_rms_Nm", "tracking_error_max_Nm",
@@ -267,8 +267,8 @@ def launch_capability(sc, level: str) -> tuple[float, float]:
     rolling resistance (the driveline's ``t_load_rest``). Both at the disc, N.m. The launch is physically
     possible when ``engine_Nm > load_Nm`` (the car can be accelerated once locked).
     """
-    from .driveline import Driveline
-    from .engine import RPM, EngineGovernor
+    from ..plant.driveline import Driveline
+    from ..plant.engine import RPM, EngineGovernor
 
     eng = EngineGovernor(sc.engine, sc.run.step_s)
     load = Driveline(sc, eng.w_idle).t_load_rest
@@ -292,8 +292,8 @@ def launch_possible(sc, level: str) -> bool:
         return False
     if level == "creep":
         return True
-    from .driveline import Driveline
-    from .engine import EngineGovernor
+    from ..plant.driveline import Driveline
+    from ..plant.engine import EngineGovernor
 
     eng = EngineGovernor(sc.engine, sc.run.step_s)
     pedal = sc.driver.pedal(level)

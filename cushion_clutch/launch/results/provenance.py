@@ -30,5 +30,5 @@ class Provenance:
 
 
 def _version() -> str:
-    from .. import __version__
+    from ... import __version__
     return __version__

@@ -10,11 +10,11 @@ from __future__ import annotations
 
 import random
 
-from ..model import ClutchParameters, thermal_step
-from ..model.clutch_model import hold_theta_cm
-from .tcu_params import Observer, Sensors
-from .thermal import FacingModel
-from ..model.thermal_network import ThermalNetwork
+from ...model import ClutchParameters, thermal_step
+from ...model.clutch_model import hold_theta_cm
+from ..scenario.tcu_params import Observer, Sensors
+from ..plant.thermal import FacingModel
+from ...model.thermal_network import ThermalNetwork
 
 
 class SpeedSensors:

@@ -14,8 +14,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..model import KELVIN
-from .simulate import LaunchResult
+from ...model import KELVIN
+from ..simulate import LaunchResult
 
 if TYPE_CHECKING:
     from .provenance import Provenance
@@ -73,7 +73,7 @@ def _integer_ticks(ax) -> None:
 
 
 def _default_table_range() -> tuple[float, float]:
-    from ..model import load_table
+    from ...model import load_table
     theta = load_table().theta_degC
     return float(np.min(theta)), float(np.max(theta))
 
@@ -116,7 +116,7 @@ def _plot_last(results: dict[str, LaunchResult], out: Path, prov: "Provenance") 
     """The hottest launch: speeds, bearing positions, and per TCU the torques (one panel each)."""
     import matplotlib.pyplot as plt
 
-    from ..plotting import finish_figure
+    from ...plotting import finish_figure
 
     # the launch whose start is hottest for the most TCUs' plants (each TCU heats its own clutch)
     starts = {name: {m["launch"]: m["theta_cs_start_degC"] for m in res.metrics} for name, res in results.items()}
@@ -204,7 +204,7 @@ def _plot_temperatures(results: dict[str, LaunchResult], out: Path, table_range:
     from that plant, the launches it inhibited or never locked up marked."""
     import matplotlib.pyplot as plt
 
-    from ..plotting import finish_figure
+    from ...plotting import finish_figure
 
     names = list(results)
     ncols = min(3, len(names))
@@ -256,7 +256,7 @@ def _plot_metrics(results: dict[str, LaunchResult], out: Path, prov: "Provenance
     import matplotlib.pyplot as plt
     from matplotlib.transforms import blended_transform_factory
 
-    from ..plotting import finish_figure
+    from ...plotting import finish_figure
 
     names = list(results)
     ncols = 3

@@ -52,12 +52,12 @@ import copy
 import math
 from dataclasses import dataclass
 
-from ..model import KELVIN, ClutchParameters, SpringTable, kiss_point, outputs, thermal_step, x_to_for_torque
-from ..model.clutch_model import hold_theta_cm
+from ...model import KELVIN, ClutchParameters, SpringTable, kiss_point, outputs, thermal_step, x_to_for_torque
+from ...model.clutch_model import hold_theta_cm
 from .adaptation import KissLearner
 from .observer import FacingObserver
 from .protection import LIMIT, ThermalProtection
-from .scenario import Scenario
+from ..scenario.load import Scenario
 
 
 @dataclass(frozen=True)

@@ -17,8 +17,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..model import KELVIN, ClutchParameters, SpringTable, outputs
-from ..model.clutch_model import OMEGA_SLIP_START
+from ...model import KELVIN, ClutchParameters, SpringTable, outputs
+from ...model.clutch_model import OMEGA_SLIP_START
 
 
 @dataclass(frozen=True)
@@ -96,7 +96,7 @@ def simulate(fmu: Path, cycle: EngagementCycle = EngagementCycle(), n_engagement
     """
     from fmpy import simulate_fmu
 
-    from ..fmpy_logger import restore_fmpy_logger
+    from ...fmpy_logger import restore_fmpy_logger
 
     stop = n_engagements * cycle.period_s
     t = np.arange(0.0, stop + step_s / 2, step_s)
@@ -115,7 +115,7 @@ def plot_engagements(res: np.ndarray, path: Path) -> Path:
     """theta_cm and theta_cs over repeated engagements (paper Fig. 10), and the torque."""
     import matplotlib.pyplot as plt
 
-    from ..plotting import finish_figure
+    from ...plotting import finish_figure
 
     fig, (a1, a2) = plt.subplots(2, 1, figsize=(9, 6), sharex=True)
     a1.plot(res["time"], res["theta_cm"] - KELVIN, label="facing θ_cm")
@@ -131,7 +131,7 @@ def plot_torque_characteristic(table: SpringTable, path: Path, p: ClutchParamete
     """T(x_to) at each table temperature (paper Fig. 12), from the shared model."""
     import matplotlib.pyplot as plt
 
-    from ..plotting import finish_figure
+    from ...plotting import finish_figure
 
     x = np.linspace(p.x_kiss_ref - 1.0e-3, p.x_kiss_ref + p.lever_ratio * 1.45e-3, 600)
     fig, ax = plt.subplots(figsize=(7, 4.5))
@@ -148,9 +148,9 @@ def plot_thermal_step(path: Path, p: ClutchParameters = ClutchParameters()) -> P
     import control
     import matplotlib.pyplot as plt
 
-    from ..plotting import finish_figure
+    from ...plotting import finish_figure
 
-    from ..model import thermal_system
+    from ...model import thermal_system
 
     sys = thermal_system(p)
     t = np.linspace(0.0, 6 * p.C / (p.U + p.H), 400)

@@ -24,7 +24,7 @@ from bisect import bisect_right
 from dataclasses import dataclass
 from typing import Iterable
 
-from ..config import Checked
+from ...config import Checked
 
 TWO_PI = 2.0 * math.pi
 

@@ -15,8 +15,8 @@ import math
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
-from ..errors import ParameterError
-from ..number_check import is_finite_number, is_number
+from ...errors import ParameterError
+from ...number_check import is_finite_number, is_number
 
 #: format version of the file
 VERSION = 1

@@ -18,7 +18,7 @@ from pathlib import Path
 
 import cffi
 
-from ..errors import FmuCallError
+from ...errors import FmuCallError
 
 #: inputs and outputs exchanged every step, in this order
 INPUTS = ("x_to", "theta_cm", "omega_slip")
@@ -43,7 +43,7 @@ class ClutchFmu:
         from fmpy import extract, read_model_description
         from fmpy.fmi2 import FMU2Slave
 
-        from ..fmpy_logger import restore_fmpy_logger
+        from ...fmpy_logger import restore_fmpy_logger
 
         md = read_model_description(str(fmu))
         vr = {v.name: v.valueReference for v in md.modelVariables}
@@ -125,8 +125,8 @@ class ClutchFmu:
     def friction_table(self):
         """The FMU's own friction table (``friction.csv`` in its resources) as a
         :class:`~cushion_clutch.model.friction.FrictionTable`, or None (the FMU's mu is the constant parameter)."""
-        from ..model.friction import FrictionTable
-        from ..model.table_format import FRICTION
+        from ...model.friction import FrictionTable
+        from ...model.table_format import FRICTION
         found = sorted(Path(self.unzip, "resources").rglob(FRICTION))
         return FrictionTable.from_csv(found[0]) if found else None
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 import math
 from bisect import bisect_right
 
-from .scenario import Engine
+from ..scenario.load import Engine
 
 RPM = math.pi / 30.0          #: rad/s per rpm
 

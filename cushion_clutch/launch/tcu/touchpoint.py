@@ -58,10 +58,10 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
-from ..model import ClutchParameters, SpringTable, kiss_point, x_to_for_torque
-from .fmu_client import ClutchFmu
-from .sensors import ProductionSensors, TcuSensors
-from .tcu_params import Standstill
+from ...model import ClutchParameters, SpringTable, kiss_point, x_to_for_torque
+from ..plant.fmu_client import ClutchFmu
+from ..plant.sensors import ProductionSensors, TcuSensors
+from ..scenario.tcu_params import Standstill
 
 #: periods on either side of a sample for the shaft's acceleration
 HALF_WINDOW = 3

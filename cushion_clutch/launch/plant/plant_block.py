@@ -18,8 +18,8 @@ C compiler, and cached under ``$XDG_CACHE_HOME/cushion_clutch`` (default ``~/.ca
 """
 from __future__ import annotations
 
-from ..errors import FmuCallError
-from ..fmu.hostlib import HostLibrary
+from ...errors import FmuCallError
+from ...fmu.hostlib import HostLibrary
 
 SOURCE, HEADER = "launch_plant.c", "launch_plant.h"
 #: the most points of an engine torque curve the C step takes (lp_consts.curve_w)
@@ -138,7 +138,7 @@ class NativePlant:
     def _network(self, net, dt: float) -> None:
         """The network's constants for both clamp states, the fixed nodes' decay factors at the step ``dt``
         (s), as :meth:`.ThermalNetwork.step` prepares them."""
-        from ..model.thermal_network import FACINGS, SURFACES
+        from ...model.thermal_network import FACINGS, SURFACES
         c = self.c
         c.net_n_nodes = len(net.theta)
         c.net_cm[0], c.net_cm[1] = FACINGS

@@ -21,52 +21,10 @@ from __future__ import annotations
 import math
 import random
 from bisect import bisect_right
-from dataclasses import dataclass
-from typing import Iterable
 
-from ...config import Checked
+from ..scenario.tcu_params import ProductionSensors
 
 TWO_PI = 2.0 * math.pi
-
-
-@dataclass(frozen=True)
-class ProductionSensors(Checked):
-    """Section ``[tcu_sensors]``: the production TCU's sensors (SI)."""
-
-    crank_teeth: int = 60
-    crank_missing_teeth: int = 2
-    input_teeth: int = 32
-    tooth_pitch_error_rad: float = 0.002
-    """standard deviation of each tooth's angular position error, rad"""
-    timer_s: float = 1e-6
-    """edge time-stamp resolution, s"""
-    timeout_s: float = 0.1
-    """no edge for this long: the speed reads 0"""
-    torque_gain_error: float = 0.04
-    torque_offset_Nm: float = 3.0
-    torque_noise_Nm: float = 1.0
-    position_noise_m: float = 5e-6
-    position_offset_m: float = 20e-6
-    position_resolution_m: float = 5e-6
-    ambient_offset_K: float = 1.0
-    ambient_resolution_K: float = 0.5
-    seed: int = 7
-
-    _section = "tcu_sensors"
-
-    def _problems(self) -> Iterable[str]:
-        yield from self._ranges(spec := {
-            "crank_teeth": (4, 1000), "crank_missing_teeth": (0, 10), "input_teeth": (1, 1000),
-            "tooth_pitch_error_rad": (0.0, 0.05), "timer_s": (0.0, 1e-3), "timeout_s": (1e-3, 10.0),
-            "torque_gain_error": (-0.2, 0.2), "torque_offset_Nm": (-100.0, 100.0), "torque_noise_Nm": (0.0, 100.0),
-            "position_noise_m": (0.0, 1e-3), "position_offset_m": (-1e-3, 1e-3),
-            "position_resolution_m": (0.0, 1e-3), "ambient_offset_K": (-20.0, 20.0),
-            "ambient_resolution_K": (0.0, 10.0), "seed": (0, 2 ** 31 - 1)})
-        yield from self._integers("crank_teeth", "crank_missing_teeth", "input_teeth", "seed")
-        if self._passed(spec, "crank_teeth", "crank_missing_teeth") and \
-                isinstance(self.crank_teeth, int) and isinstance(self.crank_missing_teeth, int) and \
-                self.crank_missing_teeth >= self.crank_teeth - 2:
-            yield "tcu_sensors.crank_missing_teeth: must leave at least 2 teeth on the wheel"
 
 
 def _quantise(x: float, step: float) -> float:

@@ -11,11 +11,8 @@ from typing import Iterable
 from ...config import Checked, build_checked, load_toml, range_problem
 from ...data import DEFAULT_SCENARIO
 from ...errors import ParameterError
-from ..tcu.ekf import EkfParams, TcuNetworkParams
-from ..tcu.mass_grade import MassGrade
-from ..tcu.protection import Protection
-from ..plant.sensors import ProductionSensors
-from .tcu_params import Adaptation, Observer, Sensors, Standstill, TcuStore
+from .tcu_params import (Adaptation, EkfParams, MassGrade, Observer, ProductionSensors, Protection, Sensors, Standstill,
+                         TcuNetworkParams, TcuStore)
 from ...model.thermal_network import PlantThermal
 
 

@@ -131,15 +131,13 @@ residuals stay consistent with the biased torque).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
-from typing import Iterable
 
 import numpy as np
 
-from ...config import Checked
 from ...model import ClutchParameters, SpringTable
 from ...model.clutch_model import hold_theta_cm
-from ...model.thermal_network import FACINGS, N_NODES, TcuNetworkBase, ThermalNetwork
+from ...model.thermal_network import FACINGS, N_NODES, ThermalNetwork
+from ..scenario.tcu_params import EkfParams, TcuNetworkParams
 from .tcu_model import TcuClutchModel
 
 #: state indices: the network's nodes, then these
@@ -168,131 +166,6 @@ FADE_UNIT_K = 100.0
 EVIDENCE_TORQUES_NM = (10.0, 20.0, 40.0, 80.0, 120.0)
 #: nominal torque at which the friction is referenced and judged (the top of the evidence torques), N.m
 FRICTION_TORQUE_NM = 120.0
-
-
-@dataclass(frozen=True)
-class TcuNetworkParams(TcuNetworkBase):
-    """Section ``[tcu_thermal]``: the TCU's own thermal network, the plant's physical network with the
-    mismatch stated in :class:`~.thermal_network.TcuNetworkBase`."""
-
-    spring_U_W_per_K: float = 0.1
-    spring_H_W_per_K: float = 0.04
-    spring_C_J_per_K: float = 1.0
-
-    _section = "tcu_thermal"
-
-    def _problems(self) -> Iterable[str]:
-        yield from super()._problems()
-        yield from self._ranges({"spring_U_W_per_K": (0.0, 1e4), "spring_H_W_per_K": (0.0, 1e4),
-                                 "spring_C_J_per_K": (0.0, 1e6, True)})
-        if self.spring_U_W_per_K + self.spring_H_W_per_K <= 0.0:
-            yield (f"tcu_thermal.spring_H_W_per_K: spring_U_W_per_K + spring_H_W_per_K = "
-                   f"{self.spring_U_W_per_K + self.spring_H_W_per_K:g} W/K; must be > 0 (the spring exchanges heat)")
-
-
-@dataclass(frozen=True)
-class EkfParams(Checked):
-    """Section ``[ekf]``: noise, excitation conditions and the update period (SI)."""
-
-    period_s: float = 0.1
-    theta0_sd_K: float = 5.0
-    heat_share_sd: float = 0.3
-    """relative uncertainty of each node's slip heat"""
-    theta_walk_K2_per_s: float = 0.01
-    kiss_sd_m: float = 0.4e-3
-    """prior sd of the touch-point offset"""
-    kiss_walk_m2_per_s: float = 1e-12
-    mu_sd: float = 0.1
-    mu_walk_per_s: float = 1e-6
-    mu_walk_per_K: float = 5e-4
-    """variance of the friction scale's random walk per kelvin the estimated facings heat above
-    ``mu_reference_max_degC``, 1/K (a facing's friction changes with its temperature, by an amount the
-    calibration does not know: fade)"""
-    mu_reference_max_degC: float = 80.0
-    """friction updates while the estimated facings are below this temperature (degC) reference the engine
-    torque estimate's gain and offset (the nominal mu holds on cool facings); above, the friction is judged
-    relative to that reference and follows the facings' temperature (``mu_fade_sd``)"""
-    mu_slope_sd: float = 0.03
-    """prior sd of the friction's slip-speed slope, 1 per 100 rad/s (0: mu does not depend on the slip)"""
-    mu_slope_walk_per_s: float = 1e-7
-    """random walk of the slip-speed slope, 1/s"""
-    mu_slope_evidence_sd: float = 1.0
-    """the slope is applied only beyond this many of its standard deviations (by the excess)"""
-    mu_fade_sd: float = 0.1
-    """prior sd of the friction's temperature slope above ``mu_reference_max_degC``, 1 per 100 K of the
-    estimated facings (0: ``mu_scale`` does not follow the estimated facing temperature)"""
-    mu_fade_walk_per_K: float = 1e-3
-    """variance of the temperature slope's random walk per kelvin the estimated facings heat above
-    ``mu_reference_max_degC``, 1/(100 K)^2/K (a fade curve steepens as the facings heat)"""
-    torque_sd_Nm: float = 8.0
-    """measurement noise of the engine-side clutch torque"""
-    slip_min_rad_s: float = 10.0
-    touch_torque_min_Nm: float = 8.0
-    touch_torque_max_Nm: float = 80.0
-    mu_torque_min_Nm: float = 40.0
-    gate_sd: float = 4.0
-    mu_deadband: float = 0.05
-    """the engine torque estimate's stated gain accuracy: a learned mu_scale within 1 +- this is not applied"""
-    torque_offset_accuracy_Nm: float = 3.0
-    """the engine torque estimate's stated offset accuracy, N.m: the evidence envelope and the prior sd of
-    the offset state"""
-    offset_walk_Nm2_per_s: float = 1e-4
-    """random walk of the torque estimate's offset (it drifts with the engine's state), N.m2/s"""
-    position_accuracy_m: float = 20e-6
-    """the position sensor's stated offset accuracy, m (the evidence envelope)"""
-    evidence_threshold: float = 1.0
-    """the learned characteristic is applied once its difference from the prior exceeds this multiple of the
-    bias envelope (the touch point and the friction scale fit a gain and offset error of the torque only
-    approximately: with a bias at the envelope the ratio overshot 1 by 4 % in a synthetic launch)"""
-    evidence_release: float = 0.7
-    """the learned characteristic stays applied until its difference from the prior falls below this
-    fraction of the bias envelope"""
-    evidence_confirm: int = 5
-    """... and is applied once the difference has exceeded the envelope in this many consecutive touch-point
-    or friction updates (a transient of the filter within a launch is no evidence)"""
-    temperature_update: bool = True
-    loss_scale_sd: float = 0.5
-    """prior sd of the heat-loss scale (every node's sink conductance: convection and engine block), 1;
-    0 keeps the network's losses as given"""
-    loss_walk_per_s: float = 1e-7
-    """random walk of the heat-loss scale, 1/s (its variance grows by this per second)"""
-    heat_scale_sd: float = 0.15
-    """prior sd of the heat scale (the network's heat per J/K, its inverse heat capacity relative to the TCU's: the
-    slip heat, conduction and losses alike), 1;
-    0 keeps the slip power as measured"""
-    heat_walk_per_s: float = 1e-7
-    """random walk of the heat-input scale, 1/s"""
-    theta_torque_min_Nm: float = 40.0
-    """the temperatures and both thermal scales are corrected only above this model torque, N.m"""
-    loss_excitation_K: float = 30.0
-    """the heat-loss scale is corrected only while the estimated facings are this far above the ambient, K"""
-    scale_min: float = 0.25
-    scale_max: float = 4.0
-    """both scales are kept within [scale_min, scale_max] (a physical network)"""
-
-    _section = "ekf"
-
-    def _problems(self) -> Iterable[str]:
-        yield from self._ranges(spec := {
-            "period_s": (1e-3, 10.0), "theta0_sd_K": (0.0, 500.0), "heat_share_sd": (0.0, 10.0),
-            "theta_walk_K2_per_s": (0.0, 1e4), "kiss_sd_m": (0.0, 0.01), "kiss_walk_m2_per_s": (0.0, 1e-3),
-            "mu_sd": (0.0, 1.0), "mu_walk_per_s": (0.0, 1.0),
-            "mu_walk_per_K": (0.0, 1.0), "mu_reference_max_degC": (-50.0, 1000.0), "mu_slope_sd": (0.0, 1.0),
-            "mu_slope_walk_per_s": (0.0, 1.0),
-            "mu_slope_evidence_sd": (0.0, 100.0), "mu_fade_sd": (0.0, 2.0), "mu_fade_walk_per_K": (0.0, 1.0),
-            "torque_sd_Nm": (1e-3, 1e3),
-            "slip_min_rad_s": (0.0, 1e3), "touch_torque_min_Nm": (0.0, 1e4), "touch_torque_max_Nm": (0.0, 1e4),
-            "mu_torque_min_Nm": (0.0, 1e4), "gate_sd": (1.0, 100.0, True),
-            "mu_deadband": (0.0, 0.5), "torque_offset_accuracy_Nm": (0.0, 100.0),
-            "position_accuracy_m": (0.0, 1e-3), "evidence_release": (0.0, 1.0), "evidence_threshold": (1.0, 100.0),
-            "offset_walk_Nm2_per_s": (0.0, 100.0),
-            "evidence_confirm": (1, 1000), "loss_scale_sd": (0.0, 2.0), "loss_walk_per_s": (0.0, 1.0),
-            "heat_scale_sd": (0.0, 2.0), "heat_walk_per_s": (0.0, 1.0), "loss_excitation_K": (0.0, 500.0), "theta_torque_min_Nm": (0.0, 1e4),
-            "scale_min": (0.0, 1.0, True), "scale_max": (1.0, 100.0)})
-        yield from self._integers("evidence_confirm")
-        if self._passed(spec, "touch_torque_max_Nm", "touch_torque_min_Nm") and \
-                self.touch_torque_max_Nm <= self.touch_torque_min_Nm:
-            yield "ekf.touch_torque_max_Nm: must exceed ekf.touch_torque_min_Nm"
 
 
 def _exp_and_integral(a: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:

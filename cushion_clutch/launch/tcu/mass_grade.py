@@ -22,39 +22,12 @@ variance fell below ``ready_sd`` of its prior.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
-from typing import Iterable
 
 import numpy as np
 
-from ...config import Checked
+from ..scenario.tcu_params import MassGrade
 
 G = 9.81  #: gravity, m/s2
-
-
-@dataclass(frozen=True)
-class MassGrade(Checked):
-    """Section ``[mass_grade]``: the TCU's RLS estimator of mass and grade (SI)."""
-
-    mass_prior_kg: float = 1600.0
-    mass_prior_sd_kg: float = 500.0
-    load_prior_sd_N: float = 3000.0
-    forgetting: float = 0.999
-    """per TCU period"""
-    noise_sd_N: float = 200.0
-    """expected equation error (torque estimate, acceleration noise), N"""
-    torque_min_Nm: float = 20.0
-    speed_min_m_s: float = 0.3
-    ready_sd: float = 0.2
-    """a parameter counts as estimated once its sd is below this fraction of its prior sd"""
-
-    _section = "mass_grade"
-
-    def _problems(self) -> Iterable[str]:
-        yield from self._ranges({
-            "mass_prior_kg": (100.0, 1e5), "mass_prior_sd_kg": (1.0, 1e5), "load_prior_sd_N": (1.0, 1e6),
-            "forgetting": (0.9, 1.0), "noise_sd_N": (1e-3, 1e5), "torque_min_Nm": (0.0, 1e4),
-            "speed_min_m_s": (0.0, 50.0), "ready_sd": (0.0, 1.0, True)})
 
 
 class MassGradeEstimator:

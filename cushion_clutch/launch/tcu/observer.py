@@ -54,8 +54,7 @@ class FacingObserver:
         self.net = ThermalNetwork(obs, theta_a, theta0) if obs.network else None
         self.facing = None if obs.network else FacingModel(obs.capacity_J_per_K, obs.loss_W_per_K, obs.heat_share,
                                                            theta_a, dt)
-        self.p = ClutchParameters(U=obs.spring_U_W_per_K, H=obs.spring_H_W_per_K, C=obs.spring_C_J_per_K,
-                                  theta_a=theta_a, theta_cs_start=theta0)
+        self.p = ClutchParameters(**obs.spring_parameters(), theta_a=theta_a, theta_cs_start=theta0)
         self.dt = dt
         self.theta_cm = self.theta_cs = theta0
         self.p_prev = 0.0

@@ -48,52 +48,16 @@ not shorten a load-limited slip.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
 from pathlib import Path
-from typing import Iterable
 
-from ...config import Checked
 from ...model import KELVIN
+from ..scenario.tcu_params import Protection
 
 OK, WARN, LIMIT, INHIBIT = 0, 1, 2, 3
 LEVEL_NAMES = ("ok", "warn", "limit", "inhibit")
 #: what the driver is told on entering a level
 MESSAGES = ("clutch temperature normal", "clutch hot: avoid repeated starts",
             "clutch hot: launches limited", "clutch overheated: wait, launch inhibited until it has cooled")
-
-
-@dataclass(frozen=True)
-class Protection(Checked):
-    """Section ``[protection]``: thresholds on the estimated facing temperature (degC) and the limit action."""
-
-    enabled: bool = False
-    """off unless a scenario turns it on (the shipped comparisons of the TCUs' characteristics run without it;
-    the ``protection`` scenario turns it on)"""
-    warn_degC: float = 250.0
-    limit_degC: float = 280.0
-    inhibit_degC: float = 310.0
-    resume_degC: float = 250.0
-    damage_degC: float = 350.0
-    """the seed paper: permanent damage above 350-400 degC"""
-    hysteresis_K: float = 10.0
-    limit_engine_speed_rpm: float = 1300.0
-    """the launch's engine-speed target at full pedal while limiting (the pedal scales it), rpm"""
-
-    _section = "protection"
-
-    def _problems(self) -> Iterable[str]:
-        if not isinstance(self.enabled, bool):
-            yield f"protection.enabled = {self.enabled!r}: must be true or false"
-        yield from self._ranges(spec := {
-            "warn_degC": (20.0, 600.0), "limit_degC": (20.0, 600.0), "inhibit_degC": (20.0, 600.0),
-            "resume_degC": (20.0, 600.0), "damage_degC": (20.0, 800.0), "hysteresis_K": (0.0, 100.0),
-            "limit_engine_speed_rpm": (500.0, 8000.0)})
-        if not self._passed(spec, "warn_degC", "limit_degC", "inhibit_degC", "damage_degC", "resume_degC"):
-            return
-        if not self.warn_degC <= self.limit_degC <= self.inhibit_degC < self.damage_degC:
-            yield "protection: need warn_degC <= limit_degC <= inhibit_degC < damage_degC"
-        if self.resume_degC >= self.inhibit_degC:
-            yield "protection.resume_degC: must be below protection.inhibit_degC"
 
 
 class ThermalProtection:

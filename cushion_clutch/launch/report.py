@@ -12,7 +12,8 @@ import numpy as np
 from ..model import KELVIN, ClutchParameters, SpringTable
 from .results.metrics import METRIC_COLUMNS, SUMMARY, add_temperature_metrics, summarise
 from .scenario.load import Scenario
-from .simulate import COLUMNS, LaunchResult, simulate_launches
+from .results.series import COLUMNS, LaunchResult
+from .simulate import simulate_launches
 from .tcu.controller import VARIANTS
 from .results.provenance import Provenance
 

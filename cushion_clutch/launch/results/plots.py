@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ...model import KELVIN
-from ..simulate import LaunchResult
+from .series import LaunchResult
 
 if TYPE_CHECKING:
     from .provenance import Provenance

@@ -239,7 +239,7 @@ def test_every_tcu_variant_applies_the_calibrations_mu_at_the_measured_slip(tabl
     p = ClutchParameters()
     for slope, expected in ((sc.tcu.facing_mu_slope_per_100_rad_s, sc.tcu.mu_calibration(40.0)), (0.0, 1.0)):
         s = dataclasses.replace(sc, tcu=dataclasses.replace(sc.tcu, facing_mu_slope_per_100_rad_s=slope))
-        ctl = TcuController(VARIANTS["naive"], s, table, p, TA, 10.0, 50.0)
+        ctl = TcuController(VARIANTS["naive"], table, p, TA, 10.0, 50.0, **s.tcu_sections())
         ctl.cycle(1, 0.0, False, 140.0, 100.0, 0.0, TA)          # pre-fill: 40 rad/s of slip measured
         x = x_to_for_torque(100.0, ctl.theta_used(), table, p)
         nominal = outputs(x, ctl.theta_used(), table, p).torque

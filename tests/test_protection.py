@@ -148,8 +148,8 @@ def test_the_launch_target_locks_up_in_time():
 
     def tcu(scen, scale=1.0):
         dl = Driveline(scen, 83.78)
-        return TcuController(VARIANTS["aware"], scen, load_table(), ClutchParameters(), 293.15, dl.j_d * scale,
-                             dl.t_load_rest * scale)
+        return TcuController(VARIANTS["aware"], load_table(), ClutchParameters(), 293.15, dl.j_d * scale,
+                             dl.t_load_rest * scale, **scen.tcu_sections())
 
     def lock_time(ctl, scen, w):
         p = scen.driver.hard_pedal

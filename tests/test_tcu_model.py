@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from cushion_clutch.data import DEFAULT_TABLES
-from cushion_clutch.launch import tcu_model
+from cushion_clutch.launch.tcu import tcu_model
 from cushion_clutch.launch.tcu.tcu_model import TcuClutchModel
 from cushion_clutch.model import ClutchParameters, load_table, outputs, x_to_for_torque
 from cushion_clutch.model.clutch_model import THETA_MAX_K, X_TO_MAX

@@ -66,11 +66,12 @@ def _tcu(name: str, sc: Scenario, table: SpringTable, p: ClutchParameters, theta
          engine: EngineGovernor) -> TcuController:
     """The TCU of variant ``name``: the production TCU with its own sensors, network, EKF and estimators."""
     if name != "production":
-        return TcuController(VARIANTS[name], sc, table, p, theta0, dl.j_d, dl.t_load_rest, dl.j_e, engine.w_idle)
-    return ProductionTcu(VARIANTS[name], sc, table, p, theta0, dl.j_d, dl.t_load_rest, dl.j_e, engine.w_idle,
+        return TcuController(VARIANTS[name], table, p, theta0, dl.j_d, dl.t_load_rest, dl.j_e, engine.w_idle,
+                             **sc.tcu_sections())
+    return ProductionTcu(VARIANTS[name], table, p, theta0, dl.j_d, dl.t_load_rest, dl.j_e, engine.w_idle,
                          sc.tcu_sensors, sc.tcu_thermal, sc.ekf, sc.mass_grade,
                          (dl.i_tot, dl.r, dl.eta, sc.driveline.disc_inertia_kg_m2, sc.vehicle.rolling_resistance,
-                          dl.air))
+                          dl.air), **sc.tcu_sections())
 
 
 def _plant(kind: str, sc: Scenario, clutch: ClutchFmu, engine: EngineGovernor, dl: Driveline,
@@ -217,7 +218,7 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
     wall, cpu = time.perf_counter() - wall0, time.process_time() - cpu0
     dl.en.kinetic = dl.kinetic() - ke0
     dl.en.elastic = dl.elastic()
-    learned = ctl.learner.estimates if ctl.learner is not None else []
+    learned = ctl.learned_kiss()
     if keyed is not None:
         key_off(ctl, sc, keyed)
     return LaunchResult(name, series(rows), [r.metrics(run.hot_degC) for r in recs], dl.en, events, wall, total, cpu,

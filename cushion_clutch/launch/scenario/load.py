@@ -359,6 +359,12 @@ class Scenario(Checked):
         path = Path(name)
         return path if path.is_absolute() else Path(self.folder or ".") / path
 
+    def tcu_sections(self) -> dict:
+        """The sections a TCU controller takes (:class:`~..tcu.controller.TcuController`'s keywords): ``tcu``,
+        ``driver``, ``engine``, ``observer``, ``adaptation``, ``protection``."""
+        return {"tcu": self.tcu, "driver": self.driver, "engine": self.engine, "observer": self.observer,
+                "adaptation": self.adaptation, "protection": self.protection}
+
     def spring_thermal_set(self):
         """The plant's cushion-spring heat path (:class:`~cushion_clutch.model.thermal_set.ThermalSet`)."""
         return _thermal_set(self.clutch.spring_thermal, self.folder)

@@ -52,33 +52,34 @@ import copy
 import math
 from dataclasses import dataclass
 
-from ...model import KELVIN, ClutchParameters, SpringTable, kiss_point, outputs, thermal_step, x_to_for_torque
-from ...model.clutch_model import hold_theta_cm
-from .adaptation import KissLearner
-from .observer import FacingObserver
+from ...model import KELVIN, ClutchParameters, SpringTable, kiss_point, outputs, x_to_for_torque
+from ..scenario.load import Driver, Engine, Tcu
+from ..scenario.tcu_params import Adaptation, Observer, Protection
+from .knowledge import (CLOSE, LAUNCH, OPEN, PREFILL, EkfEstimate, LearnedKiss, ModelKiss, Observed, TableReference,
+                        Told)
 from .protection import LIMIT, ThermalProtection
-from ..scenario.load import Scenario
 
 
 @dataclass(frozen=True)
 class Variant:
-    """How a TCU knows the clutch: ``temperature`` in {"none", "ideal", "estimated"}, ``adaptive``."""
+    """A TCU variant, composed of what it knows (:mod:`.knowledge`): how it knows the temperatures
+    (``temperature``, a strategy class) and whether it learns the kiss point (``kiss``)."""
 
     name: str
-    temperature: str
-    adaptive: bool
+    temperature: type
+    kiss: type
 
 
 VARIANTS = {v.name: v for v in (
-    Variant("naive", "none", False),
-    Variant("aware", "ideal", False),
-    Variant("aware_estimated", "estimated", False),
-    Variant("adaptive", "none", True),
-    Variant("adaptive_aware_estimated", "estimated", True),
-    Variant("production", "ekf", False),     # see .production: sensors, EKF, adaptations, mass and grade
+    Variant("naive", TableReference, ModelKiss),
+    Variant("aware", Told, ModelKiss),
+    Variant("aware_estimated", Observed, ModelKiss),
+    Variant("adaptive", TableReference, LearnedKiss),
+    Variant("adaptive_aware_estimated", Observed, LearnedKiss),
+    Variant("production", EkfEstimate, ModelKiss),  # see .production: sensors, EKF, adaptations, mass and grade
 )}
 
-OPEN, LAUNCH, CLOSE, PREFILL = 0, 1, 2, 3     #: TCU phases
+__all__ = ["CLOSE", "LAUNCH", "OPEN", "PREFILL", "VARIANTS", "TcuController", "Variant"]
 
 #: entries a memo of the TCU's model keeps before it starts afresh
 MEMO_SIZE = 64
@@ -124,7 +125,6 @@ class TcuController:
     Parameters
     ----------
     variant : Variant
-    sc : Scenario
     table : SpringTable
         The TCU's characteristic (its friction table, if any, is ignored: mu nominal).
     p : ClutchParameters
@@ -136,32 +136,39 @@ class TcuController:
         holding the car (N.m): known to the TCU (lock-up torque, kiss-point learner).
     j_e_kg_m2, w_idle_rad_s : float
         Engine inertia (kg m2) and idle speed (rad/s).
+    tcu, driver, engine : Tcu, Driver, Engine
+        Its scenario sections: the controller's settings, the driver's pedal and creep torque, the engine's
+        full-load curve as the engine control reports it.
+    observer, adaptation, protection : Observer, Adaptation, Protection
+        The sections of the observer, the kiss-point learner and the thermal protection (defaults: the
+        sections' defaults); each used by the variants that have one.
     """
 
-    def __init__(self, variant: Variant, sc: Scenario, table: SpringTable, p: ClutchParameters, theta0: float,
-                 j_d_kg_m2: float, t_load_Nm: float, j_e_kg_m2: float = 0.25, w_idle_rad_s: float = 83.78):
+    def __init__(self, variant: Variant, table: SpringTable, p: ClutchParameters, theta0: float,
+                 j_d_kg_m2: float, t_load_Nm: float, j_e_kg_m2: float = 0.25, w_idle_rad_s: float = 83.78, *,
+                 tcu: Tcu, driver: Driver, engine: Engine, observer: Observer | None = None,
+                 adaptation: Adaptation | None = None, protection: Protection | None = None):
         if table.friction is not None:          # the TCU's model has the nominal, constant mu
             table = copy.copy(table)
             table.friction = None
-        self.v, self.sc, self.table, self.p = variant, sc, table, p
-        self.period = sc.tcu.period_s
+        self.v, self.table, self.p = variant, table, p
+        self.tc, self.driver, self.engine = tcu, driver, engine
+        self.period = tcu.period_s
         # the characteristic a temperature-blind TCU believes: the table's reference temperature (its kiss point,
         # delta_kiss = 0; 20 degC), not its first row (-40 degC since the tables run from a winter start)
         self.theta_ref = next((t for t, d in zip(table.theta_degC, table.delta_kiss_m) if d == 0.0),
                               table.theta_degC[0]) + KELVIN
-        self.theta_ideal = theta0
-        self.theta_cm_ideal = theta0      # the ideal TCU's facing temperature (it is told the true one), K
-        self.observer = (FacingObserver(sc.observer, p.theta_a, theta0, self.period)
-                         if variant.temperature == "estimated" else None)
-        self.learner = (KissLearner(sc.adaptation, self.period, j_d_kg_m2, t_load_Nm)
-                        if variant.adaptive else None)
+        #: how it knows the temperatures, whether it learns the kiss point (:mod:`.knowledge`)
+        self.know = variant.temperature(self, observer or Observer(), theta0)
+        self.kiss_learning = variant.kiss(adaptation or Adaptation(), self.period, j_d_kg_m2, t_load_Nm)
+        self.learner = self.kiss_learning.learner
         self.offset = 0.0               #: learned kiss point minus the model's at the assumed temperature, m
         self.phase, self.t_dem, self.x_cmd = OPEN, 0.0, 0.0
         #: demand rate over the coming period (the TCU's extrapolation), N.m/s
         self.t_rate = 0.0
         self.launch = 0
         self.j_d, self.t_load, self.j_e, self.w_idle = j_d_kg_m2, t_load_Nm, j_e_kg_m2, w_idle_rad_s
-        tc = sc.tcu
+        tc = tcu
         self.act = math.exp(-tc.period_s / tc.actuator_time_constant_s) if tc.actuator_time_constant_s > 0 else 0.0
         self.w_ref = self.s_ref = self.integral = 0.0
         self.sync = False
@@ -173,8 +180,8 @@ class TcuController:
         self._command_memo: dict = {}
         self._torque_memo: dict = {}
         #: thermal protection by the facing-temperature estimate (:mod:`.protection`), TCUs that have one
-        self.protection = (ThermalProtection(sc.protection)
-                           if sc.protection.enabled and variant.temperature != "none" else None)
+        protection = protection or Protection()
+        self.protection = ThermalProtection(protection) if protection.enabled and self.know.protects else None
         self.inhibited = self.limited = False
         #: the launch's engine-speed target (:meth:`launch_target_rad_s`, decided at its start), rad/s
         self.w_target = w_idle_rad_s
@@ -194,32 +201,26 @@ class TcuController:
 
     def theta_used(self) -> float:
         """The cushion-spring temperature the TCU assumes, K."""
-        if self.v.temperature == "ideal":
-            return self.theta_ideal
-        if self.observer is not None:
-            return self.observer.theta_cs
-        return self.theta_ref
+        return self.know.theta_cs()
 
     def theta_cm_estimate(self) -> float:
-        """The observer's facing temperature, K (NaN without an observer)."""
-        return self.observer.theta_cm if self.observer is not None else float("nan")
+        """Its facing-temperature estimate (observer, EKF), K (NaN without one)."""
+        return self.know.estimate()
 
     def theta_facing_protect(self) -> float:
         """The facing temperature the thermal protection acts on (the TCU's estimate; ``aware``: the true), K."""
-        return self.theta_cm_ideal if self.v.temperature == "ideal" else self.theta_cm_estimate()
+        return self.know.protect()
 
     def theta_cm_used(self) -> float | None:
         """The facing temperature the TCU's clutch model assumes (the stack's growth), K; None: theta_cs.
 
         Held within the model's range (:func:`~cushion_clutch.model.clutch_model.hold_theta_cm`), as the
         production TCU's EKF holds it: an estimate past it must not stop the TCU."""
-        if self.v.temperature == "ideal":
-            theta = self.theta_cm_ideal
-        elif self.observer is not None:
-            theta = self.observer.theta_cm
-        else:
-            return None
-        return hold_theta_cm(theta)
+        return self.know.theta_cm_model()
+
+    def learned_kiss(self) -> list[tuple[int, float]]:
+        """(launch, learned kiss point m) of every adaptation (none if it does not learn)."""
+        return self.kiss_learning.estimates()
 
     def model_kiss(self, theta: float) -> float:
         """The model's kiss point at ``theta`` (K), m (the cover's balance: cushion, growth, wear).
@@ -259,7 +260,9 @@ class TcuController:
         return self.mu_cal * _memo(self._torque_memo, (x_m, theta, theta_cm, self.offset), lambda: outputs(
             x_m - self.offset, theta, self.table, self.p, theta_cm).torque)
 
-    def _learn(self, torque_Nm: float, x_mean: float) -> None:
+    def learn_kiss(self, torque_Nm: float, x_mean: float) -> None:
+        """Move the believed kiss point towards the one that the window's clutch torque (N.m) at the mean
+        bearing position ``x_mean`` (m) gives (:class:`~.knowledge.LearnedKiss`)."""
         theta = self.theta_used()
         distance = (x_to_for_torque(torque_Nm / self.mu_cal, theta, self.table, self.p, theta_cm=self.theta_cm_used())
                     - self.model_kiss(theta))
@@ -271,14 +274,14 @@ class TcuController:
         """Command that brings a first-order actuator from ``x_meas`` to ``x_target`` in one period, m
         (within the actuator's travel)."""
         u = (x_target - self.act * x_meas) / (1.0 - self.act)
-        hi = self.sc.tcu.x_to_closed_m
+        hi = self.tc.x_to_closed_m
         return 0.0 if u < 0.0 else (hi if u > hi else u)
 
     def holds(self, level: str, w_rad_s: float) -> bool:
         """True if the engine at ``w_rad_s`` (rad/s) and the level's pedal carries the holding torque the TCU
         believes (its full-load curve less its drag): locked there, the car does not roll back."""
-        eng = self.sc.engine
-        return (self.sc.driver.pedal(level) * _full_load_Nm(eng, w_rad_s) - eng.drag_Nm_per_rad_s * w_rad_s
+        eng = self.engine
+        return (self.driver.pedal(level) * _full_load_Nm(eng, w_rad_s) - eng.drag_Nm_per_rad_s * w_rad_s
                 > self.t_load)
 
 
@@ -304,8 +307,8 @@ class TcuController:
           duty believed 12 s where the launch locked up in 7 s; raising it there cost 131 instead of 88 kJ
           per start.)
         """
-        tc, eng = self.sc.tcu, self.sc.engine
-        pedal = self.sc.driver.pedal(level)
+        tc, eng = self.tc, self.engine
+        pedal = self.driver.pedal(level)
         budget = tc.lockup_deadline_s + tc.forced_sync_s
         rpm = math.pi / 30.0
 
@@ -334,7 +337,7 @@ class TcuController:
 
     def _demand(self, level: str, w_e: float, w_d: float, t_e: float) -> float:
         """The launch's clutch-torque demand for this period, N.m (updates references and integral)."""
-        tc, drv, dt = self.sc.tcu, self.sc.driver, self.period
+        tc, drv, dt = self.tc, self.driver, self.period
         slip = w_e - w_d
         kp, ki = tc.speed_kp_Nm_per_rad_s, tc.speed_ki_Nm_per_rad
         k = 1.0 / self.j_e + 1.0 / self.j_d
@@ -388,22 +391,15 @@ class TcuController:
         ``t_e`` the engine's torque signal (N.m); ``level`` the driver's demand level; ``w_v`` the
         measured wheel speed at the disc (rad/s, the kiss-point learner's input; default ``w_d``).
         """
-        tc = self.sc.tcu
+        tc = self.tc
         prot = self.protection
         self.mu_cal = tc.mu_calibration(w_e - w_d)
-        if self.v.temperature == "ideal":
-            self.theta_ideal = thermal_step(self.theta_ideal, hold_theta_cm(theta_cm_true), self.period, self.p)
-            self.theta_cm_ideal = theta_cm_true
-        elif self.observer is not None:
-            slip = abs(w_e - w_d)
-            self.observer.update(self.model_torque(x_meas) * slip if self.phase == LAUNCH else 0.0, w_e, w_d,
-                                 self.phase == LAUNCH or self.phase == CLOSE)
+        self.know.update(self, theta_cm_true, x_meas, w_e, w_d)
         if launch != self.launch:
             self.launch = launch
             self.sync, self.integral, self.t_dem, self.w_ref = False, 0.0, 0.0, w_e
             self.t_closed = math.inf
-            if self.learner is not None:
-                self.learner.start_launch()
+            self.kiss_learning.start_launch()
             if prot is not None:
                 self.inhibited = prot.launch_start(self.theta_facing_protect(), tl, launch)
                 # the launch's limit is set at its start: a mid-launch switch of the engine-speed target made the
@@ -430,10 +426,7 @@ class TcuController:
             demand = self._demand(level, w_e, w_d, t_e)
             limit = min(t_prev + tc.torque_ramp_Nm_per_s * self.period, self.t_closed)
             self.t_dem = 0.0 if demand < 0.0 else (limit if demand > limit else demand)
-            if self.learner is not None:
-                torque = self.learner.sample(w_d if w_v is None else w_v, x_meas)
-                if torque is not None:
-                    self._learn(torque, self.learner.mean_position())
+            self.kiss_learning.sample(self, w_d if w_v is None else w_v, x_meas)
             self.t_rate = (self.t_dem - t_prev) / self.period
             self.x_cmd = self._to_actuator(self.command(max(0.0, self.t_dem + self.t_rate * self.period)), x_meas)
             self.x_close = x_meas

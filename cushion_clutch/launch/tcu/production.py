@@ -61,25 +61,28 @@ class ProductionTcu(TcuController):
 
     Parameters
     ----------
-    variant, sc, table, p, theta0, j_d_kg_m2, t_load_Nm, j_e_kg_m2, w_idle_rad_s
-        As :class:`~.tcu.TcuController`; ``j_d_kg_m2`` and ``t_load_Nm`` (the truth) are
+    variant, table, p, theta0, j_d_kg_m2, t_load_Nm, j_e_kg_m2, w_idle_rad_s
+        As :class:`~.controller.TcuController`; ``j_d_kg_m2`` and ``t_load_Nm`` (the truth) are
         not used: the TCU starts from its mass prior on level ground and then uses its estimates.
     sensors, net, ekf, mass_grade
         The TCU's sensors, own thermal network, EKF and RLS settings.
     ratios : tuple of float
         ``(i_tot, r_m, eta, j_disc_kg_m2, rolling, air_N_s2_per_m2)`` of the launch gear, nominal.
+    sections
+        The controller's sections (``tcu``, ``driver``, ``engine``, ``protection``), as
+        :class:`~.controller.TcuController` takes them.
     """
 
-    def __init__(self, variant: Variant, sc, table: SpringTable, p: ClutchParameters, theta0: float,
+    def __init__(self, variant: Variant, table: SpringTable, p: ClutchParameters, theta0: float,
                  j_d_kg_m2: float, t_load_Nm: float, j_e_kg_m2: float, w_idle_rad_s: float,
                  sensors: ProductionSensors, net: TcuNetworkParams, ekf: EkfParams, mass_grade: MassGrade,
-                 ratios: tuple[float, ...]):
+                 ratios: tuple[float, ...], **sections):
         if table.friction is not None:          # the TCU's model has the nominal, constant mu
             table = copy.copy(table)
             table.friction = None
         self.sens = TcuSensors(sensors)
         theta_a_meas = self.sens.ambient(p.theta_a)
-        self.ekf = ClutchEkf(net, ekf, table, p, theta_a_meas, theta0, sc.tcu.mu_calibration)
+        self.ekf = ClutchEkf(net, ekf, table, p, theta_a_meas, theta0, sections["tcu"].mu_calibration)
         self.rls = MassGradeEstimator(mass_grade, *ratios)
         self.i_tot, self.r = ratios[0], ratios[1]
         self.t = 0.0
@@ -91,20 +94,10 @@ class ProductionTcu(TcuController):
         self._closed_value = 0.0
         self._kiss_rev, self._kiss_belief = -1, 0.0     # the EKF revision of the kiss point below
         self._rls_n, self._rls_load = -1, (0.0, 0.0)     # the RLS's update count and its inertia and load then
-        super().__init__(variant, sc, table, p, theta0, self.rls.inertia_at_disc_kg_m2(),
-                         self.rls.holding_torque_Nm(), j_e_kg_m2, w_idle_rad_s)
+        super().__init__(variant, table, p, theta0, self.rls.inertia_at_disc_kg_m2(),
+                         self.rls.holding_torque_Nm(), j_e_kg_m2, w_idle_rad_s, **sections)
 
-    # --- what the TCU believes ---------------------------------------------------------------------
-    def theta_used(self) -> float:
-        return self.ekf.theta_cs
-
-    def theta_cm_estimate(self) -> float:
-        return self.ekf.theta_cm
-
-    def theta_cm_used(self) -> float:
-        """The facing temperature the TCU's clutch model assumes (the EKF's estimate, within the model's range), K."""
-        return self.ekf.theta_cm_model
-
+    # --- what the TCU believes (its temperatures: the EKF's, :class:`~.knowledge.EkfEstimate`) -----------
     def kiss(self) -> float:
         """The kiss point the TCU believes, in the true bearing frame, m (kept until the EKF's estimate changes,
         :attr:`~.ekf.ClutchEkf.revision`)."""
@@ -135,7 +128,7 @@ class ProductionTcu(TcuController):
         scaled by the friction the TCU applies at the measured slip.
         """
         e = self.ekf
-        if x_m == self.sc.tcu.x_to_closed_m:
+        if x_m == self.tc.x_to_closed_m:
             if e.revision != self._closed_key:          # the nominal-friction torque; the friction scales it
                 self._closed_key, self._closed_value = e.revision, e.used_torque(x_m + self.x_offset, mu=1.0)
             return self._closed_value * e.mu_applied

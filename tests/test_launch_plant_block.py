@@ -125,7 +125,7 @@ def _creep_plant(fmu, theta0_K):
     sc = _scenario("creep", 1)
     h = sc.run.step_s
     engine = EngineGovernor(sc.engine, h)
-    dl = Driveline(sc, engine.w_idle)
+    dl = Driveline(**sc.driveline_sections(), w_e=engine.w_idle)
     clutch = ClutchFmu(fmu, {})
     try:
         native = NativePlant(clutch, engine, dl, ThermalNetwork(sc.plant_thermal, 293.15, theta0_K), h, 0.9, 300.0,

@@ -147,7 +147,7 @@ def test_the_launch_target_locks_up_in_time():
     budget = tc.lockup_deadline_s + tc.forced_sync_s
 
     def tcu(scen, scale=1.0):
-        dl = Driveline(scen, 83.78)
+        dl = Driveline(**scen.driveline_sections(), w_e=83.78)
         return TcuController(VARIANTS["aware"], load_table(), ClutchParameters(), 293.15, dl.j_d * scale,
                              dl.t_load_rest * scale, **scen.tcu_sections())
 

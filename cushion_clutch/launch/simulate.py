@@ -123,7 +123,7 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
     spring_heat = sc.spring_thermal_set()               # the cushion spring's heat path (clutch.spring_thermal)
     p = ClutchParameters(theta_a=theta_a, theta_cs_start=theta0, **spring_heat.parameters())
     engine = EngineGovernor(sc.engine, h)
-    dl = Driveline(sc, engine.w_idle)
+    dl = Driveline(**sc.driveline_sections(), w_e=engine.w_idle)
     ctl = _tcu(name, sc, table, p, theta0, dl, engine)
     sense = ctl.sense if name == "production" else None
     sensors = SpeedSensors(sc.sensors)

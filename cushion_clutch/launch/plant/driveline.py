@@ -28,7 +28,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from ..scenario.load import Scenario
+from ..scenario.load import Driveline as DrivelineSection, Scenario, Vehicle
 
 G = 9.81    #: gravity, m/s2
 
@@ -70,15 +70,27 @@ class Driveline:
 
     After a step, ``t_c`` is the clutch torque (N.m), ``slip_J`` the slip
     energy of the step (J) and ``slip_W`` the slip power at midpoint speeds (W).
+
+    Parameters
+    ----------
+    driveline, vehicle : Driveline, Vehicle
+        The scenario's ``[driveline]`` and ``[vehicle]`` sections.
+    engine_inertia_kg_m2 : float
+        The engine's inertia, kg m2.
+    step_s : float
+        The step :meth:`step` advances, s.
+    w_e : float
+        The engine's speed at the start, rad/s.
     """
 
     __slots__ = ("h", "i_tot", "r", "eta", "f_grade", "f_roll", "j_v", "j_d", "j_e", "j_disc", "mass", "k", "c",
                  "kappa", "air", "brake_torque", "w_e", "w_d", "v", "phi", "locked", "en", "t_c", "slip_J",
                  "slip_W", "t_load_rest")
 
-    def __init__(self, sc: Scenario, w_e: float):
-        dl, veh = sc.driveline, sc.vehicle
-        self.h = h = sc.run.step_s
+    def __init__(self, driveline: DrivelineSection, vehicle: Vehicle, engine_inertia_kg_m2: float, step_s: float,
+                 w_e: float):
+        dl, veh = driveline, vehicle
+        self.h = h = step_s
         self.i_tot = i = dl.gear_ratio * dl.final_drive_ratio
         self.r, self.eta = dl.wheel_radius_m, dl.efficiency
         slope = math.atan(veh.slope_percent / 100.0)
@@ -87,7 +99,7 @@ class Driveline:
         self.mass, self.j_disc = veh.mass_kg, dl.disc_inertia_kg_m2
         self.j_v = veh.mass_kg * (self.r / i) ** 2                         # vehicle at the disc
         self.j_d = self.j_disc + self.j_v / self.eta                        # disc and vehicle as the clutch feels them
-        self.j_e = sc.engine.inertia_kg_m2
+        self.j_e = engine_inertia_kg_m2
         self.k, self.c = dl.stiffness_Nm_per_rad / i ** 2, dl.damping_Nm_s_per_rad / i ** 2
         self.kappa = self.k * h / 2.0 + self.c
         self.air = 0.5 * veh.air_density_kg_m3 * veh.drag_area_m2

@@ -271,7 +271,7 @@ def launch_capability(sc, level: str) -> tuple[float, float]:
     from ..plant.engine import RPM, EngineGovernor
 
     eng = EngineGovernor(sc.engine, sc.run.step_s)
-    load = Driveline(sc, eng.w_idle).t_load_rest
+    load = Driveline(**sc.driveline_sections(), w_e=eng.w_idle).t_load_rest
     if level == "creep":
         return eng.max_torque(eng.w_idle) - eng.drag * eng.w_idle, load
     pedal = sc.driver.pedal(level)
@@ -300,4 +300,4 @@ def launch_possible(sc, level: str) -> bool:
     n = 400
     hold = next(w for w in (eng.w_idle + (eng.w_max - eng.w_idle) * k / n for k in range(n + 1))
                 if pedal * eng.max_torque(w) - eng.drag * w > load)
-    return hold * Driveline(sc, eng.w_idle).j_d / (engine - load) <= sc.tcu.drive_time_s
+    return hold * Driveline(**sc.driveline_sections(), w_e=eng.w_idle).j_d / (engine - load) <= sc.tcu.drive_time_s

@@ -365,6 +365,12 @@ class Scenario(Checked):
         return {"tcu": self.tcu, "driver": self.driver, "engine": self.engine, "observer": self.observer,
                 "adaptation": self.adaptation, "protection": self.protection}
 
+    def driveline_sections(self) -> dict:
+        """What the plant's driveline takes (:class:`~..plant.driveline.Driveline`'s keywords but ``w_e``): the
+        ``[driveline]`` and ``[vehicle]`` sections, the engine's inertia (kg m2) and the step (s)."""
+        return {"driveline": self.driveline, "vehicle": self.vehicle,
+                "engine_inertia_kg_m2": self.engine.inertia_kg_m2, "step_s": self.run.step_s}
+
     def spring_thermal_set(self):
         """The plant's cushion-spring heat path (:class:`~cushion_clutch.model.thermal_set.ThermalSet`)."""
         return _thermal_set(self.clutch.spring_thermal, self.folder)

@@ -74,6 +74,27 @@ def _tcu(name: str, sc: Scenario, table: SpringTable, p: ClutchParameters, theta
                           dl.air), **sc.tcu_sections())
 
 
+def _slots(sc: Scenario) -> tuple[list[float], list[float], list[str], list[LaunchRecord]]:
+    """The launch slots' starts and ends (s), demand levels and launch records (``run.launches`` hot ones, then
+    the cool-down ones)."""
+    run, h = sc.run, sc.run.step_s
+    starts = run.starts()
+    ends, levels = starts[1:] + [run.duration()], [sc.driver.level(i + 1) for i in range(len(starts))]
+    possible = {lv: launch_possible(sc, lv) for lv in set(levels)}
+    recs = [LaunchRecord(i + 1, i >= run.launches, h, levels[i], possible[levels[i]]) for i in range(len(starts))]
+    return starts, ends, levels, recs
+
+
+def _clutch_start(sc: Scenario, p: ClutchParameters, spring: dict[str, float], plant_start: dict | None) -> dict:
+    """The plant FMU's start values: ambient and soak (K), the kiss point with the scenario's offset (m), the
+    cushion spring's heat path (``U``, ``H``, ``C``) and the facing wear (m) if any; with an SSP parameter set
+    (``plant_start``) its values and the scenario's duty (:func:`plant_start_values`)."""
+    start = {"theta_a": p.theta_a, "theta_cs_start": p.theta_cs_start,
+             "x_kiss_ref": p.x_kiss_ref + sc.clutch.x_kiss_offset_m, **spring,
+             **({"facing_wear": sc.clutch.facing_wear_m} if sc.clutch.facing_wear_m else {})}
+    return plant_start_values(plant_start, start, p.x_kiss_ref, sc) if plant_start else start
+
+
 def _plant(kind: str, sc: Scenario, clutch: ClutchFmu, engine: EngineGovernor, dl: Driveline,
            p: ClutchParameters, theta_a: float, theta0: float, record_every: int, alpha_jerk: float) -> Plant:
     """The plant of the run: the thermal network (a prescribed ``profile_csv`` overrides it; disabled: the
@@ -118,24 +139,17 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
         raise ValueError(f"plant = {plant!r}: allowed {', '.join(PLANTS)}")
     if record_every < 1:
         raise ValueError(f"record_every = {record_every!r}: must be at least 1 (steps between the series' rows)")
-    tc, run, drv, h = sc.tcu, sc.run, sc.driver, sc.run.step_s
+    run, drv, h = sc.run, sc.driver, sc.run.step_s
     theta_a, theta0 = sc.facing.ambient_degC + KELVIN, sc.facing.initial_degC + KELVIN
     spring_heat = sc.spring_thermal_set()               # the cushion spring's heat path (clutch.spring_thermal)
     p = ClutchParameters(theta_a=theta_a, theta_cs_start=theta0, **spring_heat.parameters())
     engine = EngineGovernor(sc.engine, h)
     dl = Driveline(**sc.driveline_sections(), w_e=engine.w_idle)
     ctl = _tcu(name, sc, table, p, theta0, dl, engine)
-    sense = ctl.sense if name == "production" else None
     sensors = SpeedSensors(sc.sensors)
-    starts, total = run.starts(), run.duration()
-    ends, levels = starts[1:] + [total], [drv.level(i + 1) for i in range(len(starts))]
-    possible = {lv: launch_possible(sc, lv) for lv in set(levels)}
-    recs = [LaunchRecord(i + 1, i >= run.launches, h, levels[i], possible[levels[i]]) for i in range(len(starts))]
-    clutch_start = {"theta_a": theta_a, "theta_cs_start": theta0, "x_kiss_ref": p.x_kiss_ref + sc.clutch.x_kiss_offset_m,
-                    **spring_heat.parameters(),
-                    **({"facing_wear": sc.clutch.facing_wear_m} if sc.clutch.facing_wear_m else {})}
-    if plant_start:
-        clutch_start = plant_start_values(plant_start, clutch_start, p.x_kiss_ref, sc)
+    starts, ends, levels, recs = _slots(sc)
+    total = ends[-1]
+    clutch_start = _clutch_start(sc, p, spring_heat.parameters(), plant_start)
     keyed = (key_on(ctl, sc, fmu, clutch_start, sc.driveline.disc_inertia_kg_m2, engine.w_idle)
              if name == "production" else None)
     clutch = ClutchFmu(fmu, clutch_start)
@@ -165,13 +179,8 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
             cycled = countdown == 0
             if cycled:                                           # -- TCU cycle
                 countdown = tcu_every
-                if sense is not None:         # production TCU: its own speed sensors, read from the truth given;
-                    sense(t, dl.w_e, dl.w_d, pl.t_e)              # the wheel speed as the others read it (ABS)
-                    ctl.cycle(n + 1, tl, rec.lock_time is not None, dl.w_e, dl.w_d, pl.x_act, pl.theta_cm, pl.t_e,
-                              levels[n], sensors.read(dl.v * r_to_disc))
-                else:
-                    ctl.cycle(n + 1, tl, rec.lock_time is not None, sensors.read(dl.w_e), sensors.read(dl.w_d),
-                              pl.x_act, pl.theta_cm, pl.t_e, levels[n], sensors.read(dl.v * r_to_disc))
+                ctl.read_and_cycle(sensors, t, n + 1, tl, rec.lock_time is not None, dl.w_e, dl.w_d, dl.v * r_to_disc,
+                                   pl.x_act, pl.theta_cm, pl.t_e, levels[n])
                 phase = ctl.phase
                 engaged, launching = phase == LAUNCH or phase == CLOSE, phase == LAUNCH
                 sampling = (launching or phase == PREFILL) and rec.lock_time is None

@@ -380,6 +380,14 @@ class TcuController:
             self.integral += ki * e * dt                     # anti-windup: not while rate- or capacity-limited
         return demand
 
+    def read_and_cycle(self, sensors, t: float, launch: int, tl: float, locked_once: bool, w_e: float, w_d: float,
+                       w_v: float, x_act: float, theta_cm: float, t_e: float, level: str) -> None:
+        """One TCU period from the plant's true values: the engine, disc and wheel speeds at the disc (rad/s) as
+        the ``sensors`` (:class:`~.observer.SpeedSensors`) read them, then :meth:`cycle` (``t`` in s, unused
+        here; the rest as :meth:`cycle` takes them)."""
+        self.cycle(launch, tl, locked_once, sensors.read(w_e), sensors.read(w_d), x_act, theta_cm, t_e, level,
+                   sensors.read(w_v))
+
     def cycle(self, launch: int, tl: float, locked_once: bool, w_e: float, w_d: float, x_meas: float,
               theta_cm_true: float, t_e: float = 0.0, level: str = "hard", w_v: float | None = None) -> None:
         """One TCU period: update estimates, learn, set ``phase``, ``t_dem`` (N.m), ``t_rate`` and ``x_cmd`` (m).

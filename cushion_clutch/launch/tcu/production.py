@@ -148,6 +148,13 @@ class ProductionTcu(TcuController):
             self.sens.advance(t, 0.5 * (self.w_prev[0] + w_engine), 0.5 * (self.w_prev[1] + w_disc), dt)
         self.t, self.t_engine, self.w_prev = t, engine_torque_Nm, (w_engine, w_disc)
 
+    def read_and_cycle(self, sensors, t: float, launch: int, tl: float, locked_once: bool, w_e: float, w_d: float,
+                       w_v: float, x_act: float, theta_cm: float, t_e: float, level: str) -> None:
+        """As :meth:`.controller.TcuController.read_and_cycle`, with its own speed sensors read from the truth
+        given (:meth:`sense`); the wheel speed as the others read it (ABS)."""
+        self.sense(t, w_e, w_d, t_e)
+        self.cycle(launch, tl, locked_once, w_e, w_d, x_act, theta_cm, t_e, level, sensors.read(w_v))
+
     def _estimate(self, x_true: float, w_v: float) -> tuple[float, float, float, float]:
         """Read the sensors, update the RLS and the EKF; the readings ``(w_e, w_d, x, T_est)``."""
         s, e = self.sens, self.ekf

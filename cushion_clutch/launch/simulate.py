@@ -100,8 +100,8 @@ def _plant(kind: str, sc: Scenario, clutch: ClutchFmu, engine: EngineGovernor, d
     """The plant of the run: the thermal network (a prescribed ``profile_csv`` overrides it; disabled: the
     lumped facing), the actuator's decay per step, and the compiled or the Python engine."""
     fac, tc, h = sc.facing, sc.tcu, sc.run.step_s
-    net = ThermalNetwork(sc.plant_thermal, theta_a, theta0) if sc.plant_thermal.enabled and not fac.profile_csv \
-        else None
+    net = (ThermalNetwork(sc.plant_thermal, theta_a, theta0) if sc.plant_thermal.enabled and not fac.profile_csv
+           else None)
     tcu_every = max(1, int(round(tc.period_s / h)))
     # mu at the friction surface (issue 37): with the network and a friction table the plant's torque is
     # n mu(theta_friction, |omega_slip|) R_eq F_clamp, the clutch FMU's own torque formula with mu read at the

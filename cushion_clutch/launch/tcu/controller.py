@@ -159,7 +159,10 @@ class TcuController:
         self.theta_ref = next((t for t, d in zip(table.theta_degC, table.delta_kiss_m) if d == 0.0),
                               table.theta_degC[0]) + KELVIN
         #: how it knows the temperatures, whether it learns the kiss point (:mod:`.knowledge`)
-        self.know = variant.temperature(self, observer or Observer(), theta0)
+        self.know = know = variant.temperature(self, observer or Observer(), theta0)
+        # its answers, bound once (the methods below say what they are; asked several times a TCU cycle)
+        self.theta_used, self.theta_cm_used = know.theta_cs, know.theta_cm_model
+        self.theta_cm_estimate, self.theta_facing_protect = know.estimate, know.protect
         self.kiss_learning = variant.kiss(adaptation or Adaptation(), self.period, j_d_kg_m2, t_load_Nm)
         self.learner = self.kiss_learning.learner
         self.offset = 0.0               #: learned kiss point minus the model's at the assumed temperature, m

@@ -133,7 +133,7 @@ def _calibrate(args: argparse.Namespace) -> int:
 def _simulate(args: argparse.Namespace) -> int:
     import csv
 
-    from .launch.engagements import (EngagementCycle, plot_engagements, plot_thermal_step,
+    from .launch.fleet.engagements import (EngagementCycle, plot_engagements, plot_thermal_step,
                                      plot_torque_characteristic, simulate)
     from .model import ClutchParameters, load_table
     from .outputs import OutputSet
@@ -187,11 +187,11 @@ def _launch(args: argparse.Namespace) -> int:
 
     from .fmu.check import check_fmu
     from .model import load_table
-    from .launch.plant import build_plant_fmu
+    from .launch.plant.build import build_plant_fmu
     from .launch.report import (Provenance, lockup_lines, peak_lines, ratio_line, run_all, series_interval_s,
                                 summary_rows, write_outputs)
     from .launch.scenario import load_scenario, scenario_path
-    from .launch.tcu import VARIANTS
+    from .launch.tcu.controller import VARIANTS
     from .outputs import OutputSet
 
     sc = load_scenario(scenario_path(args.scenario))
@@ -303,8 +303,8 @@ def _fleet(args: argparse.Namespace) -> int:
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn, \
         TimeRemainingColumn
 
-    from .launch.fleet import PARTS, run_fleet
-    from .launch.population import load_population, population_path
+    from .launch.fleet.run import PARTS, run_fleet
+    from .launch.fleet.population import load_population, population_path
 
     pop = load_population(population_path(args.population))
     tcus = tuple(t.strip() for t in args.tcus.split(",") if t.strip())
@@ -625,7 +625,7 @@ def _simulation_commands(sub) -> None:
     """``launch``, ``fleet`` and ``simulate``: the commands that run the clutch FMU."""
     from .fmu.build import add_backend
     from .launch.scenario import DEFAULT_SCENARIO
-    from .launch.tcu import VARIANTS
+    from .launch.tcu.controller import VARIANTS
 
     la = _command(sub, "launch", _launch, f"repeated launches with the {len(VARIANTS)} TCU variants (main job)",
                   f"Build the clutch FMU from --tables (or take --fmu), run a launch scenario with each of the "

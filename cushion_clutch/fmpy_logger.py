@@ -7,7 +7,7 @@ instantiated later with fmpy's default callbacks then calls freed memory as soon
 interpreter dies with a segmentation fault (the clutch FMUs log Warnings and Discards whatever ``loggingOn``).
 :func:`restore_fmpy_logger` points the proxy back at fmpy's own printer, kept alive for the whole process;
 the project calls it before every instance it makes with fmpy's default callbacks
-(:class:`~cushion_clutch.launch.fmu_client.FmuClient`, :func:`~cushion_clutch.launch.engagements.simulate`,
+(:class:`~cushion_clutch.launch.plant.fmu_client.FmuClient`, :func:`~cushion_clutch.launch.fleet.engagements.simulate`,
 the test suite). FMI 3 loggers are not variadic and need no proxy.
 """
 from __future__ import annotations

@@ -12,7 +12,7 @@ import pytest
 from cushion_clutch import __version__
 from cushion_clutch.cli import build_parser, launch_terminal_table, main
 from cushion_clutch.fe.params import DEFAULT_SPRING
-from cushion_clutch.launch.tcu import VARIANTS
+from cushion_clutch.launch.tcu.controller import VARIANTS
 
 
 def _subparsers() -> dict[str, argparse.ArgumentParser]:

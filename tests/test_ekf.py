@@ -7,7 +7,7 @@ import pytest
 from cushion_clutch.errors import ParameterError
 from cushion_clutch.model import load_table
 from cushion_clutch.model import ClutchParameters, outputs, thermal_step, x_to_for_torque
-from cushion_clutch.launch.ekf import IX_DX, IX_HEAT, IX_LOSS, ClutchEkf, EkfParams, TcuNetworkParams
+from cushion_clutch.launch.tcu.ekf import IX_DX, IX_HEAT, IX_LOSS, ClutchEkf, EkfParams, TcuNetworkParams
 from cushion_clutch.model.thermal_network import NetworkParams, ThermalNetwork
 
 TA = 293.15
@@ -187,7 +187,7 @@ def test_discretisation_matches_scipy_expm():
     """The EKF's scaling-and-squaring exponential of its network (9 temperatures, surface layers at 0.2 s)."""
     from scipy.linalg import expm
 
-    from cushion_clutch.launch.ekf import N_T, _exp_and_integral
+    from cushion_clutch.launch.tcu.ekf import N_T, _exp_and_integral
 
     table = load_table()
     ekf = ClutchEkf(TcuNetworkParams(), EkfParams(), table, ClutchParameters(), TA, TA)

@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from cushion_clutch.launch.ekf import ClutchEkf, EkfParams, TcuNetworkParams
+from cushion_clutch.launch.tcu.ekf import ClutchEkf, EkfParams, TcuNetworkParams
 from cushion_clutch.model import ClutchParameters, load_table, outputs, x_to_for_torque
 
 TA = 293.15

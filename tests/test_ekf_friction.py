@@ -3,7 +3,7 @@ referenced to the engine torque estimate's gain learned on cool ones."""
 import numpy as np
 import pytest
 
-from cushion_clutch.launch.ekf import F1, F2, IX_FADE, IX_MU, IX_OFF, IX_SLOPE, ClutchEkf, EkfParams, TcuNetworkParams
+from cushion_clutch.launch.tcu.ekf import F1, F2, IX_FADE, IX_MU, IX_OFF, IX_SLOPE, ClutchEkf, EkfParams, TcuNetworkParams
 from cushion_clutch.model import ClutchParameters, load_table, outputs, x_to_for_torque
 
 TA = 293.15
@@ -233,13 +233,13 @@ def test_every_tcu_variant_applies_the_calibrations_mu_at_the_measured_slip(tabl
     import dataclasses
 
     from cushion_clutch.launch.scenario import load_scenario, scenario_path
-    from cushion_clutch.launch.tcu import VARIANTS, TcuController
+    from cushion_clutch.launch.tcu.controller import VARIANTS, TcuController
     sc = load_scenario(scenario_path("fade"))
     assert sc.tcu.facing_mu_slope_per_100_rad_s < 0.0
     p = ClutchParameters()
     for slope, expected in ((sc.tcu.facing_mu_slope_per_100_rad_s, sc.tcu.mu_calibration(40.0)), (0.0, 1.0)):
         s = dataclasses.replace(sc, tcu=dataclasses.replace(sc.tcu, facing_mu_slope_per_100_rad_s=slope))
-        ctl = TcuController(VARIANTS["naive"], s, table, p, TA, 10.0, 50.0)
+        ctl = TcuController(VARIANTS["naive"], table, p, TA, 10.0, 50.0, **s.tcu_sections())
         ctl.cycle(1, 0.0, False, 140.0, 100.0, 0.0, TA)          # pre-fill: 40 rad/s of slip measured
         x = x_to_for_torque(100.0, ctl.theta_used(), table, p)
         nominal = outputs(x, ctl.theta_used(), table, p).torque

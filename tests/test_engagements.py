@@ -3,7 +3,7 @@ import math
 import numpy as np
 import pytest
 
-from cushion_clutch.launch.engagements import EngagementCycle
+from cushion_clutch.launch.fleet.engagements import EngagementCycle
 
 
 def test_facing_temperature_is_the_exact_piecewise_solution():
@@ -39,8 +39,8 @@ CRASH_SCRIPT = r'''
 import sys
 import numpy as np
 from fmpy import simulate_fmu
-from cushion_clutch.launch.engagements import simulate
-from cushion_clutch.launch.fmu_client import ClutchFmu
+from cushion_clutch.launch.fleet.engagements import simulate
+from cushion_clutch.launch.plant.fmu_client import ClutchFmu
 
 fmu = sys.argv[1]
 sig = np.array([(0.0, np.nan), (1.0, np.nan)], dtype=[("time", float), ("x_to", float)])

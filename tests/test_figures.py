@@ -36,8 +36,8 @@ CALIBRATION_SOURCES = ("cushion_clutch/benchmarks/calibrate.py", "cushion_clutch
 HEAT_PATH_SOURCES = ("cushion_clutch/fe/heat_*.py", "cushion_clutch/fe/kiss_field.py", "cushion_clutch/fe/deck.py",
                      "cushion_clutch/fe/springs/default.toml")
 #: the fleet study (1000 samples of three TCUs on Dask, about 15 min; docs/results/fleet.md names its commit)
-FLEET_SOURCES = ("cushion_clutch/benchmarks/fleet.py", "cushion_clutch/launch/fleet.py",
-                 "cushion_clutch/launch/population.py", "cushion_clutch/launch/populations/*.toml")
+FLEET_SOURCES = ("cushion_clutch/benchmarks/fleet.py", "cushion_clutch/launch/fleet/run.py",
+                 "cushion_clutch/launch/fleet/population.py", "cushion_clutch/launch/populations/*.toml")
 RECORDED = {
     "images/heat_path.png": ("cushion-clutch heat-path --kiss-shift --out heat_path_out "
                              "(then copied as docs/developer/guide.md says)", HEAT_PATH_SOURCES),

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from cushion_clutch.errors import ClusterError, ParameterError
-from cushion_clutch.launch.population import draw, load_population, population_path, sample_scenario
+from cushion_clutch.launch.fleet.population import draw, load_population, population_path, sample_scenario
 
 SMALL = """
 name = "small"
@@ -139,7 +139,7 @@ def _rows_equal(a: list[dict], b: list[dict]) -> None:
 @pytest.mark.fmu
 def test_dask_equals_serial_and_a_rerun_resumes(tmp_path):
     from cushion_clutch.data import DEFAULT_TABLES
-    from cushion_clutch.launch.fleet import COLUMNS, RUN_FILE, SUMMARY_FILE, read_samples, run_fleet
+    from cushion_clutch.launch.fleet.run import COLUMNS, RUN_FILE, SUMMARY_FILE, read_samples, run_fleet
 
     pop = _small(tmp_path)
     tcus = ("naive", "production")
@@ -178,7 +178,7 @@ def test_failing_workers_are_named(tmp_path):
 
     from cushion_clutch.data import DEFAULT_TABLES
     from cushion_clutch.fe.cluster import open_cluster
-    from cushion_clutch.launch.fleet import run_fleet, run_sample
+    from cushion_clutch.launch.fleet.run import run_fleet, run_sample
     from cushion_clutch.model import load_table
 
     pop = _small(tmp_path)

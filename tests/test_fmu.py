@@ -261,7 +261,7 @@ def test_many_steps_do_not_grow_memory(fmu):
     Python code (about 60 us each), hence 0.3 M instead of the former 1.1 M fmpy steps (whose 20 MB
     limit on the peak RSS was 20 bytes a step).
     """
-    from cushion_clutch.launch.fmu_client import ClutchFmu
+    from cushion_clutch.launch.plant.fmu_client import ClutchFmu
     path, _, _ = fmu
     client = ClutchFmu(path, {})
     step, h = client.step, 1e-3

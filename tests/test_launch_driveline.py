@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from cushion_clutch.launch.driveline import Driveline, first_mode_hz
+from cushion_clutch.launch.plant.driveline import Driveline, first_mode_hz
 from cushion_clutch.launch.scenario import load_scenario, scenario_path
 
 
@@ -23,7 +23,7 @@ def test_first_mode_of_the_shipped_scenarios_is_a_passenger_car_shuffle(name):
 
 def test_first_mode_matches_the_two_inertia_closed_form_and_energy_is_conserved():
     sc = frictionless(load_scenario())
-    dl = Driveline(sc, 100.0)
+    dl = Driveline(**sc.driveline_sections(), w_e=100.0)
     dl.w_d, dl.v, dl.locked, dl.phi = 100.0, 100.0 * dl.r / dl.i_tot, True, 0.01
     e0 = dl.kinetic() + dl.elastic()
     phi, n = [], int(2.0 / dl.h)
@@ -48,7 +48,7 @@ def test_first_mode_matches_the_two_inertia_closed_form_and_energy_is_conserved(
 
 def test_damping_decays_the_shuffle_and_books_close_to_round_off():
     sc = frictionless(load_scenario(), damping=300.0)
-    dl = Driveline(sc, 100.0)
+    dl = Driveline(**sc.driveline_sections(), w_e=100.0)
     dl.w_d, dl.v, dl.locked, dl.phi = 100.0, 100.0 * dl.r / dl.i_tot, True, 0.01
     e0 = dl.kinetic() + dl.elastic()
     for _ in range(int(3.0 / dl.h)):
@@ -60,7 +60,7 @@ def test_damping_decays_the_shuffle_and_books_close_to_round_off():
 
 def test_the_clutch_slips_when_the_locked_torque_exceeds_the_capacity():
     sc = frictionless(load_scenario())
-    dl = Driveline(sc, 150.0)
+    dl = Driveline(**sc.driveline_sections(), w_e=150.0)
     dl.w_d, dl.v, dl.locked = 150.0, 150.0 * dl.r / dl.i_tot, True
     events = [dl.step(200.0, 30.0, True, False) for _ in range(50)]
     assert -1 in events and not dl.locked and dl.w_e > dl.w_d

@@ -8,8 +8,8 @@ from cushion_clutch.fmu.build import build_fmu
 from cushion_clutch.data import DEFAULT_TABLES
 from cushion_clutch.model import KELVIN, ClutchParameters, load_table, outputs
 from cushion_clutch.model.friction import FrictionTable
-from cushion_clutch.launch.fmu_client import ClutchFmu
-from cushion_clutch.launch.plant import build_plant_fmu
+from cushion_clutch.launch.plant.fmu_client import ClutchFmu
+from cushion_clutch.launch.plant.build import build_plant_fmu
 from cushion_clutch.launch.scenario import load_scenario, scenario_path
 from cushion_clutch.launch.simulate import simulate_launches
 

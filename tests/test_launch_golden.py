@@ -32,7 +32,7 @@ pytestmark = pytest.mark.fmu
 def _runs(fmu_dir: Path) -> dict:
     """{"scenario/variant": {"metrics": [...], "energy": {...}, "lock_events": [...]}} of the short runs."""
     from cushion_clutch.data import DEFAULT_TABLES
-    from cushion_clutch.launch.plant import build_plant_fmu
+    from cushion_clutch.launch.plant.build import build_plant_fmu
     from cushion_clutch.launch.scenario import load_scenario, scenario_path
     from cushion_clutch.launch.simulate import simulate_launches
     from cushion_clutch.model import load_table
@@ -98,7 +98,7 @@ if __name__ == "__main__" and "--write" in sys.argv:
 
 def test_the_tcu_memo_returns_what_it_computed_and_stays_bounded():
     """The TCU's model memo (tcu._memo): exact keys only; -0.0 is not remembered under 0.0's key."""
-    from cushion_clutch.launch.tcu import MEMO_SIZE, _memo
+    from cushion_clutch.launch.tcu.controller import MEMO_SIZE, _memo
 
     memo: dict = {}
     calls = []

@@ -1,4 +1,4 @@
-"""The compiled plant steps (launch/plant_block.py, fmu_src/hosts/launch_plant.c) against the Python loop, the reference.
+"""The compiled plant steps (launch/plant/plant_block.py, fmu_src/hosts/launch_plant.c) against the Python loop, the reference.
 
 Both paths must give the same time series, per-launch metrics, energy terms, lock events and TCU estimates
 (the plant's thermal network steps in C too, in the blocks and in the quiet periods: its temperatures are in
@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from cushion_clutch.data import DEFAULT_TABLES
-from cushion_clutch.launch.plant import build_plant_fmu
+from cushion_clutch.launch.plant.build import build_plant_fmu
 from cushion_clutch.launch.scenario import load_scenario, scenario_path
 from cushion_clutch.launch.simulate import simulate_launches
 from cushion_clutch.model import load_table
@@ -116,16 +116,16 @@ def test_unknown_plant_named(fmu):
 def _creep_plant(fmu, theta0_K):
     """A native plant of one ``creep`` launch with the network at ``theta0_K``, its clutch FMU (the caller closes
     it) and the step, s."""
-    from cushion_clutch.launch.driveline import Driveline
-    from cushion_clutch.launch.engine import EngineGovernor
-    from cushion_clutch.launch.fmu_client import ClutchFmu
-    from cushion_clutch.launch.plant_block import NativePlant
+    from cushion_clutch.launch.plant.driveline import Driveline
+    from cushion_clutch.launch.plant.engine import EngineGovernor
+    from cushion_clutch.launch.plant.fmu_client import ClutchFmu
+    from cushion_clutch.launch.plant.plant_block import NativePlant
     from cushion_clutch.model.thermal_network import ThermalNetwork
 
     sc = _scenario("creep", 1)
     h = sc.run.step_s
     engine = EngineGovernor(sc.engine, h)
-    dl = Driveline(sc, engine.w_idle)
+    dl = Driveline(**sc.driveline_sections(), w_e=engine.w_idle)
     clutch = ClutchFmu(fmu, {})
     try:
         native = NativePlant(clutch, engine, dl, ThermalNetwork(sc.plant_thermal, 293.15, theta0_K), h, 0.9, 300.0,
@@ -139,7 +139,7 @@ def _creep_plant(fmu, theta0_K):
 def test_fmu_refusal_raises_naming_the_function(fmu):
     """An input the FMU refuses (a NaN bearing position): FmuCallError naming fmi2DoStep, as the Python path."""
     from cushion_clutch.errors import FmuCallError
-    from cushion_clutch.launch.metrics import LaunchRecord
+    from cushion_clutch.launch.results.metrics import LaunchRecord
 
     native, clutch, h = _creep_plant(fmu, 400.0)
     try:
@@ -157,8 +157,8 @@ def test_quiet_period_refusals(fmu):
     """lp_run_quiet: a torque with the bearing not retracted is reported (None: the loop raises), an input the
     FMU refuses raises FmuCallError naming the function."""
     from cushion_clutch.errors import FmuCallError
-    from cushion_clutch.launch.metrics import LaunchRecord
-    from cushion_clutch.launch.plant_block import HEAD
+    from cushion_clutch.launch.results.metrics import LaunchRecord
+    from cushion_clutch.launch.plant.plant_block import HEAD
 
     native, clutch, h = _creep_plant(fmu, 300.0)
     try:

@@ -7,10 +7,10 @@ from cushion_clutch.cli import main
 from cushion_clutch.fmu.build import build_fmu
 from cushion_clutch.data import DEFAULT_TABLES
 from cushion_clutch.model import load_table
-from cushion_clutch.launch.metrics import METRIC_COLUMNS
+from cushion_clutch.launch.results.metrics import METRIC_COLUMNS
 from cushion_clutch.launch.report import run_all, summary_rows, summary_table, write_outputs
 from cushion_clutch.launch.scenario import load_scenario
-from cushion_clutch.launch.tcu import VARIANTS
+from cushion_clutch.launch.tcu.controller import VARIANTS
 
 from test_launch import short
 
@@ -104,7 +104,7 @@ def test_a_run_that_leaves_the_model_s_domain_stops_there_and_says_so(tmp_path):
     import dataclasses
 
     from cushion_clutch.data import DEFAULT_TABLES
-    from cushion_clutch.launch.plant import build_plant_fmu
+    from cushion_clutch.launch.plant.build import build_plant_fmu
     from cushion_clutch.launch.scenario import load_scenario, scenario_path
     from cushion_clutch.launch.simulate import simulate_launches
     from cushion_clutch.model import load_table

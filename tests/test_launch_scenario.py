@@ -112,8 +112,8 @@ def test_the_duty_cycles_ship_with_their_sources_and_run(tmp_path):
     from pathlib import Path
 
     from cushion_clutch.data import DEFAULT_TABLES
-    from cushion_clutch.launch.duty import DAMAGE_DEGC, peak_degC, restarts_to_damage
-    from cushion_clutch.launch.plant import build_plant_fmu
+    from cushion_clutch.launch.fleet.duty import DAMAGE_DEGC, peak_degC, restarts_to_damage
+    from cushion_clutch.launch.plant.build import build_plant_fmu
     from cushion_clutch.launch.simulate import simulate_launches
     from cushion_clutch.model import load_table
 

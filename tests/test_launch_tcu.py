@@ -9,10 +9,10 @@ from cushion_clutch.errors import FmuCallError
 from cushion_clutch.fmu.build import build_fmu
 from cushion_clutch.data import DEFAULT_TABLES
 from cushion_clutch.model import load_table
-from cushion_clutch.launch.fmu_client import ClutchFmu
+from cushion_clutch.launch.plant.fmu_client import ClutchFmu
 from cushion_clutch.launch.scenario import load_scenario, scenario_path
 from cushion_clutch.model.thermal_network import NetworkParams
-from cushion_clutch.launch.tcu_params import Observer
+from cushion_clutch.launch.scenario.tcu_params import Observer
 from cushion_clutch.launch.simulate import simulate_launches
 
 from test_launch import short

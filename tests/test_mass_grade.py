@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from cushion_clutch.errors import ParameterError
-from cushion_clutch.launch.mass_grade import G, MassGrade, MassGradeEstimator
+from cushion_clutch.launch.tcu.mass_grade import G, MassGrade, MassGradeEstimator
 
 I_TOT, R, ETA, J_D, CR, AIR = 15.58, 0.31, 0.95, 0.03, 0.012, 0.42
 

@@ -107,7 +107,7 @@ def test_the_slip_heat_the_tcu_books_is_the_clutchs_not_the_torque_signals_gain(
     cool facings: the ECU's +4 % gain is not heat (``k_heat``, the network's inverse heat capacity, would learn it on
     the heat-up and then cool every cool-down too slowly). What remains is the ECU's +3 N.m offset, about 1-2 % of
     the trailer's launch torque. Measured (2026-11-26): booked / plant slip energy 1.013 (1.053 with the raw torque)."""
-    from cushion_clutch.launch.ekf import ClutchEkf
+    from cushion_clutch.launch.tcu.ekf import ClutchEkf
 
     booked = []
     accumulate = ClutchEkf.accumulate

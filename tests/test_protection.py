@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from cushion_clutch.errors import ParameterError
-from cushion_clutch.launch.protection import INHIBIT, LIMIT, OK, WARN, Protection, ThermalProtection
+from cushion_clutch.launch.tcu.protection import INHIBIT, LIMIT, OK, WARN, Protection, ThermalProtection
 from cushion_clutch.model import KELVIN
 
 
@@ -112,7 +112,7 @@ def test_every_production_launch_of_the_protection_scenario_locks_up_or_is_inhib
 def test_launch_capability_is_the_engine_at_the_pedal_against_the_holding_torque():
     """Closed forms: the holding torque m g (sin a + c_r cos a) r / (eta i) and the engine's best net torque
     at the pedal over its curve's nodes; a launch on a grade the engine cannot hold is not possible."""
-    from cushion_clutch.launch.metrics import launch_capability, launch_possible
+    from cushion_clutch.launch.results.metrics import launch_capability, launch_possible
     from cushion_clutch.launch.scenario import load_scenario, scenario_path
 
     sc = load_scenario(scenario_path("protection"))
@@ -137,9 +137,9 @@ def test_the_launch_target_locks_up_in_time():
     """A limited launch aims at the lowest speed from the limit up that locks up by the deadline (the TCU's
     beliefs), a light one at the limit itself; a launch whose pedal speed cannot lock up in time (a steep grade,
     a light pedal) aims at the lowest faster speed that can."""
-    from cushion_clutch.launch.driveline import Driveline
+    from cushion_clutch.launch.plant.driveline import Driveline
     from cushion_clutch.launch.scenario import load_scenario, scenario_path
-    from cushion_clutch.launch.tcu import VARIANTS, TcuController, _full_load_Nm
+    from cushion_clutch.launch.tcu.controller import VARIANTS, TcuController, _full_load_Nm
     from cushion_clutch.model import ClutchParameters, load_table
 
     sc = load_scenario(scenario_path("protection"))
@@ -147,9 +147,9 @@ def test_the_launch_target_locks_up_in_time():
     budget = tc.lockup_deadline_s + tc.forced_sync_s
 
     def tcu(scen, scale=1.0):
-        dl = Driveline(scen, 83.78)
-        return TcuController(VARIANTS["aware"], scen, load_table(), ClutchParameters(), 293.15, dl.j_d * scale,
-                             dl.t_load_rest * scale)
+        dl = Driveline(**scen.driveline_sections(), w_e=83.78)
+        return TcuController(VARIANTS["aware"], load_table(), ClutchParameters(), 293.15, dl.j_d * scale,
+                             dl.t_load_rest * scale, **scen.tcu_sections())
 
     def lock_time(ctl, scen, w):
         p = scen.driver.hard_pedal

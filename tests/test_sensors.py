@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from cushion_clutch.errors import ParameterError
-from cushion_clutch.launch.sensors import ProductionSensors, TcuSensors, ToothedWheel
+from cushion_clutch.launch.plant.sensors import ProductionSensors, TcuSensors, ToothedWheel
 
 
 def run_wheel(wheel, speed, seconds, h=1e-3, read_every=10):

@@ -1,4 +1,4 @@
-"""The production TCU's clutch model torque through the native clutch model (cushion_clutch/launch/tcu_model.py,
+"""The production TCU's clutch model torque through the native clutch model (cushion_clutch/launch/tcu/tcu_model.py,
 fmu_src/hosts/tcu_model.c) against the Python model, the reference: the same torque to round-off over a scan of the
 bearing position and both temperatures, the same inverse (bearing position for a torque) within its tolerance over
 a scan of torque and both temperatures, the round trip torque(x(T)) = T, the same errors outside the ranges, a
@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 from cushion_clutch.data import DEFAULT_TABLES
-from cushion_clutch.launch import tcu_model
-from cushion_clutch.launch.tcu_model import TcuClutchModel
+from cushion_clutch.launch.tcu import tcu_model
+from cushion_clutch.launch.tcu.tcu_model import TcuClutchModel
 from cushion_clutch.model import ClutchParameters, load_table, outputs, x_to_for_torque
 from cushion_clutch.model.clutch_model import THETA_MAX_K, X_TO_MAX
 
@@ -141,7 +141,7 @@ def test_python_path_is_the_reference_and_the_fallback(monkeypatch, caplog):
 
     monkeypatch.setattr(tcu_model.LIBRARY, "_loaded", None)
     monkeypatch.setattr(tcu_model.LIBRARY, "path", broken)
-    with caplog.at_level(logging.WARNING, logger="cushion_clutch.launch.tcu_model"):
+    with caplog.at_level(logging.WARNING, logger="cushion_clutch.launch.tcu.tcu_model"):
         m = TcuClutchModel(table, p)
     assert not m.native and "no compiler (test)" in caplog.text
     assert m.torque(5e-3, 320.0, 350.0) == outputs(5e-3, 320.0, table, p, 350.0).torque
@@ -162,7 +162,7 @@ def test_the_inverse_outside_the_ranges_raises_the_python_models_error():
 def test_the_production_command_goes_through_the_ekfs_model(monkeypatch):
     """ProductionTcu.x_for_torque is the EKF's model's inverse: native by default, the Python x_to_for_torque to
     the bit with tcu_model.NATIVE = False."""
-    from cushion_clutch.launch.production import ProductionTcu
+    from cushion_clutch.launch.tcu.production import ProductionTcu
     calls = []
     for native in (True, False):
         monkeypatch.setattr(tcu_model, "NATIVE", native)
@@ -192,7 +192,7 @@ def test_each_model_has_its_own_cover_state():
 
 def _creep_runs(tmp_path, monkeypatch, paths):
     """Two creep launches with the production TCU per (native torque, native inverse) pair: the launch metrics."""
-    from cushion_clutch.launch.plant import build_plant_fmu
+    from cushion_clutch.launch.plant.build import build_plant_fmu
     from cushion_clutch.launch.scenario import load_scenario, scenario_path
     from cushion_clutch.launch.simulate import simulate_launches
 

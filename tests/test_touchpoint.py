@@ -9,11 +9,11 @@ from cushion_clutch.data import DEFAULT_TABLES
 from cushion_clutch.errors import ParameterError
 from cushion_clutch.fmu.build import build_fmu
 from cushion_clutch.launch.scenario import load_scenario, scenario_path
-from cushion_clutch.launch.sensors import ProductionSensors
+from cushion_clutch.launch.plant.sensors import ProductionSensors
 from cushion_clutch.launch.simulate import simulate_launches
-from cushion_clutch.launch.store import AdaptedState, load_state, save_state
-from cushion_clutch.launch.tcu_params import Standstill, TcuStore
-from cushion_clutch.launch.touchpoint import learn_touch_point
+from cushion_clutch.launch.tcu.store import AdaptedState, load_state, save_state
+from cushion_clutch.launch.scenario.tcu_params import Standstill, TcuStore
+from cushion_clutch.launch.tcu.touchpoint import learn_touch_point
 from cushion_clutch.model import ClutchParameters, load_table
 
 pytestmark = pytest.mark.fmu

@@ -18,7 +18,7 @@ from fmpy.fmi1 import FMICallException
 
 from cushion_clutch.data import DEFAULT_TABLES
 from cushion_clutch.fmu.build import build_fmu
-from cushion_clutch.launch.metrics import temperature_metrics
+from cushion_clutch.launch.results.metrics import temperature_metrics
 from cushion_clutch.model import ClutchParameters, CoverParameters, kiss_point, load_table, outputs, thermal_step, \
     x_to_for_torque
 from cushion_clutch.model import clutch_model as cm
@@ -301,7 +301,7 @@ def test_a_winter_launch_runs_inside_the_tables(table, tmp_path):
     """Issue 37: a launch at -10 degC ambient (every node and the cushion spring soaked at -10 degC) spends none
     of its time beyond the default tables (-40 to 350 degC) and never reports validity 1."""
     import dataclasses
-    from cushion_clutch.launch.plant import build_plant_fmu
+    from cushion_clutch.launch.plant.build import build_plant_fmu
     from cushion_clutch.launch.scenario import load_scenario
     from cushion_clutch.launch.simulate import simulate_launches
     sc = load_scenario()

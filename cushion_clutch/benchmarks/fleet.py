@@ -7,7 +7,7 @@ Each part keeps its figures in ``W/<part>.json`` (the fleet runs their outputs i
 is written from those that exist, so a part that did not run is said to be missing, never guessed:
 
 * ``possible``: per shipped scenario and demand level, the engine's largest torque at the pedal against the
-  torque that holds the car on the grade (:func:`~cushion_clutch.launch.metrics.launch_capability`);
+  torque that holds the car on the grade (:func:`~cushion_clutch.launch.results.metrics.launch_capability`);
 * ``duty``: ``hill_restart`` and ``hill_fade`` with naive (no estimate, no protection), aware_estimated and
   production, with and without protection: restarts to damage (facings or friction surface above 350 degC,
   LuK 2006), peak temperature, inhibited and stranded launches. A run whose facings leave the clutch FMU's
@@ -41,7 +41,7 @@ def _load() -> list[float]:
 
 
 def part_possible(work: Path) -> dict:
-    from cushion_clutch.launch.metrics import launch_capability, launch_possible
+    from cushion_clutch.launch.results.metrics import launch_capability, launch_possible
     from cushion_clutch.launch.scenario import load_scenario, scenario_path, shipped_names
     rows = []
     for name in shipped_names():
@@ -81,8 +81,8 @@ def part_duty(work: Path) -> dict:
     import dataclasses
 
     from cushion_clutch.data import DEFAULT_TABLES
-    from cushion_clutch.launch.duty import DAMAGE_DEGC, peak_degC, restarts_to_damage
-    from cushion_clutch.launch.plant import build_plant_fmu
+    from cushion_clutch.launch.fleet.duty import DAMAGE_DEGC, peak_degC, restarts_to_damage
+    from cushion_clutch.launch.plant.build import build_plant_fmu
     from cushion_clutch.launch.scenario import load_scenario, scenario_path
     from cushion_clutch.model import load_table
 
@@ -111,8 +111,8 @@ def part_duty(work: Path) -> dict:
 
 def _fleet(work: Path, folder: str, samples: int, tcus, jobs: int | None, serial=False) -> dict:
     from cushion_clutch.data import DEFAULT_TABLES
-    from cushion_clutch.launch.fleet import run_fleet
-    from cushion_clutch.launch.population import load_population, population_path
+    from cushion_clutch.launch.fleet.run import run_fleet
+    from cushion_clutch.launch.fleet.population import load_population, population_path
     pop = load_population(population_path("default"))
     load0 = _load()
     res = run_fleet(pop, Path(DEFAULT_TABLES), work / folder, samples, tcus, 1, jobs=jobs, serial=serial,
@@ -139,7 +139,7 @@ def part_big(work: Path, samples: int) -> dict:
 
 
 def part_identity(work: Path) -> dict:
-    from cushion_clutch.launch.fleet import SAMPLES_FILE, read_samples
+    from cushion_clutch.launch.fleet.run import SAMPLES_FILE, read_samples
     out = _fleet(work, "fleet_naive_production_20_jobs1", 20, ("naive", "production"), 1)
     a = read_samples(work / "fleet_naive_production_20_jobs1" / SAMPLES_FILE)
     b = [r for r in read_samples(work / "fleet_naive_production" / SAMPLES_FILE) if r["sample"] < 20]
@@ -196,7 +196,7 @@ def write_page(work: Path, page: Path, argv: list[str]) -> None:
                          f"on 2 workers (at most 15 min on two idle cores: "
                          f"{'met' if got['bar']['wall_s'] <= 900 else 'not met on this machine'}, "
                          f"load average {got['bar']['load_before'][0]}).\n")
-            from cushion_clutch.launch.fleet import SAMPLES_FILE, plot_fleet, read_samples
+            from cushion_clutch.launch.fleet.run import SAMPLES_FILE, plot_fleet, read_samples
             rows, tcus = [], []
             for g, _ in runs:
                 rows += read_samples(work / g["folder"] / SAMPLES_FILE)

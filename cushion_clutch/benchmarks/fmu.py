@@ -97,7 +97,7 @@ def record_launch(fmu: Path, launches: int = 2, tcu: str = "naive") -> dict[str,
     throughout (``quiet_steps`` off: a fixed-step host's pattern; the launch loop's quiet periods would step
     10 ms) and the Python plant loop (the compiled one calls the FMU from C), through ``fmu`` (a native FMU with
     a binary for this machine). Every call of the clutch FMU's step is recorded by a subclass of
-    :class:`~cushion_clutch.launch.fmu_client.ClutchFmu` put in for the run.
+    :class:`~cushion_clutch.launch.plant.fmu_client.ClutchFmu` put in for the run.
 
     Returns
     -------
@@ -109,7 +109,7 @@ def record_launch(fmu: Path, launches: int = 2, tcu: str = "naive") -> dict[str,
     from unittest import mock
 
     from cushion_clutch.launch import simulate
-    from cushion_clutch.launch.fmu_client import ClutchFmu
+    from cushion_clutch.launch.plant.fmu_client import ClutchFmu
     from cushion_clutch.launch.scenario import load_scenario
     from cushion_clutch.model import load_table
 

@@ -33,7 +33,7 @@ def _fmu_call_us(fmu: Path, n: int = 50000) -> tuple[float, float]:
     from fmpy import extract, read_model_description
     from fmpy.fmi2 import FMU2Slave
 
-    from cushion_clutch.launch.fmu_client import INPUTS, OUTPUTS, ClutchFmu
+    from cushion_clutch.launch.plant.fmu_client import INPUTS, OUTPUTS, ClutchFmu
 
     c = ClutchFmu(fmu, {})
     t0 = time.perf_counter()
@@ -194,8 +194,8 @@ def markdown(scenarios: list[str], backend: str = "native", keep: dict | None = 
 
     from cushion_clutch.data import DEFAULT_TABLES
     from cushion_clutch.model import load_table
-    from cushion_clutch.launch.driveline import first_mode_hz
-    from cushion_clutch.launch.plant import build_plant_fmu
+    from cushion_clutch.launch.plant.driveline import first_mode_hz
+    from cushion_clutch.launch.plant.build import build_plant_fmu
     from cushion_clutch.launch.report import run_all
     from cushion_clutch.launch.scenario import load_scenario, scenario_path
 
@@ -241,7 +241,7 @@ def check_run(backend: str = "native", launches: int = CHECK_LAUNCHES) -> str:
 
     from cushion_clutch.data import DEFAULT_TABLES
     from cushion_clutch.model import load_table
-    from cushion_clutch.launch.plant import build_plant_fmu
+    from cushion_clutch.launch.plant.build import build_plant_fmu
     from cushion_clutch.launch.report import run_all
     from cushion_clutch.launch.scenario import load_scenario, scenario_path
 
@@ -282,10 +282,10 @@ def write_page(out: Path, scenarios: list[str], backend: str, argv, launches: in
 def main(argv=None) -> None:
     from cushion_clutch.data import DEFAULT_TABLES
     from cushion_clutch.model import load_table
-    from cushion_clutch.launch.plant import build_plant_fmu
+    from cushion_clutch.launch.plant.build import build_plant_fmu
     from cushion_clutch.launch.scenario import DEFAULT_SCENARIO, load_scenario, scenario_path
     from cushion_clutch.launch.simulate import simulate_launches
-    from cushion_clutch.launch.tcu import VARIANTS
+    from cushion_clutch.launch.tcu.controller import VARIANTS
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--scenario", default=str(DEFAULT_SCENARIO))

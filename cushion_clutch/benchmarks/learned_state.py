@@ -4,7 +4,7 @@
 
 The file is what a scenario with ``tcu_store.start = "learned"`` starts from (the shipped ``wear_learned``
 scenario reads ``wear_learned.json``, written by the command above). It lives here, beside the scripts that
-write shipped results, and not in :mod:`cushion_clutch.launch.store`, which the TCU itself imports.
+write shipped results, and not in :mod:`cushion_clutch.launch.tcu.store`, which the TCU itself imports.
 """
 from __future__ import annotations
 
@@ -17,10 +17,10 @@ from pathlib import Path
 def learn_state(scenario: str | Path, out: Path, tables: Path | None = None) -> Path:
     """Run ``scenario`` with a reset production TCU and store its adapted state at key-off in ``out`` (JSON)."""
     from cushion_clutch.data import DEFAULT_TABLES
-    from cushion_clutch.launch.plant import build_plant_fmu
+    from cushion_clutch.launch.plant.build import build_plant_fmu
     from cushion_clutch.launch.scenario import load_scenario, scenario_path
     from cushion_clutch.launch.simulate import simulate_launches
-    from cushion_clutch.launch.tcu_params import TcuStore
+    from cushion_clutch.launch.scenario.tcu_params import TcuStore
     from cushion_clutch.model import load_table
 
     sc = load_scenario(scenario_path(str(scenario)))

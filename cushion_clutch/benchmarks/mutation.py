@@ -92,7 +92,7 @@ MUTANTS = (
            "if (is_parameter(vr[k]) && after_init) {", "if (is_parameter(vr[k]) && !after_init && 0) {",
            NATIVE_TESTS, "parameters can be changed while stepping"),
     # ---- Python: the mutants that survived on c5f3d16 (issue 21) and two the ccx tests alone caught
-    Mutant("py-energy-endpoint", "cushion_clutch/launch/driveline.py",
+    Mutant("py-energy-endpoint", "cushion_clutch/launch/plant/driveline.py",
            "wm_e, wm_d, wm_v = 0.5 * (w_e + w_e_new), 0.5 * (w_d + w_d_new), 0.5 * (w_v + w_v_new)",
            "wm_e, wm_d, wm_v = w_e_new, w_d_new, w_v_new",
            ("tests/test_launch.py",), "energy bookkeeping with end-of-step speeds"),

@@ -31,7 +31,7 @@ def bar(name: str, repeat: int = 1, seed: int | None = None) -> dict:
     import dataclasses
 
     from cushion_clutch.data import DEFAULT_TABLES
-    from cushion_clutch.launch.plant import build_plant_fmu
+    from cushion_clutch.launch.plant.build import build_plant_fmu
     from cushion_clutch.launch.report import peaks
     from cushion_clutch.launch.scenario import load_scenario, scenario_path
     from cushion_clutch.launch.simulate import simulate_launches

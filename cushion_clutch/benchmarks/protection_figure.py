@@ -23,7 +23,7 @@ COLOURS = {"naive": "tab:red", "aware": "tab:green", "production": "tab:blue"}
 def run() -> tuple[object, dict]:
     """The ``protection`` scenario and its results for :data:`TCUS` (``report.run_all``)."""
     from cushion_clutch.data import DEFAULT_TABLES
-    from cushion_clutch.launch.plant import build_plant_fmu
+    from cushion_clutch.launch.plant.build import build_plant_fmu
     from cushion_clutch.launch.report import run_all
     from cushion_clutch.launch.scenario import load_scenario, scenario_path
     from cushion_clutch.model import load_table
@@ -40,7 +40,7 @@ def figure(sc, results: dict, path: Path) -> list[str]:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from cushion_clutch.launch.protection import LEVEL_NAMES
+    from cushion_clutch.launch.tcu.protection import LEVEL_NAMES
     from cushion_clutch.launch.report import peaks
     from cushion_clutch.model import KELVIN, ClutchParameters
 

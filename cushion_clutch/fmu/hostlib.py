@@ -1,6 +1,6 @@
 """C sources of ``fmu_src`` (its role folders) compiled for the machine Python runs on and cached by their hash.
 
-The launch loop's compiled parts (:mod:`cushion_clutch.launch.plant_block`) load such a library with cffi. It
+The launch loop's compiled parts (:mod:`cushion_clutch.launch.plant.plant_block`) load such a library with cffi. It
 is built once per source version with the FMU's compiler (:func:`.crossbuild.compile_command` with no
 platform: zig, else the system C compiler) and kept under ``$XDG_CACHE_HOME/cushion_clutch`` (default
 ``~/.cache``; the temporary folder if that is not writable).

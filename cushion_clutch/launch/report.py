@@ -10,11 +10,12 @@ from typing import Callable, Iterable
 import numpy as np
 
 from ..model import KELVIN, ClutchParameters, SpringTable
-from .metrics import METRIC_COLUMNS, SUMMARY, add_temperature_metrics, summarise
-from .scenario import Scenario
-from .simulate import COLUMNS, LaunchResult, simulate_launches
-from .tcu import VARIANTS
-from .provenance import Provenance
+from .results.metrics import METRIC_COLUMNS, SUMMARY, add_temperature_metrics, summarise
+from .scenario.load import Scenario
+from .results.series import COLUMNS, LaunchResult
+from .simulate import simulate_launches
+from .tcu.controller import VARIANTS
+from .results.provenance import Provenance
 
 #: the summary's groups of launches: (name, selector)
 GROUPS = (("hot", lambda r: r["hot"] and r["phase"] == "repeated"),
@@ -130,7 +131,7 @@ def write_outputs(results: dict[str, LaunchResult], out: Path, provenance: Prove
     plots always use every recorded row. ``provenance``: scenario, version and command on every plot (None: a
     scenario named "unnamed").
     """
-    from .plots import plot_launches
+    from .results.plots import plot_launches
 
     if not (isinstance(every, int) and every >= 1):
         raise ValueError(f"every = {every!r}: must be a whole number >= 1 (keep every N-th row of the time series)")

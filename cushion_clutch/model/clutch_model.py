@@ -43,7 +43,7 @@ __all__ = ["KELVIN", "VARIABLES", "ClutchParameters", "CoverParameters", "CoverM
            "load_csv", "pchip_slopes", "thermal_step", "friction_coefficient", "outputs", "x_to_for_torque", "kiss_point",
            "OMEGA_SLIP_START", "OMEGA_SLIP_LIMIT", "start_values", "INPUT_RANGES", "X_TO_MIN", "X_TO_MAX",
            "THETA_MIN_K", "THETA_MAX_K", "validity", "validity_warning", "table_problems", "variable_bounds",
-           "range_message", "declared_ranges", "facing_wear_max", "OUTPUT_RANGES"]
+           "range_message", "declared_ranges", "heat_path_problem", "facing_wear_max", "OUTPUT_RANGES"]
 
 #: The FMU interface, in value-reference order: (name, causality, unit, description).
 #: Both FMUs (pythonfmu and native C) expose exactly these; parameters take
@@ -145,6 +145,27 @@ NOMINAL_OVERRIDES = {"x_to": 0.01, "theta_cm": 373.15, "omega_slip": 100.0, "fac
 VALID, BEYOND_TABLES, ABOVE_DAMAGE = 0, 1, 2
 
 
+def heat_path_problem(u_W_per_K: float, h_W_per_K: float, u_name: str = "U", h_name: str = "H",
+                      key: str = "") -> str | None:
+    """The rule ``U + H > 0``: None if it holds, else the message.
+
+    Parameters
+    ----------
+    u_W_per_K, h_W_per_K : float
+        U and H, W/K (numbers: check their ranges first).
+    u_name, h_name : str
+        Their names where they are given (``U``/``H`` for the FMU, ``spring_U_W_per_K``/... in a section).
+    key : str
+        The key the message names first (a section's ``observer.spring_H_W_per_K``); "" for none.
+    """
+    total = u_W_per_K + h_W_per_K
+    if total > 0.0:
+        return None
+    if not key:
+        return f"{u_name} + {h_name} must be > 0 (the cushion spring needs a heat path)"
+    return f"{key}: {u_name} + {h_name} = {total:g} W/K; must be > 0 (the cushion spring needs a heat path)"
+
+
 @dataclass
 class ClutchParameters:
     """Clutch and thermal parameters (SI; temperatures in K)."""
@@ -198,8 +219,8 @@ class ClutchParameters:
         out = range_problems(self, self.RANGES, {name: unit for name, _, unit, _ in VARIABLES})
         if not out and self.n_surfaces != int(self.n_surfaces):
             out.append(f"n_surfaces = {self.n_surfaces!r} must be a positive integer in [1, 16]")
-        if not out and self.U + self.H <= 0.0:
-            out.append("U + H must be > 0 (the cushion spring needs a heat path)")
+        if not out and (msg := heat_path_problem(self.U, self.H)):
+            out.append(msg)
         return out + self.cover.problems(self.lever_ratio if "lever_ratio" not in " ".join(out) else None)
 
 

@@ -16,7 +16,7 @@ from typing import Any
 
 from ..config import load_toml, range_problem
 from ..errors import ParameterError
-from .clutch_model import ClutchParameters
+from .clutch_model import ClutchParameters, heat_path_problem
 
 #: the name of the paper's set (no file: the ClutchParameters defaults)
 PAPER = "paper"
@@ -94,8 +94,8 @@ def load_thermal_set(name: str | Path) -> ThermalSet:
         msg = range_problem(key, data.get(key), 0.0, 1e6, lo_open)
         if msg:
             problems.append(msg)
-    if not problems and data["U_W_per_K"] + data["H_W_per_K"] <= 0.0:
-        problems.append("U_W_per_K + H_W_per_K must be > 0 (the spring exchanges heat)")
+    if not problems and (msg := heat_path_problem(data["U_W_per_K"], data["H_W_per_K"], "U_W_per_K", "H_W_per_K")):
+        problems.append(msg)
     if not problems and "tau_s" in data and not math.isclose(
             data["tau_s"], data["C_J_per_K"] / (data["U_W_per_K"] + data["H_W_per_K"]), rel_tol=1e-3):
         problems.append(f"tau_s = {data['tau_s']!r}: must equal C_J_per_K / (U_W_per_K + H_W_per_K)")

@@ -1,0 +1,1 @@
+"""What a launch run yields: per-launch metrics (:mod:`.metrics`), plots (:mod:`.plots`) and provenance."""

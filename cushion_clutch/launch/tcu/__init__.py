@@ -1,0 +1,1 @@
+"""The six TCU variants (:mod:`.controller`), their estimators and the production TCU (:mod:`.production`)."""

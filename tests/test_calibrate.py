@@ -146,10 +146,30 @@ def test_profile_factor_widens_a_flat_misfit_and_never_narrows():
     lo, hi = np.full(2, 0.5), np.full(2, 1.5)
     for curv, want in ((0.25, [2.0, 2.0]), (4.0, [1.0, 1.0]), (0.0, [np.inf, np.inf])):
         chi2 = lambda zz, a=curv: float(a * (((zz - z) / np.sqrt(np.diag(cov))) ** 2).sum() + 0.3 * (zz - z)[0] / 0.01)
-        assert _profile_factors(chi2, lambda pts: None, z, cov, lo, hi) == pytest.approx(want)
+        assert _profile_factors(chi2, lambda pts: None, z, cov, lo, hi)[0] == pytest.approx(want)
     at_bound = np.array([1.0, 1.0]), np.array([1.5, 1.5])          # z sits on its lower bound: one side only
     chi2 = lambda zz: float(0.25 * (((zz - z) / np.sqrt(np.diag(cov))) ** 2).sum())
-    assert _profile_factors(chi2, lambda pts: None, z, cov, *at_bound) == pytest.approx([2.0, 2.0])
+    assert _profile_factors(chi2, lambda pts: None, z, cov, *at_bound)[0] == pytest.approx([2.0, 2.0])
+
+
+def test_scan_of_a_poorly_seen_parameter_finds_a_deeper_minimum_and_spans_it():
+    """A bumpy misfit: locally a = 1 at the fit, but 25 sigma away (at the bound) chi2 is 3 lower. The scan of
+    the flagged parameter names that point and its factor reaches past it; the other is left alone."""
+    from cushion_clutch.fe.studies.calibrate import _interval_reach, _profile_factors
+    cov = np.diag([0.01 ** 2, 0.01 ** 2])
+    z = np.ones(2)
+    lo, hi = np.full(2, 0.7), np.full(2, 1.3)
+
+    def chi2(zz):
+        t = (zz - z) / 0.01
+        return float(np.sum(np.minimum(t ** 2, 4.0)) - 7.0 * np.exp(-((t[0] - 30.0) / 4.0) ** 2))
+    asked = []
+    factor, deeper = _profile_factors(chi2, asked.extend, z, cov, lo, hi, [True, False])
+    assert len(asked) == 2 + 8 + 2                       # +-1 sigma each, the first also 8 over its bounds
+    assert factor[1] == pytest.approx(1.0) and factor[0] > 25
+    assert deeper[1] is None and deeper[0][0][0] == pytest.approx(1.3) and deeper[0][1] < -2
+    # the farther crossing of the level: linear between the points around it
+    assert _interval_reach([(-2.0, 4.0), (-1.0, 0.5), (0.0, 0.0), (1.0, 3.0)], 1.0) == pytest.approx(1 + 0.5 / 3.5)
 
 
 def test_poorly_seen_parameter_is_named_unless_a_datum_sees_it():

@@ -18,10 +18,11 @@ hardly depends on the wave height; the free height does.
 The reported 1-sigma of each parameter (:attr:`Calibration.std`) is not the
 linearised noise alone. It combines, in quadrature,
 
-- the noise term: the linearised covariance, the larger of two Jacobians (steps
-  up and down), widened where the FE's misfit grows more slowly than the linear
-  model says along the parameter's profile direction (checked by two FE runs at
-  +-1 sigma), and
+- the noise term: the linearised covariance, the largest of two Jacobians (steps
+  up and down) and the heteroscedasticity-consistent (sandwich) estimate, widened
+  where the FE's misfit grows more slowly than the linear model says along the
+  parameter's profile direction (two FE runs at +-1 sigma; a parameter the data
+  hardly see is scanned over its bounds, ``SCAN_POINTS`` runs), and
 - the mesh term: how far the fitted value would move if the FE ran on a
   ``MESH_REFINEMENT`` times finer mesh (one more FE case per temperature, linearised).
 
@@ -156,6 +157,10 @@ MIN_SENSITIVITY_PCT = 0.25
 MIN_DATUM_SENSITIVITY_SD = 0.5
 #: condition number of the Jacobian (parameters scaled by their start values) above this: ill-conditioned
 MAX_CONDITION = 30.0
+#: FE runs of the scan over the bound range of a parameter that the data hardly see
+SCAN_POINTS = 8
+#: a scanned point this far (chi2, in units of the noise) below the fit's: the fit stopped in a local minimum
+DEEPER_CHI2 = 0.5
 #: relative force noise assumed before the fit has estimated it (weights a free height against the forces)
 NOISE_GUESS = 0.01
 
@@ -206,6 +211,9 @@ class Calibration:
     """Condition number of the Jacobian, parameters scaled by their start values."""
     free_height: list | None = None
     """Per curve with a measured free height: (theta_degC, measured m, 1-sigma m, FE start m, FE fitted m)."""
+    deeper: list | None = None
+    """Per parameter scanned over its bounds (poorly seen): (value, chi2 change) of a point with a lower misfit
+    than the fit's, by more than ``DEEPER_CHI2`` (the fit stopped in a local minimum), else None."""
 
     def warnings(self) -> list[str]:
         """Every fitted parameter at a bound, poorly identified or not identifiable, and a systematic residual."""
@@ -221,14 +229,19 @@ class Calibration:
                            f"{(sd / abs(v) if v else np.inf):.0%} of its value (limit {MAX_REL_SIGMA:.0%})")
             datum = (np.max(np.abs(self.free_height_sensitivity_sd[:, i]))
                      if self.free_height_sensitivity_sd is not None and len(self.free_height_sensitivity_sd) else 0.0)
-            if sens[i] < MIN_SENSITIVITY_PCT and datum < MIN_DATUM_SENSITIVITY_SD:
-                seen = (f"; the measured free height by {datum:.2f} of its 1-sigma (limit "
-                        f"{MIN_DATUM_SENSITIVITY_SD:g})" if self.free_height else
-                        ". A datum that depends on it identifies it: for the wave height the pair's free height "
-                        "(free_height_m and free_height_sd_m in the curve file)")
+            if poorly_seen(sens, self.free_height_sensitivity_sd)[i]:
+                seen = (f", the measured free height by {datum:.2f} of its 1-sigma (limit "
+                        f"{MIN_DATUM_SENSITIVITY_SD:g})" if self.free_height else "")
+                hint = ("" if self.free_height else ". A datum that depends on it identifies it: for the wave "
+                        "height the pair's free height (free_height_m and free_height_sd_m in the curve file)")
                 out.append(f"{n} is poorly identified: a 1 % change moves the measured forces by {sens[i]:.3f} % "
                            f"RMS of the largest force (limit {MIN_SENSITIVITY_PCT:g} %){seen}; its value rests on "
-                           "the noise and the mesh, read its 1-sigma")
+                           f"the noise and the mesh, read its 1-sigma{hint}")
+            if self.deeper and self.deeper[i] is not None:
+                value, drop = self.deeper[i]
+                out.append(f"{n}: the misfit is lower at {value:.5g} than at the fitted {v:.5g} (chi2 {drop:+.2f} "
+                           "in units of the noise, scanned over its bounds): the fit stopped in a local minimum of "
+                           "a bumpy misfit; its 1-sigma spans both")
             for j in range(i + 1, len(self.names)):
                 c = self.correlation[i, j]
                 if not np.isfinite(c) or abs(c) > MAX_CORRELATION:
@@ -431,7 +444,7 @@ def calibrate(base: SpringParams, measured: Measured | Sequence[Measured], names
         sol = least_squares(resid, z, jac=jac, bounds=(lo, hi), x_scale=1.0, diff_step=FD_STEP,
                             max_nfev=max_iterations, xtol=1e-3, ftol=1e-4)
         z = sol.x
-        found = math.sqrt(float(np.sum(resid(z) ** 2)) / dof)
+        found = max(math.sqrt(float(np.sum(resid(z) ** 2)) / dof), 1e-9)
         if not datums or abs(math.log(found / noise[0])) < math.log(1.5):
             break
         noise[0] = found
@@ -446,8 +459,15 @@ def calibrate(base: SpringParams, measured: Measured | Sequence[Measured], names
     std_hc = _sandwich_std(J, r, dof)
     with np.errstate(invalid="ignore"):
         std_lin = np.fmax(np.fmax(std_up, std_down), std_hc) * x0
-    factor = _profile_factors(lambda zz: float(np.sum(resid(zz) ** 2)) / s2,
-                              lambda zs: model.many([zz * x0 for zz in zs]), z, cov, lo, hi)
+    w = np.clip(np.concatenate(f_fit), 1e-9, None)
+    big = np.concatenate([np.full(len(m.u_m), sc) for m, sc in zip(measured, scales)])
+    sens = np.array([float(np.sum(J[:n_force, i] * big * z[i]) / np.sum(w)) for i in range(len(x0))])
+    # RMS over every measured force of its change per 1 % of the parameter, % of the largest force
+    sens_rms = np.sqrt(np.mean(J[:n_force] ** 2, axis=0)) * z     # fraction per unit relative change = % per %
+    sens_datum = J[n_force:] / noise[0] * z * 0.01                 # in the datum's 1-sigma per 1 %
+    factor, deeper = _profile_factors(lambda zz: float(np.sum(resid(zz) ** 2)) / s2,
+                                      lambda zs: model.many([zz * x0 for zz in zs]), z, cov, lo, hi,
+                                      poorly_seen(sens_rms, sens_datum))
     std_noise = std_lin * factor
     mesh_m, std_mesh = None, np.zeros_like(x0)
     if mesh_check:
@@ -458,12 +478,6 @@ def calibrate(base: SpringParams, measured: Measured | Sequence[Measured], names
         std_mesh = np.abs(np.linalg.lstsq(J, dr, rcond=None)[0]) * x0
         model.solved, model.cached = model.solved + fine.solved, model.cached + fine.cached
     std = np.sqrt(std_noise ** 2 + std_mesh ** 2)
-    w = np.clip(np.concatenate(f_fit), 1e-9, None)
-    big = np.concatenate([np.full(len(m.u_m), sc) for m, sc in zip(measured, scales)])
-    sens = np.array([float(np.sum(J[:n_force, i] * big * z[i]) / np.sum(w)) for i in range(len(x0))])
-    # RMS over every datum of the data's change per 1 % of the parameter, % of the largest force
-    sens_rms = np.sqrt(np.mean(J[:n_force] ** 2, axis=0)) * z     # fraction per unit relative change = % per %
-    sens_datum = J[n_force:] / noise[0] * z * 0.01                 # in the datum's 1-sigma per 1 %
     cond = float(np.linalg.cond(J)) if np.all(np.isfinite(J)) else float("inf")
     heights = [(m.theta_degC, m.free_height_m, m.free_height_sd_m, h0, h1)
                for m, h0, h1 in zip(measured, model.free_heights(x0), model.free_heights(values))
@@ -484,7 +498,17 @@ def calibrate(base: SpringParams, measured: Measured | Sequence[Measured], names
         lag1_autocorrelation=lag1, fe_cases=model.solved, cached_cases=model.cached,
         wall_time_s=time.perf_counter() - t0, message=str(sol.message), std_noise=std_noise,
         profile_factor=factor, std_mesh=std_mesh, mesh_check_m=mesh_m, sensitivity_rms_pct=sens_rms,
-        condition=cond, free_height=heights, free_height_sensitivity_sd=sens_datum)
+        condition=cond, free_height=heights, free_height_sensitivity_sd=sens_datum,
+        deeper=[None if dp is None else (float(dp[0][i] * x0[i]), float(dp[1])) for i, dp in enumerate(deeper)])
+
+
+def poorly_seen(sensitivity_rms_pct: np.ndarray, free_height_sensitivity_sd: np.ndarray | None) -> np.ndarray:
+    """Per parameter: the forces move by less than ``MIN_SENSITIVITY_PCT`` RMS per 1 % and no measured free
+    height by ``MIN_DATUM_SENSITIVITY_SD`` of its 1-sigma or more."""
+    datum = (np.max(np.abs(free_height_sensitivity_sd), axis=0)
+             if free_height_sensitivity_sd is not None and len(free_height_sensitivity_sd)
+             else np.zeros(len(sensitivity_rms_pct)))
+    return (np.asarray(sensitivity_rms_pct) < MIN_SENSITIVITY_PCT) & (datum < MIN_DATUM_SENSITIVITY_SD)
 
 
 def _covariance(J: np.ndarray, s2: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -518,18 +542,33 @@ def _sandwich_std(J: np.ndarray, r: np.ndarray, dof: int) -> np.ndarray:
 
 
 def _profile_factors(chi2: Callable[[np.ndarray], float], prefetch: Callable[[list], object], z: np.ndarray,
-                     cov: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
-    """Per parameter: how much wider than linear the FE's misfit is at +-1 sigma along its profile direction.
+                     cov: np.ndarray, lo: np.ndarray, hi: np.ndarray,
+                     scan: Sequence[bool] | None = None) -> tuple[np.ndarray, list]:
+    """Per parameter: how much wider than linear the FE's misfit is along its profile direction.
 
     The direction moves parameter i by its 1-sigma and the others by their linear regression on it
-    (``cov[:, i] / sd_i``), where linear theory raises chi2 (in units of the noise) by exactly 1.
-    A quadratic ``a t^2 + b t`` through the FE's chi2 at both ends (clipped to the bounds) gives
-    the curvature a; the factor is ``1 / sqrt(a)`` when a < 1 (a flatter misfit, a wider interval),
-    1 when a >= 1 (never narrowed), inf when the FE finds no curvature. ``prefetch`` solves the
-    points' FE cases together (in parallel) before ``chi2`` reads them.
+    (``cov[:, i] / sd_i``), where linear theory raises chi2 (in units of the noise) by exactly 1 per
+    unit step t squared. A quadratic ``a t^2 + b t`` through the FE's chi2 at t = +-1 (clipped to the bounds)
+    gives the curvature a; the factor is ``1 / sqrt(a)`` when a < 1 (a flatter misfit, a wider interval),
+    1 when a >= 1 (never narrowed), inf when the FE finds no curvature.
+
+    A parameter with ``scan[i]`` (one the data hardly see) is scanned instead over its whole bound range,
+    ``SCAN_POINTS`` FE runs: the interval is where chi2 stays within 1 of the lowest value found
+    (crossings interpolated linearly), and its factor the interval's farther end from the fitted value, in
+    sigma (at least the quadratic one). ``prefetch`` solves the points' FE cases together (in parallel)
+    before ``chi2`` reads them.
+
+    Returns
+    -------
+    factors : ndarray
+        Per parameter, >= 1 or inf.
+    deeper : list
+        Per parameter, (scaled parameter vector, chi2 change) of the lowest scanned point if its chi2 lies
+        more than ``DEEPER_CHI2`` below the fit's (the fit stopped in a local minimum), else None.
     """
     n = len(z)
-    out = np.full(n, np.inf)
+    scan = list(scan) if scan is not None else [False] * n
+    out, deeper = np.full(n, np.inf), [None] * n
     plans = []
     for i in range(n):
         sd = math.sqrt(cov[i, i]) if np.isfinite(cov[i, i]) and cov[i, i] > 0 else float("nan")
@@ -537,20 +576,20 @@ def _profile_factors(chi2: Callable[[np.ndarray], float], prefetch: Callable[[li
             plans.append(None)
             continue
         d = cov[:, i] / sd
-        ts = []
+        room = {}
         for sign in (1.0, -1.0):
-            room = [((hi[k] if d[k] * sign > 0 else lo[k]) - z[k]) / (d[k] * sign)
-                    for k in range(n) if d[k] != 0]
-            t = sign * min([1.0, *room])
-            if abs(t) > 1e-3:
-                ts.append(t)
-        plans.append((d, ts))
-    prefetch([z + t * plan[0] for plan in plans if plan for t in plan[1]])
+            room[sign] = min([np.inf, *(((hi[k] if d[k] * sign > 0 else lo[k]) - z[k]) / (d[k] * sign)
+                                        for k in range(n) if d[k] != 0)])
+        ts = [sign * min(1.0, room[sign]) for sign in (1.0, -1.0) if min(1.0, room[sign]) > 1e-3]
+        grid = ([t for t in np.linspace(-room[-1.0], room[1.0], SCAN_POINTS) if abs(t) > 1e-3]
+                if scan[i] and np.isfinite(room[1.0] + room[-1.0]) else [])
+        plans.append((d, ts, grid))
+    prefetch([z + t * plan[0] for plan in plans if plan for t in [*plan[1], *plan[2]]])
     c0 = chi2(z)
     for i, plan in enumerate(plans):
         if plan is None:
             continue
-        d, ts = plan
+        d, ts, grid = plan
         pts = [(t, chi2(z + t * d) - c0) for t in ts]
         if len(pts) == 2:
             (t1, d1), (t2, d2) = pts
@@ -560,4 +599,29 @@ def _profile_factors(chi2: Callable[[np.ndarray], float], prefetch: Callable[[li
         else:
             a = 0.0
         out[i] = 1.0 / math.sqrt(a) if 0 < a < 1 else (1.0 if a >= 1 else np.inf)
-    return out
+        if grid:
+            curve = sorted(pts + [(t, chi2(z + t * d) - c0) for t in grid] + [(0.0, 0.0)])
+            lowest = min(c for _, c in curve)
+            if lowest < -DEEPER_CHI2:
+                t_low = min(curve, key=lambda tc: tc[1])[0]
+                deeper[i] = (z + t_low * d, lowest)
+            out[i] = max(out[i], _interval_reach(curve, lowest + 1.0))
+    return out, deeper
+
+
+def _interval_reach(curve: list[tuple[float, float]], level: float) -> float:
+    """Farthest |t| of the points at or below ``level`` (t = 0 included), each edge moved out to where the
+    piecewise-linear chi2 crosses ``level`` towards the next point; the last point if it is never crossed."""
+    t = np.array([c[0] for c in curve])
+    c = np.array([c[1] for c in curve])
+    inside = np.flatnonzero(c <= level)
+    inside = np.union1d(inside, np.flatnonzero(t == 0.0))
+    lo_i, hi_i = int(inside.min()), int(inside.max())
+    ends = []
+    for k, step in ((hi_i, 1), (lo_i, -1)):
+        j = k + step
+        if 0 <= j < len(t) and c[j] > level and c[j] != c[k]:
+            ends.append(t[k] + (t[j] - t[k]) * (level - c[k]) / (c[j] - c[k]) if c[k] <= level else t[k])
+        else:
+            ends.append(t[k])
+    return float(max(abs(e) for e in ends))

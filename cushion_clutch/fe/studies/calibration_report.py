@@ -84,11 +84,13 @@ def plot_calibration(cal: Calibration, path: Path, title: str = "") -> Path:
         ax.plot(u, f1[order], "-", color=f"C{i}", label=f"FE calibrated, {m.theta_degC:g} degC")
     fitted = "; ".join(f"{n.split('.')[-1]} {v:.4g} +- {sd / abs(v):.1%}" for n, v, sd in
                        zip(cal.names, cal.values, cal.std))
-    heights = "; ".join(f"free height {t:g} degC: measured {h * 1e3:.3f} +- {sd * 1e3:.3f} mm, FE {h1 * 1e3:.3f} mm"
-                        for t, h, sd, _, h1 in cal.free_height or [])
-    ax.text(0.98, 0.02, "\n".join(filter(None, [f"fitted (1-sigma): {fitted}", heights])), transform=ax.transAxes,
-            va="bottom", ha="right", fontsize=7, color="0.2")
+    heights = [f"free height {t:g} degC: measured {h * 1e3:.3f} +- {sd * 1e3:.3f} mm, FE {h1 * 1e3:.3f} mm"
+               for t, h, sd, _, h1 in cal.free_height or []]
+    # the curves rise to the upper right: the fit's numbers and the legend below them in the empty upper left
+    lines = [f"fitted (1-sigma): {fitted}", *heights]
+    ax.text(0.02, 0.98, "\n".join(lines), transform=ax.transAxes, va="top", ha="left", fontsize=7, color="0.2")
+    ax.legend(loc="upper left", bbox_to_anchor=(0.0, 0.97 - 0.045 * len(lines)), fontsize=8)
     ax.set(xlabel="compression from the reference kiss point u [mm]",
            ylabel=f"force of {'one paddle pair' if cal.measured[0].basis == 'pair' else 'the whole spring'} [N]",
            title=title or f"Cushion spring: FE against measurement (RMS {cal.rms_pct:.1f} %)")
-    return finish_figure(fig, ax, path)
+    return finish_figure(fig, ax, path, legend=False)

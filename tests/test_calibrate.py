@@ -188,6 +188,18 @@ def test_poorly_seen_parameter_is_named_unless_a_datum_sees_it():
     assert "the measured free height by 0.20 of its 1-sigma" in "\n".join(blurred.warnings())
 
 
+def test_plot_prints_the_fitted_values_and_free_heights(tmp_path):
+    import dataclasses
+    from cushion_clutch.fe.studies.calibration_report import plot_calibration, report_text
+    cal = _fake_calibration([0.42e-3, 0.7e-3], [(0.3e-3, 0.5e-3), (0.5e-3, 0.9e-3)], [1e-6, 1e-5],
+                            [[1, 0.2], [0.2, 1]], np.zeros(10))
+    cal = dataclasses.replace(cal, free_height=[(20.0, 2.7e-3, 1e-5, 2.6e-3, 2.71e-3)])
+    png = plot_calibration(cal, tmp_path / "c.png")
+    assert png.stat().st_size > 10_000
+    assert "free height at 20 degC: measured 2.7000 +- 0.0100 mm, FE start 2.6000 mm, FE fitted 2.7100 mm " \
+           "(+1.00 sigma)" in report_text(cal)
+
+
 #: the bench's free height 1-sigma in the recovery tests, m (a dial gauge against a datum)
 FREE_HEIGHT_SD_M = 10e-6
 

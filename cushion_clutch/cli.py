@@ -113,7 +113,7 @@ def _calibrate(args: argparse.Namespace) -> int:
     out = Path(args.out)
     cal = calibrate(params, measured, [n.strip() for n in args.fit.split(",") if n.strip()],
                     parse_bounds(args.bounds), cache_dir=Path(args.cache), jobs=args.jobs,
-                    scheduler=args.scheduler,
+                    scheduler=args.scheduler, mesh_check=not args.no_mesh_check,
                     on_case=lambda n: print(f"FE case {n} done", file=sys.stderr, flush=True))
     report = report_text(cal)
     result = calibrated_params(cal, args.name or f"{params.name}_calibrated")
@@ -759,7 +759,9 @@ def _fe_commands(sub) -> None:
     ca.add_argument("--measured", required=True, action="append",
                     help="CSV u_m,force_N, u from the reference temperature's kiss point, as measured (noise "
                          "kept): FILE (reference temperature) or THETA_DEGC=FILE; repeat for hot curves, "
-                         "e.g. --measured 20=bench20.csv --measured 195=bench195.csv")
+                         "e.g. --measured 20=bench20.csv --measured 195=bench195.csv. Comment lines "
+                         "'# free_height_m = ...' and '# free_height_sd_m = ...' give the pair's free height "
+                         "from a datum and its 1-sigma [m]")
     ca.add_argument("--basis", choices=("pair", "spring"), default="pair",
                     help="the measured force is of one paddle pair (default) or the whole spring")
     ca.add_argument("--spring", default=DEFAULT_SPRING, help="start parameter TOML")
@@ -771,6 +773,9 @@ def _fe_commands(sub) -> None:
     _jobs(ca, "parallel ccx jobs (default 2)", default=2)
     ca.add_argument("--scheduler", help="Dask scheduler address, e.g. tcp://host:8786")
     ca.add_argument("--cache", default=DEFAULT_CACHE, help="case cache folder")
+    ca.add_argument("--no-mesh-check", action="store_true",
+                    help="skip the FE run on a 1.5x finer mesh: the 1-sigma then lacks its mesh term (the report "
+                         "says so)")
 
     im = _command(sub, "import-scan", _import_scan,
                   "fit a scanned paddle's mid-surface and write a spring TOML using it",

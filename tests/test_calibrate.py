@@ -93,34 +93,176 @@ def test_calibrated_toml_reads_back_unchanged(tmp_path):
     assert params_from_dict(load_toml(path)) == q
 
 
-@pytest.mark.ccx
-@pytest.mark.xfail(strict=True, reason=(
-    "known regression of the -40..350 degC re-sweep (issue 37, open): with the carrier clearance at 0.02 mm the "
-    "20 degC curve hardly depends on the wave height (d ln F / d ln p about -0.1) and the fit misses it by +2.7 % "
-    "at the 3 mm mesh (2.9 of its own 1-sigma) and by +13.7 % at 2 mm; the thickness is recovered within 0.1 %. "
-    "Strict: the day it passes again, this mark must go"))
-def test_parameter_recovery_from_noisy_fe_measurement(tmp_path):
-    """wave height +8 %, thickness -5 %, 1.5 % noise fitted as measured (no running maximum): within 2 %."""
+def test_measured_file_carries_a_free_height_with_its_sigma(tmp_path):
+    from cushion_clutch.errors import TableError
+    from cushion_clutch.fe.studies.measured import read_measured
+    rows = "u_m,force_N\n0,10\n1e-4,20\n2e-4,30\n3e-4,40\n"
+    m = read_measured(write_csv(tmp_path / "ok.csv", "# bench 7, pair 3\n# free_height_m = 2.75e-3\n"
+                                                     "#free_height_sd_m=10e-6\n" + rows))
+    assert (m.free_height_m, m.free_height_sd_m) == (2.75e-3, 10e-6)
+    assert read_measured(write_csv(tmp_path / "plain.csv", "# F = k u, no setting\n" + rows)).free_height_m is None
+    bad = write_csv(tmp_path / "bad.csv", "# free_hieght_m = 2e-3\n# free_height_sd_m = 5\n# free_height_sd_m = 1e-5\n"
+                    + rows)
+    with pytest.raises(TableError) as exc:          # every problem at once, each naming its key and range
+        read_measured(bad)
+    text = str(exc.value)
+    assert "line 1: unknown setting 'free_hieght_m' (allowed: free_height_m, free_height_sd_m" in text
+    assert "line 2: free_height_sd_m = '5': allowed 1e-07 .. 0.001 m" in text and "line 3: free_height_sd_m given twice" in text
+    with pytest.raises(TableError, match="free_height_m given without free_height_sd_m"):
+        read_measured(write_csv(tmp_path / "alone.csv", "# free_height_m = 2e-3\n" + rows))
+    with pytest.raises(TableError, match="free_height_m = 'abc' is not a number|free_height_m = 'abc': allowed"):
+        read_measured(write_csv(tmp_path / "nan.csv", "# free_height_m = abc\n# free_height_sd_m = 1e-5\n" + rows))
+    with pytest.raises(ParameterError, match="free_height_sd_m given without free_height_m"):
+        Measured(np.zeros(4), np.ones(4), free_height_sd_m=1e-5)
+
+
+def test_cli_bad_free_height_exits_2_with_one_message(tmp_path, capsys):
+    bad = write_csv(tmp_path / "bench.csv", "# free_height_m = -1\n# free_height_sd_m = 1e-5\nu_m,force_N\n"
+                    "0,10\n1e-4,20\n2e-4,30\n3e-4,40\n")
+    assert main(["calibrate", "--measured", str(bad), "--fit", "thickness_m", "--out", str(tmp_path / "c.toml")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error:") and "free_height_m = '-1': allowed 1e-05 .. 0.05 m" in err and "Traceback" not in err
+
+
+def test_sandwich_sigma_of_a_mean_is_the_standard_error():
+    """HC1 of one constant parameter is the standard error of the mean, sd / sqrt(n) with n - 1 degrees of freedom."""
+    from cushion_clutch.fe.studies.calibrate import _sandwich_std
+    r = np.random.default_rng(5).standard_normal(40)
+    r -= r.mean()
+    assert _sandwich_std(np.ones((40, 1)), r, 39)[0] == pytest.approx(np.std(r, ddof=1) / np.sqrt(40), rel=1e-12)
+    # noise ten times louder on half the points, where the parameter acts: wider than s2 (J^T J)^-1 says
+    J = np.r_[np.full(20, 0.1), np.ones(20)][:, None]
+    r = np.r_[0.1 * r[:20], 2 * r[20:]]
+    classic = np.sqrt(np.sum(r ** 2) / 39 / np.sum(J ** 2))
+    assert _sandwich_std(J, r, 39)[0] > 1.3 * classic
+
+
+def test_profile_factor_widens_a_flat_misfit_and_never_narrows():
+    """chi2 = a t^2 along the profile direction: factor 1/sqrt(a) below a = 1, 1 above, inf when flat;
+    clipped at a bound the one side left is used."""
+    from cushion_clutch.fe.studies.calibrate import _profile_factors
+    cov = np.diag([0.01 ** 2, 0.02 ** 2])
+    z = np.ones(2)
+    lo, hi = np.full(2, 0.5), np.full(2, 1.5)
+    for curv, want in ((0.25, [2.0, 2.0]), (4.0, [1.0, 1.0]), (0.0, [np.inf, np.inf])):
+        chi2 = lambda zz, a=curv: float(a * (((zz - z) / np.sqrt(np.diag(cov))) ** 2).sum() + 0.3 * (zz - z)[0] / 0.01)
+        assert _profile_factors(chi2, lambda pts: None, z, cov, lo, hi)[0] == pytest.approx(want)
+    at_bound = np.array([1.0, 1.0]), np.array([1.5, 1.5])          # z sits on its lower bound: one side only
+    chi2 = lambda zz: float(0.25 * (((zz - z) / np.sqrt(np.diag(cov))) ** 2).sum())
+    assert _profile_factors(chi2, lambda pts: None, z, cov, *at_bound)[0] == pytest.approx([2.0, 2.0])
+
+
+def test_scan_of_a_poorly_seen_parameter_finds_a_deeper_minimum_and_spans_it():
+    """A bumpy misfit: locally a = 1 at the fit, but 25 sigma away (at the bound) chi2 is 3 lower. The scan of
+    the flagged parameter names that point and its factor reaches past it; the other is left alone."""
+    from cushion_clutch.fe.studies.calibrate import _interval_reach, _profile_factors
+    cov = np.diag([0.01 ** 2, 0.01 ** 2])
+    z = np.ones(2)
+    lo, hi = np.full(2, 0.7), np.full(2, 1.3)
+
+    def chi2(zz):
+        t = (zz - z) / 0.01
+        return float(np.sum(np.minimum(t ** 2, 4.0)) - 7.0 * np.exp(-((t[0] - 30.0) / 4.0) ** 2))
+    asked = []
+    factor, deeper = _profile_factors(chi2, asked.extend, z, cov, lo, hi, [True, False])
+    assert len(asked) == 2 + 8 + 2                       # +-1 sigma each, the first also 8 over its bounds
+    assert factor[1] == pytest.approx(1.0) and factor[0] > 25
+    assert deeper[1] is None and deeper[0][0][0] == pytest.approx(1.3) and deeper[0][1] < -2
+    # the farther crossing of the level: linear between the points around it
+    assert _interval_reach([(-2.0, 4.0), (-1.0, 0.5), (0.0, 0.0), (1.0, 3.0)], 1.0) == pytest.approx(1 + 0.5 / 3.5)
+
+
+def test_poorly_seen_parameter_is_named_unless_a_datum_sees_it():
+    import dataclasses
+    cal = _fake_calibration([0.42e-3, 0.7e-3], [(0.3e-3, 0.5e-3), (0.5e-3, 0.9e-3)], [1e-6, 1e-5],
+                            [[1, 0.2], [0.2, 1]], np.random.default_rng(3).standard_normal(40))
+    weak = dataclasses.replace(cal, sensitivity_rms_pct=np.array([1.1, 0.12]), condition=45.0)
+    text = "\n".join(weak.warnings())
+    assert "geometry.wave_height_m is poorly identified: a 1 % change moves the measured forces by 0.120 %" in text
+    assert "free_height_m and free_height_sd_m in the curve file" in text and "thickness_m is poorly" not in text
+    assert "ill-conditioned: condition number 45" in text
+    seen = dataclasses.replace(weak, condition=6.0, free_height_sensitivity_sd=np.array([[1.2, 1.5]]),
+                               free_height=[(20.0, 2.7e-3, 1e-5, 2.6e-3, 2.7e-3)])
+    assert seen.warnings() == []
+    blurred = dataclasses.replace(seen, free_height_sensitivity_sd=np.array([[0.1, 0.2]]))
+    assert "the measured free height by 0.20 of its 1-sigma" in "\n".join(blurred.warnings())
+
+
+def test_plot_prints_the_fitted_values_and_free_heights(tmp_path):
+    import dataclasses
+    from cushion_clutch.fe.studies.calibration_report import plot_calibration, report_text
+    cal = _fake_calibration([0.42e-3, 0.7e-3], [(0.3e-3, 0.5e-3), (0.5e-3, 0.9e-3)], [1e-6, 1e-5],
+                            [[1, 0.2], [0.2, 1]], np.zeros(10))
+    cal = dataclasses.replace(cal, free_height=[(20.0, 2.7e-3, 1e-5, 2.6e-3, 2.71e-3)])
+    png = plot_calibration(cal, tmp_path / "c.png")
+    assert png.stat().st_size > 10_000
+    assert "free height at 20 degC: measured 2.7000 +- 0.0100 mm, FE start 2.6000 mm, FE fitted 2.7100 mm " \
+           "(+1.00 sigma)" in report_text(cal)
+
+
+#: the bench's free height 1-sigma in the recovery tests, m (a dial gauge against a datum)
+FREE_HEIGHT_SD_M = 10e-6
+
+
+@pytest.fixture(scope="module")
+def noisy_bench(tmp_path_factory):
+    """The truth (wave height +8 %, thickness -5 %) and its raw, noisy FE curve (1.5 % noise, a back-off and
+    reload, a 0.5 N offset) at the 3 mm mesh, with the pair's free height measured with a 10 um 1-sigma."""
+    from cushion_clutch.fe.studies.tolerance_report import pair_free_height
+    cache = tmp_path_factory.mktemp("recovery") / "cache"
     base = load_params().replace(**RECOVERY)
     keys = fit_keys(base, ["wave_height_m", "thickness_m"])
     true = np.array([base.geometry.wave_height_m * 1.08, base.geometry.thickness_m * 0.95])
     truth = with_values(base, keys, true)
-    case = next(iter(run_sweep(truth, cache_dir=tmp_path / "cache", jobs=1).values()))
+    case = next(iter(run_sweep(truth, cache_dir=cache, jobs=1).values()))
     c = curve_from_case(case.result, 1, truth.sweep.kiss_force_N)
     u = np.linspace(0.0, 0.95 * c.u_m[-1], 25)
     u = np.concatenate([u[:15], u[13:15] - 0.3 * (u[1] - u[0]), u[15:]])   # the bench backs off and reloads
     rng = np.random.default_rng(11)
     f = np.interp(u, c.u_m, c.force_N) * (1 + 0.015 * rng.standard_normal(len(u))) + 0.5
     assert np.any(np.diff(f) < 0) and np.any(np.diff(u) < 0)    # a raw curve, with a small zero offset
-    cal = calibrate(base, Measured(u, f, "pair"), ["wave_height_m", "thickness_m"],
-                    cache_dir=tmp_path / "cache", jobs=2)
-    err = cal.values / true - 1
-    assert np.all(np.abs(err) < 0.02), (cal.values, true, err)
-    assert cal.rms_pct < 2.0
-    assert not any("bound" in w for w in cal.warnings()), cal.warnings()
+    h = pair_free_height(truth, case) + FREE_HEIGHT_SD_M * rng.standard_normal()
+    return base, true, Measured(u, f, "pair"), h, cache
+
+
+@pytest.mark.ccx
+def test_without_a_datum_the_wave_height_is_said_to_be_poorly_identified(noisy_bench):
+    """Issue 37: from its own kiss point the 20 degC curve hardly depends on the wave height (its forces move
+    by less than 0.25 % RMS per 1 %). The fit must say so, and its 1-sigma (noise, profile and mesh terms) must
+    cover the truth, never a confident wrong number; the thickness, which the curve does see, within 1 %."""
+    base, true, m, _, cache = noisy_bench
+    cal = calibrate(base, m, ["wave_height_m", "thickness_m"], cache_dir=cache, jobs=2)
+    err = cal.values - true
+    assert np.all(np.abs(err) <= 2.0 * cal.std), (cal.values, true, cal.std)
+    assert abs(err[1] / true[1]) < 0.01
+    assert cal.sensitivity_rms_pct[0] < 0.25 < cal.sensitivity_rms_pct[1]
+    text = "\n".join(cal.warnings())
+    assert "geometry.wave_height_m is poorly identified" in text and "free_height_m" in text, text
+    assert "thickness_m is poorly" not in text
+    assert cal.std_mesh[0] > 0 and cal.mesh_check_m == pytest.approx(2e-3)
     from cushion_clutch.fe.studies.calibration_report import report_text
-    assert "runs test" in report_text(cal) and "1-sigma %" in report_text(cal)
-    start_err = np.max(np.abs(cal.fe_start_N[0] - f)) / f.max()
+    report = report_text(cal)
+    assert "WARNING: geometry.wave_height_m is poorly identified" in report and "mesh %" in report
+
+
+@pytest.mark.ccx
+def test_parameter_recovery_from_a_noisy_curve_and_the_free_height(noisy_bench):
+    """With the pair's free height from a datum (10 um 1-sigma) both keys are recovered within 1.5 %,
+    each within 3 of its 1-sigma, no warning about identification or bounds; the start was really off."""
+    import dataclasses
+    base, true, m, h, cache = noisy_bench
+    bench = dataclasses.replace(m, free_height_m=h, free_height_sd_m=FREE_HEIGHT_SD_M)
+    cal = calibrate(base, bench, ["wave_height_m", "thickness_m"], cache_dir=cache, jobs=2)
+    err = cal.values / true - 1
+    assert np.all(np.abs(err) < 0.015), (cal.values, true, err)
+    assert np.all(np.abs(cal.values - true) <= 3.0 * cal.std), (cal.values, true, cal.std)
+    assert cal.rms_pct < 2.0
+    assert not any("bound" in w or "identif" in w for w in cal.warnings()), cal.warnings()
+    assert cal.free_height_sensitivity_sd[0, 0] > 0.5          # 1 % wave height: more than half a sigma
+    from cushion_clutch.fe.studies.calibration_report import report_text
+    report = report_text(cal)
+    assert "runs test" in report and "1-sigma %" in report and "free height at 20 degC: measured" in report
+    start_err = np.max(np.abs(cal.fe_start_N[0] - m.force_N)) / m.force_N.max()
     assert start_err > 0.05          # the start was really off
 
 

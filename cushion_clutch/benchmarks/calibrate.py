@@ -2,8 +2,10 @@
 
 The "measurement" is the FE curve of the default spring with known perturbed
 parameters plus 1 % noise, kept raw (noisy, not made monotone: a running
-maximum would bias the curve upwards); the calibration starts from the
-default and must find them again. ``--hot`` adds a 195 degC curve (u from
+maximum would bias the curve upwards), and the pair's free height with a
+10 um 1-sigma (``--free-height-sd 0``: a bench without that datum, where the
+wave height is poorly identified and the report says so); the calibration
+starts from the default and must find them again. ``--hot`` adds a 195 degC curve (u from
 the 20 degC kiss point) and fits a thermal key too. Prints the report, the
 recovered values, the errors, FE case count and wall time; writes the Fig. 9
 style PNG.
@@ -26,9 +28,12 @@ TRUTH = {"wave_height_m": 1.08, "thickness_m": 0.95, "far_end_stiffness_N_per_m"
          "temperature_ratio": 0.8, "wave_tilt_m": 1.2}
 
 
-def synthetic_curves(truth, temperatures, cache: Path, noise: float = 0.01, points: int = 30, seed: int = 1):
-    """Noisy FE 'measurements' of ``truth`` at ``temperatures``, u from the reference kiss point."""
+def synthetic_curves(truth, temperatures, cache: Path, noise: float = 0.01, points: int = 30, seed: int = 1,
+                     free_height_sd_m: float = 0.0):
+    """Noisy FE 'measurements' of ``truth`` at ``temperatures``, u from the reference kiss point; with
+    ``free_height_sd_m`` > 0 each carries the pair's free height with that much noise (m)."""
     from cushion_clutch.fe.studies.measured import Measured
+    from cushion_clutch.fe.studies.tolerance_report import pair_free_height
     from cushion_clutch.fe.sweep import run_sweep
     from cushion_clutch.fe.tables import curve_from_case, kiss_shift
 
@@ -43,8 +48,11 @@ def synthetic_curves(truth, temperatures, cache: Path, noise: float = 0.01, poin
         c = curves[t]
         u = np.linspace(-shift[t] + 0.02e-3, 0.95 * c.u_m[-1] - shift[t], points)
         f = np.interp(u + shift[t], c.u_m, c.force_N)
-        out.append(Measured(u, f * (1 + noise * rng.standard_normal(points)), "pair", float(t),
-                            f"FE truth at {t:g} degC + {noise:.0%} noise"))
+        f = f * (1 + noise * rng.standard_normal(points))
+        h = (pair_free_height(p, cases[t]) + free_height_sd_m * rng.standard_normal() if free_height_sd_m > 0
+             else None)
+        out.append(Measured(u, f, "pair", float(t), f"FE truth at {t:g} degC + {noise:.0%} noise",
+                            h, free_height_sd_m if h is not None else None))
     return out
 
 
@@ -58,6 +66,8 @@ def main(argv=None) -> None:
                                                 "with --hot: thickness_m,temperature_ratio)")
     ap.add_argument("--truth", default=None, help="keys perturbed in the truth (default: the fitted ones)")
     ap.add_argument("--hot", action="store_true", help="also a 195 degC curve")
+    ap.add_argument("--free-height-sd", type=float, default=10e-6,
+                    help="1-sigma of the measured free height, m (0: no free height measured)")
     ap.add_argument("--mesh", type=float, default=2e-3)
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--png", type=Path, default=None)
@@ -68,13 +78,15 @@ def main(argv=None) -> None:
     true_all = np.array([getattr(getattr(base, s), k) * TRUTH[k] for s, k in tkeys])
     with tempfile.TemporaryDirectory() as tmp:
         truth = with_values(base, tkeys, true_all)
-        measured = synthetic_curves(truth, (20.0, 195.0) if args.hot else (20.0,), Path(tmp) / "truth")
+        measured = synthetic_curves(truth, (20.0, 195.0) if args.hot else (20.0,), Path(tmp) / "truth",
+                                    free_height_sd_m=args.free_height_sd)
         cal = calibrate(base, measured, names, cache_dir=Path(tmp) / "cal", jobs=args.jobs)
     print(report_text(cal), end="")
     true = {f"{s}.{k}": v for (s, k), v in zip(tkeys, true_all)}
-    for n, v, s0 in zip(cal.names, cal.values, cal.start):
+    for n, v, s0, sd in zip(cal.names, cal.values, cal.start, cal.std):
         t = true.get(n, s0)
-        print(f"{n}: true {t:.5g}, recovered {v:.5g} ({v / t - 1:+.2%})")
+        print(f"{n}: true {t:.5g}, recovered {v:.5g} ({v / t - 1:+.2%}, {(v - t) / sd:+.2f} of its 1-sigma "
+              f"{sd / abs(v):.2%})")
     print(f"calibration of {len(names)} parameters at {args.mesh * 1e3:g} mm: {cal.wall_time_s:.0f} s wall, "
           f"{cal.fe_cases} FE cases, {args.jobs} jobs")
     if args.png:

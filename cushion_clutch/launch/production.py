@@ -43,6 +43,7 @@ from collections import deque
 from pathlib import Path
 
 from ..model import ClutchParameters, SpringTable
+from ..model.thermal_network import SURFACES
 from .ekf import IX_DX, ClutchEkf, EkfParams, TcuNetworkParams
 from .mass_grade import MassGrade, MassGradeEstimator
 from .sensors import ProductionSensors, TcuSensors
@@ -100,6 +101,12 @@ class ProductionTcu(TcuController):
 
     def theta_cm_estimate(self) -> float:
         return self.ekf.theta_cm
+
+    def theta_facing_protect(self) -> float:
+        """The friction system's temperature the thermal protection acts on: the hotter of the EKF's facings (their
+        mean) and its hotter metal friction surface, K (:meth:`.tcu.TcuController.theta_facing_protect`)."""
+        s = self.ekf.s
+        return max(self.ekf.theta_cm, s.item(SURFACES[0]), s.item(SURFACES[1]))
 
     def theta_cm_used(self) -> float:
         """The facing temperature the TCU's clutch model assumes (the EKF's estimate, within the model's range), K."""

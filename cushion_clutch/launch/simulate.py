@@ -47,7 +47,7 @@ from .engine import RPM
 from .production import KeyOn, ProductionTcu, key_off, key_on
 from .tcu import CLOSE, LAUNCH, OPEN, PREFILL, VARIANTS, TcuController
 from .thermal import FacingModel
-from ..model.thermal_network import ThermalNetwork
+from ..model.thermal_network import SURFACES, ThermalNetwork
 
 #: fmi2Discard: the status of a step the plant FMU refuses for an input outside its range
 DISCARD = 2
@@ -235,6 +235,8 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
         native_block, native_quiet, native_row, native_accels = native.block, native.quiet, native.row, native.accels
         values, width, ix = native.values, native.width, native.ix
         o_kiss, o_theta_cs, o_t_cap, o_event = ix["x_kiss"], ix["theta_cs"], ix["t_cap"], ix["event"]
+    # the ideal TCU is told the true hotter friction surface too (its thermal protection, tcu.theta_facing_protect)
+    ideal_surface = net is not None and VARIANTS[name].temperature == "ideal"
     wall0, cpu0 = time.perf_counter(), time.process_time()
     stopped = ""
     try:
@@ -253,6 +255,9 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
             cycled = countdown == 0
             if cycled:                                           # -- TCU cycle
                 countdown = tcu_every
+                if ideal_surface:
+                    ctl.theta_surface_ideal = (max(native.s.theta[SURFACES[0]], native.s.theta[SURFACES[1]])
+                                               if native is not None else net.theta_surface)
                 if sense is not None:         # production TCU: its own speed sensors, read from the truth given;
                     sense(t, dl.w_e, dl.w_d, t_e)                 # the wheel speed as the others read it (ABS)
                     ctl.cycle(n + 1, tl, rec.lock_time is not None, dl.w_e, dl.w_d, x_act, theta_cm, t_e, levels[n],
@@ -445,6 +450,8 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
     dl.en.kinetic = dl.kinetic() - ke0
     dl.en.elastic = dl.elastic()
     series = np.array(rows, dtype=[(c, float) for c in COLUMNS])
+    if mu_surface is not None:
+        _say_beyond_friction_table(name, series, mu_surface)
     metrics = [r.metrics(run.hot_degC) for r in recs]
     learned = ctl.learner.estimates if ctl.learner is not None else []
     if keyed is not None:
@@ -452,6 +459,23 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
     return LaunchResult(name, series, metrics, dl.en, events, wall, total, cpu, learned, n_quiet * h_quiet, keyed,
                         ctl.protection.events if ctl.protection is not None else [],
                         "native" if native is not None else "python", stopped)
+
+
+def _say_beyond_friction_table(name: str, series, mu) -> float:
+    """Log (a warning) when the plant's friction surface left its friction table ``mu`` (the table holds mu at its
+    edge there): the time (s) the recorded hotter surface spent outside the table's temperatures, 0 if none."""
+    surface = series["theta_surface_K"] - KELVIN
+    lo, hi = mu.theta_degC[0], mu.theta_degC[-1]
+    outside = (surface > hi) | (surface < lo)
+    if not outside.any():
+        return 0.0
+    dt = np.diff(series["time_s"], append=series["time_s"][-1])
+    seconds = float(dt[outside].sum())
+    log.warning("%s: the plant's hotter friction surface was outside its friction table (%g to %g degC) for %.1f s, "
+                "from %.0f to %.0f degC: mu, read at the two surfaces' mean, is held at the table's edge there "
+                "(the model answers outside its table)", name, lo, hi, seconds, float(surface.min()),
+                float(surface.max()))
+    return seconds
 
 
 def plant_start_values(plant_start: dict, scenario_start: dict, x_kiss_ref_m: float, sc: Scenario) -> dict:

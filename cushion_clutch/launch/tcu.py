@@ -151,6 +151,7 @@ class TcuController:
                               table.theta_degC[0]) + KELVIN
         self.theta_ideal = theta0
         self.theta_cm_ideal = theta0      # the ideal TCU's facing temperature (it is told the true one), K
+        self.theta_surface_ideal = math.nan     # ... and its hotter metal friction surface (NaN: no network), K
         self.observer = (FacingObserver(sc.observer, p.theta_a, theta0, self.period)
                          if variant.temperature == "estimated" else None)
         self.learner = (KissLearner(sc.adaptation, self.period, j_d_kg_m2, t_load_Nm)
@@ -205,8 +206,14 @@ class TcuController:
         return self.observer.theta_cm if self.observer is not None else float("nan")
 
     def theta_facing_protect(self) -> float:
-        """The facing temperature the thermal protection acts on (the TCU's estimate; ``aware``: the true), K."""
-        return self.theta_cm_ideal if self.v.temperature == "ideal" else self.theta_cm_estimate()
+        """The temperature the thermal protection acts on, K: the TCU's estimate of the friction system, the hotter
+        of its facings and (an observer with the network) its hotter metal friction surface; ``aware``: the true ones
+        (:attr:`theta_surface_ideal`, set by the simulation)."""
+        if self.v.temperature == "ideal":
+            th, surface = self.theta_cm_ideal, self.theta_surface_ideal
+            return surface if surface > th else th
+        o = self.observer
+        return max(o.theta_cm, o.net.theta_surface) if o is not None and o.net is not None else self.theta_cm_estimate()
 
     def theta_cm_used(self) -> float | None:
         """The facing temperature the TCU's clutch model assumes (the stack's growth), K; None: theta_cs.

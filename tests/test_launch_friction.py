@@ -106,3 +106,27 @@ def test_a_friction_surface_outside_the_table_is_said(caplog):
     with caplog.at_level(logging.WARNING):
         assert _say_beyond_friction_table("naive", series, mu) == pytest.approx(0.3)
     assert "outside its friction table (-40 to 350 degC) for 0.3 s" in caplog.text and "400 degC" in caplog.text
+
+
+def test_a_tcu_estimate_outside_its_model_is_said(caplog):
+    """A TCU's facing estimate past the clutch model's range (held at its edge) is said, with the time; a run
+    inside it (or a TCU without a facing estimate, NaN) is silent."""
+    import logging
+
+    from cushion_clutch.launch.simulate import _say_tcu_beyond_model
+    from cushion_clutch.model.clutch_model import THETA_MAX_K
+
+    table = load_table()
+    t = np.arange(0.0, 1.0, 0.1)
+    series = np.zeros(len(t), dtype=[("time_s", float), ("theta_cm_tcu_K", float), ("theta_cs_tcu_K", float)])
+    series["time_s"] = t
+    series["theta_cm_tcu_K"] = np.nan
+    series["theta_cs_tcu_K"] = KELVIN + 100.0
+    with caplog.at_level(logging.WARNING):
+        assert _say_tcu_beyond_model("naive", series, table) == 0.0
+    assert not caplog.records
+    series["theta_cm_tcu_K"] = KELVIN + 300.0
+    series["theta_cm_tcu_K"][2:4] = THETA_MAX_K + 40.0
+    with caplog.at_level(logging.WARNING):
+        assert _say_tcu_beyond_model("production", series, table) == pytest.approx(0.2)
+    assert "left its clutch model's range for 0.2 s" in caplog.text

@@ -452,6 +452,7 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
     series = np.array(rows, dtype=[(c, float) for c in COLUMNS])
     if mu_surface is not None:
         _say_beyond_friction_table(name, series, mu_surface)
+    _say_tcu_beyond_model(name, series, table)
     metrics = [r.metrics(run.hot_degC) for r in recs]
     learned = ctl.learner.estimates if ctl.learner is not None else []
     if keyed is not None:
@@ -475,6 +476,26 @@ def _say_beyond_friction_table(name: str, series, mu) -> float:
                 "from %.0f to %.0f degC: mu, read at the two surfaces' mean, is held at the table's edge there "
                 "(the model answers outside its table)", name, lo, hi, seconds, float(surface.min()),
                 float(surface.max()))
+    return seconds
+
+
+def _say_tcu_beyond_model(name: str, series, table: SpringTable) -> float:
+    """Log (a warning) when the TCU's estimates left its clutch model's range, where the model holds its last
+    point (the facing estimate outside ``[THETA_MIN_K, THETA_MAX_K]``, ``hold_theta_cm``; the cushion-spring
+    estimate outside the table's temperatures): the recorded time (s) outside, 0 if none."""
+    from ..model.clutch_model import THETA_MAX_K, THETA_MIN_K
+
+    cm, cs = series["theta_cm_tcu_K"], series["theta_cs_tcu_K"]
+    outside = (cm < THETA_MIN_K) | (cm > THETA_MAX_K) | (cs < table.theta_min_K) | (cs > table.theta_max_K)
+    if not outside.any():                   # NaN (no facing estimate) compares False: inside
+        return 0.0
+    dt = np.diff(series["time_s"], append=series["time_s"][-1])
+    seconds = float(dt[outside].sum())
+    log.warning("%s: the TCU's temperature estimates left its clutch model's range for %.1f s (facings %.0f to "
+                "%.0f degC, the model's %.0f to %.0f; cushion spring up to %.0f degC, the table's %.0f to %.0f): the "
+                "model holds its last point there", name, seconds, np.nanmin(cm) - KELVIN, np.nanmax(cm) - KELVIN,
+                THETA_MIN_K - KELVIN, THETA_MAX_K - KELVIN, float(cs.max()) - KELVIN, table.theta_min_K - KELVIN,
+                table.theta_max_K - KELVIN)
     return seconds
 
 

@@ -85,7 +85,8 @@ class Protection(Checked):
     estimate_error_K: float = 25.0
     """allowance for the estimate's error in the next launch's check: a launch is inhibited when the estimate plus
     the largest rise of a launch so far reaches ``damage_degC`` less this, K (the shipped estimators' friction
-    surfaces were measured up to 22 K below the plant's at a launch's start on the ``protection`` duty)"""
+    surfaces were measured up to 22 K below the plant's at a launch's start on the ``protection`` duty; the ideal
+    ``aware`` TCU, told the true temperatures, takes none)"""
     limit_engine_speed_rpm: float = 1300.0
     """the launch's engine-speed target at full pedal while limiting (the pedal scales it), rpm"""
 

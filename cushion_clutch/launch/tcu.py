@@ -50,7 +50,7 @@ from __future__ import annotations
 
 import copy
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from ..model import KELVIN, ClutchParameters, SpringTable, kiss_point, outputs, thermal_step, x_to_for_torque
 from ..model.clutch_model import hold_theta_cm
@@ -173,8 +173,10 @@ class TcuController:
         self._kiss_value = math.nan
         self._command_memo: dict = {}
         self._torque_memo: dict = {}
-        #: thermal protection by the facing-temperature estimate (:mod:`.protection`), TCUs that have one
-        self.protection = (ThermalProtection(sc.protection)
+        #: thermal protection by the friction system's temperature estimate (:mod:`.protection`), TCUs that have
+        #: one; the ideal TCU knows the true temperatures: no allowance for an estimate's error
+        self.protection = (ThermalProtection(sc.protection if variant.temperature != "ideal"
+                                             else replace(sc.protection, estimate_error_K=0.0))
                            if sc.protection.enabled and variant.temperature != "none" else None)
         self.inhibited = self.limited = False
         #: the launch's engine-speed target (:meth:`launch_target_rad_s`, decided at its start), rad/s

@@ -491,6 +491,7 @@ def _say_tcu_beyond_model(name: str, series, table: SpringTable) -> float:
         return 0.0
     dt = np.diff(series["time_s"], append=series["time_s"][-1])
     seconds = float(dt[outside].sum())
+    cm = cm if np.isfinite(cm).any() else np.array([math.nan])          # no facing estimate: nan, no warning
     log.warning("%s: the TCU's temperature estimates left its clutch model's range for %.1f s (facings %.0f to "
                 "%.0f degC, the model's %.0f to %.0f; cushion spring up to %.0f degC, the table's %.0f to %.0f): the "
                 "model holds its last point there", name, seconds, np.nanmin(cm) - KELVIN, np.nanmax(cm) - KELVIN,

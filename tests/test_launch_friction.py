@@ -84,3 +84,49 @@ def test_fade_scenario_delivers_less_torque_when_hot(tmp_path):
         # the closed slip loop pushes the bearing further; the engine does not stall (a faded clutch may
         # not hold a hard launch's engine torque at all: then no lock-up, reported as NaN)
         assert not f["engine_stall"] and c["engagement_time_s"] < drive
+
+
+def test_a_friction_surface_outside_the_table_is_said(caplog):
+    """The plant holds mu at the friction table's edge beyond its temperatures: the run says so (a warning naming
+    the range and the time), and is silent while the surface stays inside."""
+    import logging
+
+    from cushion_clutch.launch.simulate import _say_beyond_friction_table
+    from cushion_clutch.model.friction import FrictionTable
+
+    mu = FrictionTable([-40.0, 20.0, 350.0], [0.0, 100.0], [[0.3, 0.29], [0.3, 0.29], [0.18, 0.17]])
+    t = np.arange(0.0, 1.0, 0.1)
+    series = np.zeros(len(t), dtype=[("time_s", float), ("theta_surface_K", float)])
+    series["time_s"] = t
+    series["theta_surface_K"] = KELVIN + 300.0
+    with caplog.at_level(logging.WARNING):
+        assert _say_beyond_friction_table("naive", series, mu) == 0.0
+    assert not caplog.records
+    series["theta_surface_K"][4:7] = KELVIN + 400.0            # three rows of 0.1 s above 350 degC
+    with caplog.at_level(logging.WARNING):
+        assert _say_beyond_friction_table("naive", series, mu) == pytest.approx(0.3)
+    assert "outside its friction table (-40 to 350 degC) for 0.3 s" in caplog.text and "400 degC" in caplog.text
+
+
+def test_a_tcu_estimate_outside_its_model_is_said(caplog):
+    """A TCU's facing estimate past the clutch model's range (held at its edge) is said, with the time; a run
+    inside it (or a TCU without a facing estimate, NaN) is silent."""
+    import logging
+
+    from cushion_clutch.launch.simulate import _say_tcu_beyond_model
+    from cushion_clutch.model.clutch_model import THETA_MAX_K
+
+    table = load_table()
+    t = np.arange(0.0, 1.0, 0.1)
+    series = np.zeros(len(t), dtype=[("time_s", float), ("theta_cm_tcu_K", float), ("theta_cs_tcu_K", float)])
+    series["time_s"] = t
+    series["theta_cm_tcu_K"] = np.nan
+    series["theta_cs_tcu_K"] = KELVIN + 100.0
+    with caplog.at_level(logging.WARNING):
+        assert _say_tcu_beyond_model("naive", series, table) == 0.0
+    assert not caplog.records
+    series["theta_cm_tcu_K"] = KELVIN + 300.0
+    series["theta_cm_tcu_K"][2:4] = THETA_MAX_K + 40.0
+    with caplog.at_level(logging.WARNING):
+        assert _say_tcu_beyond_model("production", series, table) == pytest.approx(0.2)
+    assert "left its clutch model's range for 0.2 s" in caplog.text

@@ -185,3 +185,16 @@ def test_friction_at_the_surface_native_equals_python(tmp_path):
     nat = simulate_launches(fmu, sc, table, "naive", plant="native")
     _assert_same(py, nat)
     assert py.lock_events
+
+
+def test_the_ideal_tcus_protection_sees_the_same_friction_surface_native_and_python(tmp_path):
+    """The ideal TCU's thermal protection is told the plant's hotter friction surface (the C state's nodes, or the
+    Python network's): fade's duty 60 s apart with the protection on, where the surface makes it warn from launch
+    12 and limit launch 14 (on the facings alone: ok, warn, warn); both paths the same, to the last bit."""
+    sc = _scenario("fade", 14, 60.0, protection=load_scenario(scenario_path("protection")).protection)
+    fmu = build_plant_fmu(DEFAULT_TABLES, sc, tmp_path / "CushionClutch.fmu")
+    table = load_table()
+    py = simulate_launches(fmu, sc, table, "aware", plant="python", record_every=50)
+    nat = simulate_launches(fmu, sc, table, "aware", plant="native", record_every=50)
+    _assert_same(py, nat)
+    assert [m["protection_level"] for m in nat.metrics][11:] == [1, 1, 2]

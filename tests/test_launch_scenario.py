@@ -131,3 +131,31 @@ def test_the_duty_cycles_ship_with_their_sources_and_run(tmp_path):
         assert all(math.isfinite(m["engagement_time_s"]) and m["launch_possible"] for m in r.metrics)
         assert restarts_to_damage(r.series) is None and 20.0 < peak_degC(r.series) < DAMAGE_DEGC
         assert restarts_to_damage(r.series, peak_degC(r.series) - 1.0) in (1, 2)
+
+
+@pytest.mark.fmu
+def test_fade_takes_the_friction_surface_into_the_fade_range_and_stays_inside_the_tables(tmp_path):
+    """What fade.toml states, for every TCU: the plant's friction surface passes 250 degC (the organic table's
+    fade) and stays below the table's last row, the facings stay below the damage limit, every launch locks up
+    and the run does not stop (the duty before, 60 s apart, left the table in the 14th start and ran away)."""
+    import math
+    from pathlib import Path
+
+    from cushion_clutch.data import DEFAULT_TABLES
+    from cushion_clutch.launch.fleet.duty import peak_degC
+    from cushion_clutch.launch.plant.build import build_plant_fmu
+    from cushion_clutch.launch.simulate import VARIANTS, simulate_launches
+    from cushion_clutch.model import KELVIN, ClutchParameters, load_table
+    from cushion_clutch.model.friction import FrictionTable
+
+    sc = load_scenario(scenario_path("fade"))
+    assert not sc.protection.enabled
+    table_top = FrictionTable.from_csv(SHIPPED / sc.clutch.friction_csv).theta_degC[-1]
+    damage = ClutchParameters().facing_damage_temperature_K - KELVIN
+    fmu = build_plant_fmu(Path(DEFAULT_TABLES), sc, tmp_path / "CushionClutch.fmu")
+    for name in VARIANTS:
+        r = simulate_launches(fmu, sc, load_table(), name, record_every=20)
+        assert not r.stopped and len(r.metrics) == sc.run.launches, name
+        assert all(math.isfinite(m["engagement_time_s"]) for m in r.metrics), name
+        assert 250.0 < peak_degC(r.series) < table_top, name           # surface or facings, whichever is hotter
+        assert r.series["theta_cm_K"].max() - KELVIN < damage, name

@@ -1,11 +1,13 @@
 """Thermal protection: its levels on the facing-temperature estimate, and on a heavy-duty launch run."""
 import dataclasses
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 from cushion_clutch.errors import ParameterError
+from cushion_clutch.launch.fleet.duty import peak_degC
 from cushion_clutch.launch.tcu.protection import INHIBIT, LIMIT, OK, WARN, Protection, ThermalProtection
 from cushion_clutch.model import KELVIN
 
@@ -44,6 +46,23 @@ def test_the_next_launch_rise_counts():
     assert p.launch_start(k(295.0), 0.0, 2)              # 295 + 60 reaches the 350 degC damage limit
 
 
+def test_the_rise_is_taken_to_the_slot_peak_and_the_estimate_error_allowed():
+    """The next launch's check takes the last launch's rise to the highest estimate in its slot (the facings and
+    the friction surface peak after the slip's end, or at it), and allows ``estimate_error_K`` for the estimate's
+    error: 260 + 70 reaches 350 - 25 (the rise to the launch's end, 50 K, would not)."""
+    p = ThermalProtection(Protection())
+    assert not p.launch_start(k(200.0), 0.0, 1)
+    p.update(k(270.0), 5.0, 1)                           # the slot's peak
+    p.launch_end(k(250.0))                               # the slip ended before it
+    assert p.launch_start(k(260.0), 60.0, 2) and p.rise == pytest.approx(70.0)
+    q = ThermalProtection(Protection(estimate_error_K=0.0))
+    q.launch_start(k(200.0), 0.0, 1)
+    q.update(k(270.0), 5.0, 1)
+    assert not q.launch_start(k(260.0), 60.0, 2)         # 330 < 350 without the allowance
+    with pytest.raises(ParameterError, match="estimate_error_K"):
+        Protection(estimate_error_K=-1.0)
+
+
 def test_thresholds_are_checked():
     with pytest.raises(ParameterError) as err:
         Protection(warn_degC=300.0, limit_degC=280.0)
@@ -54,7 +73,8 @@ def test_thresholds_are_checked():
 
 @pytest.mark.fmu
 def test_protected_tcus_keep_their_estimate_below_the_damage_limit(tmp_path):
-    """The protection scenario with every threshold lowered (a short run reaches them)."""
+    """The protection scenario with every threshold lowered (a short run reaches them; the estimate's allowance
+    too, or the rise check would inhibit before any launch is limited)."""
     from cushion_clutch.data import DEFAULT_TABLES
     from cushion_clutch.fmu.build import build_fmu
     from cushion_clutch.launch.scenario import load_scenario, scenario_path
@@ -66,7 +86,7 @@ def test_protected_tcus_keep_their_estimate_below_the_damage_limit(tmp_path):
     sc = dataclasses.replace(
         sc, run=dataclasses.replace(sc.run, launches=7),
         protection=Protection(enabled=True, warn_degC=60.0, limit_degC=80.0, inhibit_degC=100.0, resume_degC=60.0,
-                              damage_degC=130.0))
+                              damage_degC=130.0, estimate_error_K=5.0))
     naive = simulate_launches(fmu, sc, load_table(), "naive")
     assert naive.series["theta_cm_K"].max() - KELVIN > 130.0          # unprotected: past the (lowered) limit
     for name in ("production", "aware"):
@@ -107,6 +127,36 @@ def test_every_production_launch_of_the_protection_scenario_locks_up_or_is_inhib
         assert m["launch_possible"] and not m["stranded"], m
         assert m["protection_level"] == INHIBIT or math.isfinite(m["engagement_time_s"]), m
         assert m["protection_level"] < INHIBIT or math.isnan(m["engagement_time_s"]), m
+    # the true facings and friction surfaces stay below the damage limit (with the protection on the facings'
+    # estimate alone the surface reached 372 degC in launch 17)
+    assert peak_degC(r.series) < sc.protection.damage_degC
+
+
+@pytest.mark.fmu
+@pytest.mark.parametrize("name", ["aware", "aware_estimated", "production"])
+def test_protection_on_the_fade_duty_keeps_the_friction_surface_below_damage_and_strands_nothing(tmp_path, name):
+    """``fade``'s duty with the protection on (``protection``'s thresholds): mu fades with the friction surface, so a
+    protection that watches the facings alone let a launch start on a faded surface that could not hold the
+    engine (aware and aware_estimated: stranded, 410-430 kJ of slip, the facings past 380 degC). On the friction
+    system's temperature (the hotter of facings and surface), every launch that is not inhibited locks up, the
+    true facings and surfaces stay below the damage limit and the run does not stop."""
+    from cushion_clutch.data import DEFAULT_TABLES
+    from cushion_clutch.launch.plant.build import build_plant_fmu
+    from cushion_clutch.launch.scenario import load_scenario, scenario_path
+    from cushion_clutch.launch.simulate import simulate_launches
+    from cushion_clutch.model import load_table
+
+    sc = load_scenario(scenario_path("fade"))
+    sc = dataclasses.replace(sc, run=dataclasses.replace(sc.run, period_s=60.0),
+                             protection=load_scenario(scenario_path("protection")).protection)
+    fmu = build_plant_fmu(Path(DEFAULT_TABLES), sc, tmp_path / "CushionClutch.fmu")
+    r = simulate_launches(fmu, sc, load_table(), name, record_every=20)
+    assert not r.stopped and len(r.metrics) == sc.run.launches
+    for m in r.metrics:
+        assert not m["stranded"] and m["launch_possible"], m
+        assert m["protection_level"] == INHIBIT or math.isfinite(m["engagement_time_s"]), m
+    assert max(m["protection_level"] for m in r.metrics) >= LIMIT
+    assert peak_degC(r.series) < sc.protection.damage_degC
 
 
 def test_launch_capability_is_the_engine_at_the_pedal_against_the_holding_torque():

@@ -2,8 +2,9 @@
 scenario run with the naive (unprotected), the aware (protected on the true temperature) and the production
 TCU (protected on its own estimate).
 
-Top: each TCU's plant facing temperature (and production's estimate, dashed) against the protection
-thresholds; middle: the protection level of the two protected TCUs; bottom: each launch's slip energy (an
+Top: each TCU's plant facing temperature, the protected TCUs' plant friction surface (the hotter, dotted; the
+protection acts on the hotter of facings and surface) and production's facing estimate (dashed) against the
+protection thresholds; middle: the protection level of the two protected TCUs; bottom: each launch's slip energy (an
 inhibited launch has none). Prints each TCU's peak plant facing temperature and its inhibited launches.
 
     python -m cushion_clutch.benchmarks.protection_figure [--png docs/protection.png]
@@ -52,6 +53,9 @@ def figure(sc, results: dict, path: Path) -> list[str]:
         t_min = s["time_s"] / 60.0
         label = "plant facings (no protection)" if name == "naive" else "plant facings"
         ax[0].plot(t_min, s["theta_cm_K"] - KELVIN, color=COLOURS[name], lw=1.0, label=f"{name}: {label}")
+        if name != "naive":         # what the protection watches besides the facings (and the damage limit's)
+            ax[0].plot(t_min, s["theta_surface_K"] - KELVIN, color=COLOURS[name], lw=0.7, ls=":",
+                       label=f"{name}: plant friction surface (the hotter)")
         if name == "production":
             ax[0].plot(t_min, s["theta_cm_tcu_K"] - KELVIN, color=COLOURS[name], lw=1.0, ls="--",
                        label=f"{name}: its estimate")
@@ -60,6 +64,7 @@ def figure(sc, results: dict, path: Path) -> list[str]:
             ax[1].step(t_min, s["protection_level"], where="post", color=COLOURS[name], label=f"{name} ({what})")
         k = peaks(res)
         lines.append(f"{name}: peak plant facing temperature {k['plant_theta_cm_peak_degC']:.0f} degC, "
+                     f"friction surface {np.nanmax(s['theta_surface_K']) - KELVIN:.0f} degC, "
                      f"theta_cs {k['plant_theta_cs_peak_degC']:.0f} degC; "
                      f"{k['inhibited_launches']} inhibited launches")
     damage = ClutchParameters().facing_damage_temperature_K - KELVIN
@@ -70,7 +75,7 @@ def figure(sc, results: dict, path: Path) -> list[str]:
         ax[0].axhline(value, color="k", lw=0.6, ls=":")
         ax[0].annotate(f"{text} {value:.0f} °C", (1.005, value), xycoords=("axes fraction", "data"), va="center",
                        fontsize=8)
-    ax[0].set(xlabel="time [min]", ylabel="facing temperature [°C]")
+    ax[0].set(xlabel="time [min]", ylabel="temperature [°C]")
     ax[0].legend(fontsize=8, loc="lower right")
     ax[1].set_yticks(range(len(LEVEL_NAMES)), LEVEL_NAMES)
     ax[1].set(xlabel="time [min]", ylabel="protection level")

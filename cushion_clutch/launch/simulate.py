@@ -28,10 +28,13 @@ period in one step, or a block of steps), whichever engine runs the plant (:mod:
 """
 from __future__ import annotations
 
+import logging
 import math
 import time
 from pathlib import Path
 from typing import Callable
+
+import numpy as np
 
 from ..errors import FmuCallError
 from ..model import KELVIN, ClutchParameters, SpringTable
@@ -50,6 +53,8 @@ from .tcu.production import ProductionTcu, key_off, key_on
 
 #: fmi2Discard: the status of a step the plant FMU refuses for an input outside its range
 DISCARD = 2
+
+log = logging.getLogger(__name__)
 
 __all__ = ["COLUMNS", "Energy", "LaunchResult", "PLANTS", "simulate_launches"]
 
@@ -164,6 +169,7 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
     believed = 0.0
     next_switch = slot_end - 0.5 * h if len(starts) > 1 else math.inf
     pl.start(rec)
+    told_surface = ctl.know.told and pl.net is not None     # (its thermal protection, knowledge.Told.protect)
     wall0, cpu0 = time.perf_counter(), time.process_time()
     stopped = ""
     try:
@@ -179,6 +185,8 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
             cycled = countdown == 0
             if cycled:                                           # -- TCU cycle
                 countdown = tcu_every
+                if told_surface:                  # the ideal TCU is told the true hotter friction surface too
+                    ctl.know.theta_surface = pl.theta_surface()
                 ctl.read_and_cycle(sensors, t, n + 1, tl, rec.lock_time is not None, dl.w_e, dl.w_d, dl.v * r_to_disc,
                                    pl.x_act, pl.theta_cm, pl.t_e, levels[n])
                 phase = ctl.phase
@@ -228,11 +236,53 @@ def simulate_launches(fmu: Path, sc: Scenario, table: SpringTable, tcu: str | bo
     dl.en.kinetic = dl.kinetic() - ke0
     dl.en.elastic = dl.elastic()
     learned = ctl.learned_kiss()
+    ts = series(rows)
+    if pl.mu_surface is not None:
+        _say_beyond_friction_table(name, ts, pl.mu_surface)
+    _say_tcu_beyond_model(name, ts, table)
     if keyed is not None:
         key_off(ctl, sc, keyed)
-    return LaunchResult(name, series(rows), [r.metrics(run.hot_degC) for r in recs], dl.en, events, wall, total, cpu,
+    return LaunchResult(name, ts, [r.metrics(run.hot_degC) for r in recs], dl.en, events, wall, total, cpu,
                         learned, n_quiet * pl.h_quiet, keyed, ctl.protection.events if ctl.protection is not None else [],
                         pl.kind, stopped)
+
+
+def _say_beyond_friction_table(name: str, series, mu) -> float:
+    """Log (a warning) when the plant's friction surface left its friction table ``mu`` (the table holds mu at its
+    edge there): the time (s) the recorded hotter surface spent outside the table's temperatures, 0 if none."""
+    surface = series["theta_surface_K"] - KELVIN
+    lo, hi = mu.theta_degC[0], mu.theta_degC[-1]
+    outside = (surface > hi) | (surface < lo)
+    if not outside.any():
+        return 0.0
+    dt = np.diff(series["time_s"], append=series["time_s"][-1])
+    seconds = float(dt[outside].sum())
+    log.warning("%s: the plant's hotter friction surface was outside its friction table (%g to %g degC) for %.1f s, "
+                "from %.0f to %.0f degC: mu, read at the two surfaces' mean, is held at the table's edge there "
+                "(the model answers outside its table)", name, lo, hi, seconds, float(surface.min()),
+                float(surface.max()))
+    return seconds
+
+
+def _say_tcu_beyond_model(name: str, series, table: SpringTable) -> float:
+    """Log (a warning) when the TCU's estimates left its clutch model's range, where the model holds its last
+    point (the facing estimate outside ``[THETA_MIN_K, THETA_MAX_K]``, ``hold_theta_cm``; the cushion-spring
+    estimate outside the table's temperatures): the recorded time (s) outside, 0 if none."""
+    from ..model.clutch_model import THETA_MAX_K, THETA_MIN_K
+
+    cm, cs = series["theta_cm_tcu_K"], series["theta_cs_tcu_K"]
+    outside = (cm < THETA_MIN_K) | (cm > THETA_MAX_K) | (cs < table.theta_min_K) | (cs > table.theta_max_K)
+    if not outside.any():                   # NaN (no facing estimate) compares False: inside
+        return 0.0
+    dt = np.diff(series["time_s"], append=series["time_s"][-1])
+    seconds = float(dt[outside].sum())
+    cm = cm if np.isfinite(cm).any() else np.array([math.nan])          # no facing estimate: nan, no warning
+    log.warning("%s: the TCU's temperature estimates left its clutch model's range for %.1f s (facings %.0f to "
+                "%.0f degC, the model's %.0f to %.0f; cushion spring up to %.0f degC, the table's %.0f to %.0f): the "
+                "model holds its last point there", name, seconds, np.nanmin(cm) - KELVIN, np.nanmax(cm) - KELVIN,
+                THETA_MIN_K - KELVIN, THETA_MAX_K - KELVIN, float(cs.max()) - KELVIN, table.theta_min_K - KELVIN,
+                table.theta_max_K - KELVIN)
+    return seconds
 
 
 def plant_start_values(plant_start: dict, scenario_start: dict, x_kiss_ref_m: float, sc: Scenario) -> dict:

@@ -26,7 +26,7 @@ from typing import Callable
 import numpy as np
 
 from ...model import KELVIN
-from ...model.thermal_network import ThermalNetwork
+from ...model.thermal_network import SURFACES, ThermalNetwork
 from .driveline import Driveline
 from .engine import EngineGovernor
 from .fmu_client import ClutchFmu
@@ -119,6 +119,10 @@ class Plant:
         """The network's hotter friction surface and its last node (the pressure plate), K; NaN without it."""
         net = self.net
         return (net.theta_surface, net.theta[-1]) if net is not None else (math.nan, math.nan)
+
+    def theta_surface(self) -> float:
+        """The network's hotter friction surface now, K; NaN without it."""
+        return self.net_temps()[0]
 
     def start(self, rec) -> None:
         """The run starts with launch record ``rec``."""
@@ -324,6 +328,10 @@ class NativeSteps(Plant):
         self.ix = nat.ix
         self.o_kiss, self.o_theta_cs, self.o_t_cap, self.o_event = (nat.ix["x_kiss"], nat.ix["theta_cs"],
                                                                     nat.ix["t_cap"], nat.ix["event"])
+
+    def theta_surface(self) -> float:
+        theta = self.native.s.theta
+        return max(theta[SURFACES[0]], theta[SURFACES[1]])
 
     def start(self, rec) -> None:
         self.native.start(rec, self.x_act, self.theta_cm, self.t_e, self.t_cap, self.theta_cs, self.x_kiss)

@@ -356,6 +356,11 @@ class Protection(Checked):
     damage_degC: float = 350.0
     """the seed paper: permanent damage above 350-400 degC"""
     hysteresis_K: float = 10.0
+    estimate_error_K: float = 25.0
+    """allowance for the estimate's error in the next launch's check: a launch is inhibited when the estimate plus
+    the largest rise of a launch so far reaches ``damage_degC`` less this, K (the shipped estimators' friction
+    surfaces were measured up to 22 K below the plant's at a launch's start on the ``protection`` duty; the ideal
+    ``aware`` TCU, told the true temperatures, takes none)"""
     limit_engine_speed_rpm: float = 1300.0
     """the launch's engine-speed target at full pedal while limiting (the pedal scales it), rpm"""
 
@@ -367,7 +372,7 @@ class Protection(Checked):
         yield from self._ranges(spec := {
             "warn_degC": (20.0, 600.0), "limit_degC": (20.0, 600.0), "inhibit_degC": (20.0, 600.0),
             "resume_degC": (20.0, 600.0), "damage_degC": (20.0, 800.0), "hysteresis_K": (0.0, 100.0),
-            "limit_engine_speed_rpm": (500.0, 8000.0)})
+            "estimate_error_K": (0.0, 100.0), "limit_engine_speed_rpm": (500.0, 8000.0)})
         if not self._passed(spec, "warn_degC", "limit_degC", "inhibit_degC", "damage_degC", "resume_degC"):
             return
         if not self.warn_degC <= self.limit_degC <= self.inhibit_degC < self.damage_degC:

@@ -50,7 +50,7 @@ from __future__ import annotations
 
 import copy
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from ...model import KELVIN, ClutchParameters, SpringTable, kiss_point, outputs, x_to_for_torque
 from ..scenario.load import Driver, Engine, Tcu
@@ -184,7 +184,9 @@ class TcuController:
         self._torque_memo: dict = {}
         #: thermal protection by the facing-temperature estimate (:mod:`.protection`), TCUs that have one
         protection = protection or Protection()
-        self.protection = ThermalProtection(protection) if protection.enabled and self.know.protects else None
+        if know.told:                   # the ideal TCU knows the true temperatures: no allowance for an estimate's error
+            protection = replace(protection, estimate_error_K=0.0)
+        self.protection = ThermalProtection(protection) if protection.enabled and know.protects else None
         self.inhibited = self.limited = False
         #: the launch's engine-speed target (:meth:`launch_target_rad_s`, decided at its start), rad/s
         self.w_target = w_idle_rad_s

@@ -14,8 +14,11 @@ The controller asks them, never the variant's name.
 """
 from __future__ import annotations
 
+import math
+
 from ...model import thermal_step
 from ...model.clutch_model import hold_theta_cm
+from ...model.thermal_network import SURFACES
 from .adaptation import KissLearner
 from .observer import FacingObserver
 
@@ -28,6 +31,8 @@ class TableReference:
 
     #: no temperature to act on: no thermal protection
     protects = False
+    #: told the true temperatures (no allowance for an estimate's error in its protection)
+    told = False
     __slots__ = ("theta",)
 
     def __init__(self, ctl, observer, theta0: float):
@@ -46,7 +51,8 @@ class TableReference:
         return float("nan")
 
     def protect(self) -> float:
-        """The facing temperature its thermal protection acts on, K."""
+        """The friction system's temperature its thermal protection acts on: the hotter of its facings (their
+        mean) and, where it knows them, its hotter metal friction surface (mu is read there, issue 37), K."""
         return self.estimate()
 
     def update(self, ctl, theta_cm_true: float, x_meas: float, w_e: float, w_d: float) -> None:
@@ -56,18 +62,21 @@ class TableReference:
 class Told(TableReference):
     """The ideal ``aware`` TCU: told the true facing temperature; the spring's follows through the exact model."""
 
-    protects = True
-    __slots__ = ("p", "period", "theta_cm")
+    protects = told = True
+    __slots__ = ("p", "period", "theta_cm", "theta_surface")
 
     def __init__(self, ctl, observer, theta0: float):
         self.p, self.period = ctl.p, ctl.period
         self.theta = self.theta_cm = theta0
+        #: the true hotter friction surface, K (set by the simulation before each cycle; NaN: no network)
+        self.theta_surface = math.nan
 
     def theta_cm_model(self) -> float | None:
         return hold_theta_cm(self.theta_cm)
 
     def protect(self) -> float:
-        return self.theta_cm
+        th, surface = self.theta_cm, self.theta_surface
+        return surface if surface > th else th
 
     def update(self, ctl, theta_cm_true, x_meas, w_e, w_d) -> None:
         self.theta = thermal_step(self.theta, hold_theta_cm(theta_cm_true), self.period, self.p)
@@ -93,6 +102,10 @@ class Observed(TableReference):
     def estimate(self) -> float:
         return self.observer.theta_cm
 
+    def protect(self) -> float:
+        o = self.observer
+        return max(o.theta_cm, o.net.theta_surface) if o.net is not None else o.theta_cm
+
     def update(self, ctl, theta_cm_true, x_meas, w_e, w_d) -> None:
         slip = abs(w_e - w_d)
         phase = ctl.phase
@@ -117,6 +130,11 @@ class EkfEstimate(TableReference):
 
     def estimate(self) -> float:
         return self.ekf.theta_cm
+
+    def protect(self) -> float:
+        ekf = self.ekf
+        s = ekf.s
+        return max(ekf.theta_cm, s.item(SURFACES[0]), s.item(SURFACES[1]))
 
 
 class ModelKiss:

@@ -5,10 +5,15 @@ Production TCUs estimate the clutch temperature largely to protect the facings
 engine torque reduced, the driver told "Transmission hot - wait", the clutches
 disengaged above a calculated 300 degC; Eaton's Endurant "clutch abuse
 protection": three severity levels, a dash warning, launches restricted until
-the clutch has cooled). Here, by the estimated facing temperature ``theta`` of a
-TCU that has one (``aware``: the true one; ``aware_estimated`` and
-``adaptive_aware_estimated``: the observer's; ``production``: the EKF's; the
-``naive`` and ``adaptive`` TCUs know no temperature and cannot protect):
+the clutch has cooled). Here, by the estimated temperature ``theta`` of the friction
+system of a TCU that has one: the hotter of its facings (their mean) and its hotter
+metal friction surface (``aware``: the true ones; ``aware_estimated`` and
+``adaptive_aware_estimated``: the observer's network; ``production``: the EKF's; the
+``naive`` and ``adaptive`` TCUs know no temperature and cannot protect). The surface
+counts because the friction is read there (issue 37: mu fades with it) and the damage
+limit is the friction system's; on the facings alone the surface reached 372 degC in
+``protection`` and a launch on ``fade``'s duty started on a surface too faded to hold
+the engine and slipped for its whole pedal time:
 
 ====  ===========  =================================================================
 level  name        when / what
@@ -25,8 +30,9 @@ level  name        when / what
                    launch (switched within a launch, the speed controller pulled the
                    engine down: a 208 N.m torque spike)
 3      inhibit     at a launch's start, ``theta >= inhibit_degC`` or ``theta`` plus the
-                   last launch's rise of the estimate reaches ``damage_degC``: no launch
-                   (the driver holds the brake) until ``theta < resume_degC``
+                   largest rise of the estimate over a launch so far (to its slot's peak)
+                   reaches ``damage_degC - estimate_error_K``: no launch (the driver holds
+                   the brake) until ``theta < resume_degC`` and the rise check passes
 ====  ===========  =================================================================
 
 Levels 1 and 2 fall back ``hysteresis_K`` below their threshold. A launch that is not inhibited locks up
@@ -68,7 +74,7 @@ class ThermalProtection:
     p : Protection
     """
 
-    __slots__ = ("p", "level", "inhibited", "theta_start", "rise", "events", "peak")
+    __slots__ = ("p", "level", "inhibited", "theta_start", "rise", "events", "peak", "slot_peak")
 
     def __init__(self, p: Protection):
         self.p = p
@@ -81,6 +87,8 @@ class ThermalProtection:
         self.events: list[tuple[float, int, int, str]] = []
         #: the highest estimate seen, K
         self.peak = 0.0
+        #: the highest estimate since the last launch's start, K
+        self.slot_peak = 0.0
 
     def _set(self, level: int, t: float, launch: int) -> None:
         if level != self.level:
@@ -91,11 +99,14 @@ class ThermalProtection:
         """At a launch's start with the estimate ``theta_K`` (K): True if the launch is inhibited."""
         p = self.p
         th = theta_K - KELVIN
+        if self.theta_start is not None and not self.inhibited:     # the last launch's rise: to its slot's peak
+            self.rise = max(self.rise, self.slot_peak - self.theta_start)
+        reaches = th + self.rise >= p.damage_degC - p.estimate_error_K
         if self.inhibited:
-            self.inhibited = th >= p.resume_degC or th + self.rise >= p.damage_degC
+            self.inhibited = th >= p.resume_degC or reaches
         else:
-            self.inhibited = th >= p.inhibit_degC or th + self.rise >= p.damage_degC
-        self.theta_start = theta_K
+            self.inhibited = th >= p.inhibit_degC or reaches
+        self.theta_start = self.slot_peak = theta_K
         if self.inhibited:
             self._set(INHIBIT, t, launch)
         elif self.level == INHIBIT:
@@ -119,6 +130,7 @@ class ThermalProtection:
     def update(self, theta_K: float, t: float, launch: int) -> int:
         """Every TCU period: the level for the estimate ``theta_K`` (K); an inhibit holds for its launch."""
         self.peak = max(self.peak, theta_K)
+        self.slot_peak = max(self.slot_peak, theta_K)
         if not self.inhibited:
             self._set(self._graded(theta_K - KELVIN), t, launch)
         return self.level
@@ -177,6 +189,6 @@ def plot_protection(out: Path, png: Path, tcus: tuple[str, ...] = ("naive", "awa
     return png
 
 
-if __name__ == "__main__":      # python -m cushion_clutch.launch.protection <launch output folder> <png>
+if __name__ == "__main__":      # python -m cushion_clutch.launch.tcu.protection <launch output folder> <png>
     import sys
     print(plot_protection(Path(sys.argv[1]), Path(sys.argv[2])))

@@ -208,21 +208,22 @@ def _sublayers(z0: float, thickness: float, n: int, grade: float = 1.0) -> list[
     return list(z0 + thickness * np.cumsum(w) / w.sum())
 
 
-def sector_mesh(spring: SpringParams, hp: HeatPathParams, element_size_m: float) -> HeatMesh:
-    """Mesh the sector (see the module docstring).
+@dataclass(frozen=True)
+class _Plan:
+    """The sector's plan grid: axes (r m, phi deg) and which cells each part occupies."""
 
-    Parameters
-    ----------
-    spring : SpringParams
-        The spring (radii, span, thickness, wave, clamp zone, number of pairs).
-    hp : HeatPathParams
-        Facing, carrier, rivets, conductances.
-    element_size_m : float
-        Largest in-plane element edge at the facing's mean radius, m; the layers'
-        sub-division follows it.
-    """
+    r_axis: np.ndarray
+    phi_axis: np.ndarray
+    on_facing: np.ndarray
+    paddle: np.ndarray
+    clamp: np.ndarray
+    carrier: np.ndarray
+    rivet_centres: list[tuple[float, float]]
+
+
+def _plan(spring: SpringParams, hp: HeatPathParams, e: float) -> _Plan:
+    """Plan axes through every part's edge, finer (REFINE x) across the crest strip and the rivets."""
     g = spring.geometry
-    e = element_size_m
     r_i, r_o, r_h = g.inner_radius_m, g.outer_radius_m, hp.carrier_inner_radius_m
     if not r_h < r_i:
         raise ValueError(f"heat_path.carrier_inner_radius_m = {r_h!r}: must be below the paddle's inner radius {r_i!r}")
@@ -238,22 +239,17 @@ def sector_mesh(spring: SpringParams, hp: HeatPathParams, element_size_m: float)
     breaks = [0.0, g.clamp_start_deg, g.clamp_end_deg, *wave_breaks_deg(g), g.span_deg, sector]
     phi_axis = _refined_axis([b for b in breaks if b <= sector], e_deg,
                              [(c - b_deg, c + b_deg) for c in crest_angles_deg(spring)])
-    nr, nphi = len(r_axis) - 1, len(phi_axis) - 1
     rc = 0.5 * (r_axis[:-1] + r_axis[1:])[:, None] + 0.0 * phi_axis[None, :-1]
     pc = 0.0 * r_axis[:-1, None] + 0.5 * (phi_axis[:-1] + phi_axis[1:])[None, :]
     on_facing = (rc > r_i) & (rc < r_o)
     paddle = on_facing & (pc < g.span_deg)
     clamp = paddle & (pc > g.clamp_start_deg) & (pc < g.clamp_end_deg)
     carrier = (rc < r_i) | clamp
+    return _Plan(r_axis, phi_axis, on_facing, paddle, clamp, carrier, centres)
 
-    rr, pp, w = _cell_samples(r_axis, phi_axis)
-    h_local = interface_conductance(spring, hp, rr, pp)
-    shank = _rivet_share(rr, pp, centres, hp.rivet_shank_diameter_m / 2.0)
-    h_iface = np.sum(w * np.where(shank > 0, hp.rivet_clinch_contact_W_per_m2_K, h_local), axis=2)
-    f_rivet = np.sum(w * shank, axis=2)
 
-    # layers: (name, z planes above the previous, cell mask)
-    t_int = INTERFACE_THICKNESS_M
+def _layers(spring: SpringParams, hp: HeatPathParams, e: float) -> tuple[list[float], list[tuple[str, int]]]:
+    """Heights of the z planes from the mid-plane up, and the sub-layers as (part, index of their top plane)."""
     n_sub = lambda t: max(1, math.ceil(t / (0.6 * e) - 1e-9))  # noqa: E731
     t_c2 = hp.carrier_thickness_m / 2.0
     low = hp.facing_thickness_m * (1.0 - hp.counterbore_depth_fraction)
@@ -267,16 +263,24 @@ def sector_mesh(spring: SpringParams, hp: HeatPathParams, element_size_m: float)
             layers.append((part, len(z) - 1))
 
     add("CARRIER", _sublayers(z[-1], t_c2, n_sub(t_c2)))
-    add("JOINT", [z[-1] + t_int])
-    add("PADDLE", [z[-1] + g.thickness_m])
-    add("INTERFACE", [z[-1] + t_int])
+    add("JOINT", [z[-1] + INTERFACE_THICKNESS_M])
+    add("PADDLE", [z[-1] + spring.geometry.thickness_m])
+    add("INTERFACE", [z[-1] + INTERFACE_THICKNESS_M])
     add("FACING_LOW", _sublayers(z[-1], low, n_sub(low) + 1, grade=1 / 1.6))
     add("FACING_UP", _sublayers(z[-1], up, n_sub(up) + 1, grade=1.6))
-    masks = {"CARRIER": carrier, "JOINT": clamp, "PADDLE": paddle, "INTERFACE": paddle,
-             "FACING_LOW": on_facing, "FACING_UP": on_facing}
-    nz = len(z)
+    return z, layers
 
-    # nodes on the full grid, elements where the layer has a cell
+
+def _bricks(plan: _Plan, z: list[float], layers: list[tuple[str, int]]):
+    """Nodes on the full grid and the bricks of every layer where its part has a cell.
+
+    Returns all nodes (m), connectivity, each brick's part, layer and plan cell (i, j), and the occupancy
+    (layer, i, j).
+    """
+    r_axis, phi_axis = plan.r_axis, plan.phi_axis
+    nr, nphi, nz = len(r_axis) - 1, len(phi_axis) - 1, len(z)
+    masks = {"CARRIER": plan.carrier, "JOINT": plan.clamp, "PADDLE": plan.paddle, "INTERFACE": plan.paddle,
+             "FACING_LOW": plan.on_facing, "FACING_UP": plan.on_facing}
     R, P, Z = np.meshgrid(r_axis, np.radians(phi_axis), np.array(z), indexing="ij")
     all_nodes = np.stack([R * np.cos(P), R * np.sin(P), Z], axis=-1).reshape(-1, 3)
     nid = lambda i, j, k: (i * (nphi + 1) + j) * nz + k  # noqa: E731
@@ -294,15 +298,24 @@ def sector_mesh(spring: SpringParams, hp: HeatPathParams, element_size_m: float)
         parts += [part] * len(i)
         layer_of.append(np.full(len(i), li))
         cells.append(np.stack([i, j], axis=1))
-    conn = np.concatenate(elems)
-    parts_a = np.array(parts)
-    layer_a = np.concatenate(layer_of)
-    cell_a = np.concatenate(cells)
+    return (all_nodes, np.concatenate(elems), np.array(parts), np.concatenate(layer_of), np.concatenate(cells),
+            occ)
 
-    # properties
-    k = np.empty(len(conn))
-    rho = np.empty(len(conn))
-    c = np.empty(len(conn))
+
+def _properties(spring: SpringParams, hp: HeatPathParams, plan: _Plan, parts_a: np.ndarray, cell_a: np.ndarray):
+    """Conductivity, density and specific heat of every brick, and the rivet-column mask.
+
+    The joint and interface layers carry their contact conductance as a conductivity over their
+    thickness; lining cells crossed by a rivet shank mix rivet and lining by its area share.
+    """
+    t_int = INTERFACE_THICKNESS_M
+    rr, pp, w = _cell_samples(plan.r_axis, plan.phi_axis)
+    h_local = interface_conductance(spring, hp, rr, pp)
+    shank = _rivet_share(rr, pp, plan.rivet_centres, hp.rivet_shank_diameter_m / 2.0)
+    h_iface = np.sum(w * np.where(shank > 0, hp.rivet_clinch_contact_W_per_m2_K, h_local), axis=2)
+    f_rivet = np.sum(w * shank, axis=2)
+    n = len(parts_a)
+    k, rho, c = np.empty(n), np.empty(n), np.empty(n)
     ci, cj = cell_a[:, 0], cell_a[:, 1]
     steel = (parts_a == "CARRIER") | (parts_a == "PADDLE")
     k[steel], rho[steel], c[steel] = hp.steel_conductivity_W_per_m_K, hp.steel_density_kg_m3, \
@@ -321,17 +334,25 @@ def sector_mesh(spring: SpringParams, hp: HeatPathParams, element_size_m: float)
         (1 - f) * hp.lining_density_kg_m3 * hp.lining_specific_heat_J_per_kg_K
     rho[col] = f * hp.rivet_density_kg_m3 + (1 - f) * hp.lining_density_kg_m3
     c[col] = rho_c / rho[col]
+    return k, rho, c, col
 
-    # exterior faces from the occupancy of neighbours
-    nl = len(layers)
+
+def _exterior_faces(occ: np.ndarray, layer_a: np.ndarray, cell_a: np.ndarray,
+                    adiabatic_part: np.ndarray) -> dict[str, list[np.ndarray]]:
+    """Exterior faces (element, face 1-6) from the occupancy of neighbours, grouped by their boundary.
+
+    The mid-plane (z = 0) and the periodic cuts (phi = 0, phi = sector) are no boundary; the joint and
+    interface layers (contact conductances) have none either.
+    """
+    nl, nr, nphi = occ.shape
+    ci, cj = cell_a[:, 0], cell_a[:, 1]
     pad = np.zeros((nl + 2, nr + 2, nphi + 2), dtype=bool)
     pad[1:-1, 1:-1, 1:-1] = occ
     li, i, j = layer_a + 1, ci + 1, cj + 1
     open_ = {1: ~pad[li - 1, i, j], 2: ~pad[li + 1, i, j], 3: ~pad[li, i, j - 1], 4: ~pad[li, i + 1, j],
              5: ~pad[li, i, j + 1], 6: ~pad[li, i - 1, j]}
-    adiabatic_part = joint | iface
     groups: dict[str, list[np.ndarray]] = {"FRICTION": [], "HUB": [], "CONVECTION": []}
-    eidx = np.arange(len(conn))
+    eidx = np.arange(len(layer_a))
     for face, is_open in open_.items():
         ok = is_open & ~adiabatic_part
         if face == 1:
@@ -351,6 +372,37 @@ def sector_mesh(spring: SpringParams, hp: HeatPathParams, element_size_m: float)
             groups["HUB"].append(np.stack([sel[hub], fn[hub]], axis=1))
             sel, fn = sel[~hub], fn[~hub]
         groups["CONVECTION"].append(np.stack([sel, fn], axis=1))
+    return groups
+
+
+def _volumes(nodes: np.ndarray, conn: np.ndarray) -> np.ndarray:
+    """Brick volumes, m^3: plan area of the bottom face (shoelace) times the height."""
+    xy = nodes[conn[:, :4], :2]
+    area = 0.5 * np.abs(np.sum(xy[:, :, 0] * np.roll(xy[:, :, 1], -1, axis=1)
+                               - np.roll(xy[:, :, 0], -1, axis=1) * xy[:, :, 1], axis=1))
+    return area * (nodes[conn[:, 4], 2] - nodes[conn[:, 0], 2])
+
+
+def sector_mesh(spring: SpringParams, hp: HeatPathParams, element_size_m: float) -> HeatMesh:
+    """Mesh the sector (see the module docstring).
+
+    Parameters
+    ----------
+    spring : SpringParams
+        The spring (radii, span, thickness, wave, clamp zone, number of pairs).
+    hp : HeatPathParams
+        Facing, carrier, rivets, conductances.
+    element_size_m : float
+        Largest in-plane element edge at the facing's mean radius, m; the layers'
+        sub-division follows it.
+    """
+    e = element_size_m
+    plan = _plan(spring, hp, e)
+    z, layers = _layers(spring, hp, e)
+    all_nodes, conn, parts_a, layer_a, cell_a, occ = _bricks(plan, z, layers)
+    k, rho, c, col = _properties(spring, hp, plan, parts_a, cell_a)
+    joint, iface = parts_a == "JOINT", parts_a == "INTERFACE"
+    groups = _exterior_faces(occ, layer_a, cell_a, joint | iface)
 
     # drop unused nodes, renumber
     used = np.unique(conn)
@@ -358,15 +410,12 @@ def sector_mesh(spring: SpringParams, hp: HeatPathParams, element_size_m: float)
     new[used] = np.arange(len(used))
     nodes = all_nodes[used]
     conn = new[conn]
-    # volumes: plan area of the bottom face (shoelace) times the height
-    xy = nodes[conn[:, :4], :2]
-    area = 0.5 * np.abs(np.sum(xy[:, :, 0] * np.roll(xy[:, :, 1], -1, axis=1)
-                               - np.roll(xy[:, :, 0], -1, axis=1) * xy[:, :, 1], axis=1))
-    vol = area * (nodes[conn[:, 4], 2] - nodes[conn[:, 0], 2])
+    eidx = np.arange(len(conn))
+    lining = (parts_a == "FACING_LOW") | (parts_a == "FACING_UP")
     sets = {"CARRIER": eidx[parts_a == "CARRIER"], "JOINT": eidx[joint], "PADDLE": eidx[parts_a == "PADDLE"],
             "INTERFACE": eidx[iface], "FACING": eidx[lining], "RIVET": eidx[col]}
-    mesh = HeatMesh(nodes, conn, k, rho, c, vol, sets, {n: np.concatenate(v) for n, v in groups.items()}, {},
-                    2 * spring.n_pairs, e)
+    mesh = HeatMesh(nodes, conn, k, rho, c, _volumes(nodes, conn), sets,
+                    {n: np.concatenate(v) for n, v in groups.items()}, {}, 2 * spring.n_pairs, e)
     for name, fc in mesh.faces.items():
         q = nodes[mesh.face_nodes(fc)]
         d1, d2 = q[:, 2] - q[:, 0], q[:, 3] - q[:, 1]

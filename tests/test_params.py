@@ -48,7 +48,7 @@ def test_unknown_key_is_named(tmp_path):
 def test_out_of_range_names_key_and_range(tmp_path):
     f = tmp_path / "s.toml"
     text = DEFAULT_SPRING.read_text().replace("thickness_m = 0.42e-3", "thickness_m = 0.04")
-    text = text.replace("poisson_ratio = 0.3", "poisson_ratio = 0.7")
+    text = text.replace("\npoisson_ratio = 0.3", "\npoisson_ratio = 0.7")      # the material's, not joint.carrier_poisson_ratio
     f.write_text(text)
     with pytest.raises(ParameterError) as info:
         load_params(f)

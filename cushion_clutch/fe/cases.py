@@ -47,6 +47,7 @@ from .ccx import RunStats, ccx_version, run_ccx
 from .cluster import open_cluster
 from .cluster import run_cases as run_on_cluster
 from .deck import paddle_deck
+from .joint import resolve_far_end
 from .geometry import half_pair_assembly, pair_assembly
 from .params import SpringParams
 from .results import CaseResult, parse_case
@@ -118,6 +119,7 @@ def solve_case(params: SpringParams, theta_degC: float, workdir: Path, *, paddle
     on_increment : callable, optional
         Called with the running count of converged increments.
     """
+    params = resolve_far_end(params)              # the predicted joint's stiffness unless one is given
     size = params.mesh.element_size_m
     build = half_pair_assembly if paddles == 1 else pair_assembly
     assembly = build(params.geometry, size, params.solver.initial_gap_m, params.mesh.element_type)

@@ -101,3 +101,12 @@ def test_deck_refuses_an_unresolved_joint():
     anchors = far_end_anchors(asm, p.replace(carrier={"far_end_stiffness_N_per_m": 6.0e6}))
     assert sum(k for *_, k in anchors) == pytest.approx(6.0e6 / 1e3)  # N/mm over the edge, shared
     assert np.all(np.array([k for *_, k in anchors]) > 0)
+
+
+def test_spring_with_and_without_the_override_reads_back_from_toml(tmp_path):
+    """TOML has no null: the predicted joint (None) is written by leaving the key out, an override as a number."""
+    from cushion_clutch.fe.studies.calibration_report import params_toml
+    for p in (load_params(), load_params().replace(carrier={"far_end_stiffness_N_per_m": 7.5e6})):
+        f = tmp_path / "s.toml"
+        f.write_text(params_toml(p))
+        assert load_params(f) == p

@@ -204,10 +204,14 @@ def toml_key(key: str) -> str:
 
 def toml_document(doc: dict[str, Any], header: str = "") -> str:
     """``doc`` as TOML text that :func:`load_toml` reads back equal: ``header`` as comment lines,
-    then top-level values, then one ``[section]`` per dict (dicts inside sections as inline tables)."""
+    then top-level values, then one ``[section]`` per dict (dicts inside sections as inline tables).
+
+    ``None`` values are left out: TOML has no null, and a key left out reads back as its field's default,
+    which is ``None`` for every optional field (e.g. ``carrier.far_end_stiffness_N_per_m``)."""
     lines = [f"# {h}" for h in header.splitlines()]
-    lines += [f"{toml_key(k)} = {toml_value(v)}" for k, v in doc.items() if not isinstance(v, dict)]
+    lines += [f"{toml_key(k)} = {toml_value(v)}" for k, v in doc.items() if not isinstance(v, dict) and v is not None]
     for sec, vals in doc.items():
         if isinstance(vals, dict):
-            lines += ["", f"[{toml_key(sec)}]"] + [f"{toml_key(k)} = {toml_value(v)}" for k, v in vals.items()]
+            lines += ["", f"[{toml_key(sec)}]"] + [f"{toml_key(k)} = {toml_value(v)}" for k, v in vals.items()
+                                                   if v is not None]
     return "\n".join(lines) + "\n"

@@ -34,7 +34,7 @@ CALIBRATION_SOURCES = ("cushion_clutch/benchmarks/calibrate.py", "cushion_clutch
                        "cushion_clutch/fe/studies/measured.py", "cushion_clutch/fe/studies/calibration_report.py")
 #: the heat path (a transient thermal FE of the disc sector and the kiss shift under its field, about 10 min)
 HEAT_PATH_SOURCES = ("cushion_clutch/fe/heat_*.py", "cushion_clutch/fe/kiss_field.py", "cushion_clutch/fe/deck.py",
-                     "cushion_clutch/fe/springs/default.toml")
+                     "cushion_clutch/fe/joint.py", "cushion_clutch/fe/springs/default.toml")
 #: the fleet study (1000 samples of three TCUs on Dask, about 15 min; docs/results/fleet.md names its commit)
 FLEET_SOURCES = ("cushion_clutch/benchmarks/fleet.py", "cushion_clutch/launch/fleet/run.py",
                  "cushion_clutch/launch/fleet/population.py", "cushion_clutch/launch/populations/*.toml")

@@ -74,16 +74,28 @@ def test_first_contact_and_full_compression_are_continuous_in_theta(table):
         assert jump < 1e-3       # N; the force's theta slope is < 10 N/K
 
 
-def test_first_contact_is_where_the_force_starts(table):
-    """A curve that begins with two 0 N rows (in the shipped tables the 80 and 195 degC ones) has its first
+def test_first_contact_is_where_the_force_starts(table, tmp_path):
+    """A curve that begins with two 0 N rows (the FE's first increments can both carry nothing; the shipped tables
+    had two such curves before the predicted joint, now none, so one is made from the 80 degC curve) has its first
     contact at the second row; every temperature's first contact is where the force starts."""
-    doubled = [(th, c) for th, c in zip(table.theta_degC, table.curves) if c.y[0] == c.y[1] == 0.0]
-    assert doubled, "no curve of the shipped tables starts with two 0 N rows: the case is not exercised"
-    for th, c in doubled:
-        assert 0.0 < c.y[2] and table.first_contact(th) == c.x[1]
-    for t in (-40.0, -10.0, 20.0, 137.5, 195.0, 260.0, 300.0, 350.0):
-        a = table.first_contact(t)
-        assert table.force(a, t) == 0.0 < table.force(a + 1e-7, t)
+    import shutil
+    folder = tmp_path / "doubled"
+    shutil.copytree(DEFAULT_TABLES, folder)
+    rows = (folder / "force_deflection.csv").read_text().splitlines()
+    first = next(i for i, r in enumerate(rows[1:], 1) if r.startswith("80,"))
+    u0, u1 = float(rows[first].split(",")[1]), float(rows[first + 1].split(",")[1])
+    assert float(rows[first].split(",")[2]) == 0.0
+    rows.insert(first + 1, f"80,{0.5 * (u0 + u1):.9e},0.000000")
+    (folder / "force_deflection.csv").write_text("\n".join(rows) + "\n")
+    made = load_table(folder)
+    for tab in (table, made):
+        doubled = [(th, c) for th, c in zip(tab.theta_degC, tab.curves) if c.y[0] == c.y[1] == 0.0]
+        for th, c in doubled:
+            assert 0.0 < c.y[2] and tab.first_contact(th) == c.x[1]
+        for t in (-40.0, -10.0, 20.0, 137.5, 195.0, 260.0, 300.0, 350.0):
+            a = tab.first_contact(t)
+            assert tab.force(a, t) == 0.0 < tab.force(a + 1e-7, t)
+    assert [th for th, c in zip(made.theta_degC, made.curves) if c.y[0] == c.y[1] == 0.0] == [80.0]
 
 
 def test_clamped_outside_table_temperatures(table):

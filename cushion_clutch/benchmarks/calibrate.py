@@ -59,6 +59,7 @@ def synthetic_curves(truth, temperatures, cache: Path, noise: float = 0.01, poin
 def main(argv=None) -> None:
     from cushion_clutch.fe.studies.calibrate import calibrate, fit_keys, with_values
     from cushion_clutch.fe.studies.calibration_report import plot_calibration, report_text
+    from cushion_clutch.fe.joint import resolve_far_end
     from cushion_clutch.fe.params import load_params
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -74,6 +75,7 @@ def main(argv=None) -> None:
     args = ap.parse_args(argv)
     names = (args.fit or ("thickness_m,temperature_ratio" if args.hot else "wave_height_m,thickness_m")).split(",")
     base = load_params().replace(mesh={"element_size_m": args.mesh}, sweep={"temperatures_degC": (20.0,)})
+    base = resolve_far_end(base)       # the predicted joint as a number, so that it can be perturbed and fitted
     tkeys = fit_keys(base, (args.truth or ",".join(names)).split(","))
     true_all = np.array([getattr(getattr(base, s), k) * TRUTH[k] for s, k in tkeys])
     with tempfile.TemporaryDirectory() as tmp:

@@ -84,6 +84,38 @@ def thermal_bar(key: str) -> float:
     return d["energy_J"] / 1e3 if key == "energy_kJ" else d[key]
 
 
+def joint_MN_per_m(part: str = "far_end_stiffness_N_per_m") -> float:
+    """The default tables' far-edge joint, MN/m, as the sweep that made them recorded it (``metadata.json``
+    ``far_end``: ``far_end_stiffness_N_per_m``, the tab and rivets in series; ``tab_N_per_m``;
+    ``rivets_N_per_m``), predicted by :mod:`cushion_clutch.fe.joint`."""
+    import json
+
+    from cushion_clutch.data import DEFAULT_TABLES
+    meta = json.loads((DEFAULT_TABLES / "metadata.json").read_text(encoding="utf-8"))
+    return meta["far_end"][part] / 1e6
+
+
+@functools.lru_cache(maxsize=None)
+def _tab_checks() -> dict:
+    from cushion_clutch.fe import joint as J
+    from cushion_clutch.fe.params import load_params
+
+    p = load_params()
+    j, t, e = p.joint, p.geometry.thickness_m, p.material.youngs_modulus(p.material.reference_temperature_degC)
+    return {"timoshenko": J.timoshenko_tab_stiffness(j), "clamped_8": J.tab_stiffness_fe(j, 8, root="clamped"),
+            "carrier_4": J.tab_stiffness_fe(j, 4), "carrier_8": J.tab_stiffness_fe(j, 8),
+            "carrier_16": J.tab_stiffness_fe(j, 16),
+            "huth": J.huth_rivet_stiffness(j, t, e), "swift": J.swift_rivet_stiffness(j, t, e)}
+
+
+def tab_check_MN_per_m(key: str) -> float:
+    """The default joint's checks, MN/m, computed at build (CalculiX, a few seconds): ``timoshenko`` (the tab
+    as a clamped Timoshenko cantilever), ``clamped_8`` (the tab's FE with its root clamped, 8 elements across),
+    ``carrier_4``/``carrier_8``/``carrier_16`` (the FE with the carrier body at the root, 4/8/16 elements
+    across; 8 is the model's), ``huth``/``swift`` (one rivet by each formula)."""
+    return _tab_checks()[key] / 1e6
+
+
 #: name -> (function, default format)
 NUMBERS: dict[str, tuple[Callable[..., float], str]] = {
     "closed_torque_Nm": (closed_torque_Nm, ".1f"),
@@ -92,6 +124,8 @@ NUMBERS: dict[str, tuple[Callable[..., float], str]] = {
     "cover_mm": (cover_mm, "g"),
     "engine_peak_Nm": (engine_peak_Nm, ".0f"),
     "thermal_bar": (thermal_bar, ".4g"),
+    "joint_MN_per_m": (joint_MN_per_m, ".2f"),
+    "tab_check_MN_per_m": (tab_check_MN_per_m, ".2f"),
 }
 
 CALL = re.compile(r"^\s*(?P<name>\w+)\s*(?:\((?P<args>.*)\))?\s*(?::(?P<spec>[^:()]+))?\s*$")

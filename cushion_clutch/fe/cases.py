@@ -47,6 +47,7 @@ from .ccx import RunStats, ccx_version, run_ccx
 from .cluster import open_cluster
 from .cluster import run_cases as run_on_cluster
 from .deck import paddle_deck
+from .joint import resolve_far_end
 from .geometry import half_pair_assembly, pair_assembly
 from .params import SpringParams
 from .results import CaseResult, parse_case
@@ -118,6 +119,7 @@ def solve_case(params: SpringParams, theta_degC: float, workdir: Path, *, paddle
     on_increment : callable, optional
         Called with the running count of converged increments.
     """
+    params = resolve_far_end(params)              # the predicted joint's stiffness unless one is given
     size = params.mesh.element_size_m
     build = half_pair_assembly if paddles == 1 else pair_assembly
     assembly = build(params.geometry, size, params.solver.initial_gap_m, params.mesh.element_type)
@@ -145,27 +147,34 @@ def check_heating(result: CaseResult, params: SpringParams) -> None:
     """Refuse a case in which heating alone pressed the paddle on a plate (a spurious force).
 
     The plates are held during heating, so any force on them then is an
-    artefact: the carrier clearance is below the paddle's growth towards the
-    carrier (or within the contact law's reach of it).
+    artefact: on the carrier, the carrier clearance is below the paddle's growth
+    towards the carrier (or within the contact law's reach of it); on the upper
+    plate, the hot wave's crest grew through the start gap ``solver.initial_gap_m``.
 
     Raises
     ------
     ResultError
-        Naming the force, the clearance and the least clearance to try.
+        Naming the force, the plate, and the clearance (least value to try) or the start gap.
     """
     from ..errors import ResultError
     limit = HEATING_FORCE_FRACTION * params.sweep.kiss_force_N
     worst = max(abs(result.thermal_force_N), abs(result.thermal_force_lower_N))
-    if worst > limit:
+    if worst <= limit:
+        return
+    head = f"theta = {result.theta_degC:g} degC: heating alone pressed the paddle on "
+    tail = f"with {worst:.3g} N (limit {limit:.3g} N, {HEATING_FORCE_FRACTION:.0%} of the kiss force): "
+    if abs(result.thermal_force_lower_N) >= abs(result.thermal_force_N):
         g = params.geometry
         raise ResultError(
-            f"theta = {result.theta_degC:g} degC: heating alone pressed the paddle on "
-            f"{'the carrier' if abs(result.thermal_force_lower_N) >= abs(result.thermal_force_N) else 'a plate'} "
-            f"with {worst:.3g} N (limit {limit:.3g} N, {HEATING_FORCE_FRACTION:.0%} of the kiss force): "
-            f"geometry.carrier_clearance_m = {g.carrier_clearance_m:g} m is below the paddle's growth towards "
-            f"the carrier (the sheet alone: {params.min_carrier_clearance_m():.3g} m at "
+            f"{head}the carrier {tail}geometry.carrier_clearance_m = {g.carrier_clearance_m:g} m is below the "
+            f"paddle's growth towards the carrier (the sheet alone: {params.min_carrier_clearance_m():.3g} m at "
             f"{max(params.sweep.temperatures_degC):g} degC) plus the contact law's reach; use at least "
             f"{max(1e-5, 2 * params.min_carrier_clearance_m()):.3g} m")
+    # the upper plate (the facing side): the hot wave grew into the start gap (a stiff far-edge joint grows it most)
+    raise ResultError(
+        f"{head}the upper plate {tail}the hot wave's crest grew by more than solver.initial_gap_m = "
+        f"{params.solver.initial_gap_m:g} m (the plate's start gap) less the contact law's reach; raise "
+        f"solver.initial_gap_m")
 
 
 def idle_threads(slots: int, n_cases: int) -> int:

@@ -238,8 +238,19 @@ def far_end_anchors(assembly: Assembly, params: SpringParams) -> list[tuple[int,
     """Carrier anchor of each far-edge node: (anchor id, node id, anchor xyz m, k N/mm).
 
     Each anchor sits ``ANCHOR_LENGTH_M`` further along the circumference; the
-    edge's total stiffness is shared by tributary length along the edge.
+    edge's total stiffness (``carrier.far_end_stiffness_N_per_m``: the joint of
+    :mod:`.joint`, tab and rivets in series, set by :func:`.joint.resolve_far_end`)
+    is shared by tributary length along the edge: the far zone, 36 mm deep in its
+    plane, moves as one piece against one stiffness.
+
+    Raises
+    ------
+    ValueError
+        The stiffness is not set (the joint not resolved): the deck writer runs nothing.
     """
+    if params.carrier.far_end_stiffness_N_per_m is None:
+        raise ValueError("carrier.far_end_stiffness_N_per_m is None: resolve the joint first "
+                         "(cushion_clutch.fe.joint.resolve_far_end)")
     mesh = assembly.mesh
     far = np.asarray(mesh.node_sets["FAR_END"])
     first = mesh.n_nodes + 1 + 10 * len(assembly.plates)    # after plate, ref and rot nodes

@@ -208,15 +208,114 @@ def _sublayers(z0: float, thickness: float, n: int, grade: float = 1.0) -> list[
     return list(z0 + thickness * np.cumsum(w) / w.sum())
 
 
-def _properties(hp: HeatPathParams, parts_a: np.ndarray, cell_a: np.ndarray, h_iface: np.ndarray,
-                f_rivet: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Per element: conductivity (W/(m K)), density (kg/m3) and specific heat (J/(kg K)) by part (the contact
-    layers as thin layers of k = h t, the rivet columns mixed into the lower lining by their cell share
-    ``f_rivet``), and the mask of the lining elements that hold a rivet column."""
+@dataclass(frozen=True)
+class _Plan:
+    """The sector's plan grid: axes (r m, phi deg) and which cells each part occupies."""
+
+    r_axis: np.ndarray
+    phi_axis: np.ndarray
+    on_facing: np.ndarray
+    paddle: np.ndarray
+    clamp: np.ndarray
+    carrier: np.ndarray
+    rivet_centres: list[tuple[float, float]]
+
+
+def _plan(spring: SpringParams, hp: HeatPathParams, e: float) -> _Plan:
+    """Plan axes through every part's edge, finer (REFINE x) across the crest strip and the rivets."""
+    g = spring.geometry
+    r_i, r_o, r_h = g.inner_radius_m, g.outer_radius_m, hp.carrier_inner_radius_m
+    if not r_h < r_i:
+        raise ValueError(f"heat_path.carrier_inner_radius_m = {r_h!r}: must be below the paddle's inner radius {r_i!r}")
+    sector = 360.0 / spring.n_pairs
+    # finer (REFINE x) across the crest's contact strip and the rivets, where the heat crowds into the lining
+    centres = rivet_centres(spring, hp)
+    band = 0.5 * hp.rivet_head_diameter_m + 1e-3
+    r_fine = [(rc_ - band, rc_ + band) for rc_, _ in centres]
+    r_axis = _refined_axis([r_h, r_i, r_o], e, r_fine)
+    r_mean = 0.5 * (r_i + r_o)
+    e_deg = math.degrees(e / r_mean)
+    b_deg = math.degrees(band / r_mean)
+    breaks = [0.0, g.clamp_start_deg, g.clamp_end_deg, *wave_breaks_deg(g), g.span_deg, sector]
+    phi_axis = _refined_axis([b for b in breaks if b <= sector], e_deg,
+                             [(c - b_deg, c + b_deg) for c in crest_angles_deg(spring)])
+    rc = 0.5 * (r_axis[:-1] + r_axis[1:])[:, None] + 0.0 * phi_axis[None, :-1]
+    pc = 0.0 * r_axis[:-1, None] + 0.5 * (phi_axis[:-1] + phi_axis[1:])[None, :]
+    on_facing = (rc > r_i) & (rc < r_o)
+    paddle = on_facing & (pc < g.span_deg)
+    clamp = paddle & (pc > g.clamp_start_deg) & (pc < g.clamp_end_deg)
+    carrier = (rc < r_i) | clamp
+    return _Plan(r_axis, phi_axis, on_facing, paddle, clamp, carrier, centres)
+
+
+def _layers(spring: SpringParams, hp: HeatPathParams, e: float) -> tuple[list[float], list[tuple[str, int]]]:
+    """Heights of the z planes from the mid-plane up, and the sub-layers as (part, index of their top plane)."""
+    n_sub = lambda t: max(1, math.ceil(t / (0.6 * e) - 1e-9))  # noqa: E731
+    t_c2 = hp.carrier_thickness_m / 2.0
+    low = hp.facing_thickness_m * (1.0 - hp.counterbore_depth_fraction)
+    up = hp.facing_thickness_m - low
+    z = [0.0]
+    layers: list[tuple[str, int]] = []          # (part, index of the sub-layer's top plane)
+
+    def add(part: str, tops: list[float]) -> None:
+        for t in tops:
+            z.append(t)
+            layers.append((part, len(z) - 1))
+
+    add("CARRIER", _sublayers(z[-1], t_c2, n_sub(t_c2)))
+    add("JOINT", [z[-1] + INTERFACE_THICKNESS_M])
+    add("PADDLE", [z[-1] + spring.geometry.thickness_m])
+    add("INTERFACE", [z[-1] + INTERFACE_THICKNESS_M])
+    add("FACING_LOW", _sublayers(z[-1], low, n_sub(low) + 1, grade=1 / 1.6))
+    add("FACING_UP", _sublayers(z[-1], up, n_sub(up) + 1, grade=1.6))
+    return z, layers
+
+
+def _bricks(plan: _Plan, z: list[float], layers: list[tuple[str, int]]):
+    """Nodes on the full grid and the bricks of every layer where its part has a cell.
+
+    Returns all nodes (m), connectivity, each brick's part, layer and plan cell (i, j), and the occupancy
+    (layer, i, j).
+    """
+    r_axis, phi_axis = plan.r_axis, plan.phi_axis
+    nr, nphi, nz = len(r_axis) - 1, len(phi_axis) - 1, len(z)
+    masks = {"CARRIER": plan.carrier, "JOINT": plan.clamp, "PADDLE": plan.paddle, "INTERFACE": plan.paddle,
+             "FACING_LOW": plan.on_facing, "FACING_UP": plan.on_facing}
+    R, P, Z = np.meshgrid(r_axis, np.radians(phi_axis), np.array(z), indexing="ij")
+    all_nodes = np.stack([R * np.cos(P), R * np.sin(P), Z], axis=-1).reshape(-1, 3)
+    nid = lambda i, j, k: (i * (nphi + 1) + j) * nz + k  # noqa: E731
+    occ = np.zeros((len(layers), nr, nphi), dtype=bool)
+    elems, parts, layer_of, cells = [], [], [], []
+    I, J = np.meshgrid(np.arange(nr), np.arange(nphi), indexing="ij")
+    for li, (part, ktop) in enumerate(layers):
+        m = masks[part]
+        occ[li] = m
+        i, j = I[m], J[m]
+        kb = ktop - 1
+        conn = np.stack([nid(i, j, kb), nid(i + 1, j, kb), nid(i + 1, j + 1, kb), nid(i, j + 1, kb),
+                         nid(i, j, ktop), nid(i + 1, j, ktop), nid(i + 1, j + 1, ktop), nid(i, j + 1, ktop)], axis=1)
+        elems.append(conn)
+        parts += [part] * len(i)
+        layer_of.append(np.full(len(i), li))
+        cells.append(np.stack([i, j], axis=1))
+    return (all_nodes, np.concatenate(elems), np.array(parts), np.concatenate(layer_of), np.concatenate(cells),
+            occ)
+
+
+def _properties(spring: SpringParams, hp: HeatPathParams, plan: _Plan, parts_a: np.ndarray, cell_a: np.ndarray):
+    """Conductivity, density and specific heat of every brick, and the rivet-column mask.
+
+    The joint and interface layers carry their contact conductance as a conductivity over their
+    thickness; lining cells crossed by a rivet shank mix rivet and lining by its area share.
+    """
     t_int = INTERFACE_THICKNESS_M
-    k = np.empty(len(parts_a))
-    rho = np.empty(len(parts_a))
-    c = np.empty(len(parts_a))
+    rr, pp, w = _cell_samples(plan.r_axis, plan.phi_axis)
+    h_local = interface_conductance(spring, hp, rr, pp)
+    shank = _rivet_share(rr, pp, plan.rivet_centres, hp.rivet_shank_diameter_m / 2.0)
+    h_iface = np.sum(w * np.where(shank > 0, hp.rivet_clinch_contact_W_per_m2_K, h_local), axis=2)
+    f_rivet = np.sum(w * shank, axis=2)
+    n = len(parts_a)
+    k, rho, c = np.empty(n), np.empty(n), np.empty(n)
     ci, cj = cell_a[:, 0], cell_a[:, 1]
     steel = (parts_a == "CARRIER") | (parts_a == "PADDLE")
     k[steel], rho[steel], c[steel] = hp.steel_conductivity_W_per_m_K, hp.steel_density_kg_m3, \
@@ -240,9 +339,11 @@ def _properties(hp: HeatPathParams, parts_a: np.ndarray, cell_a: np.ndarray, h_i
 
 def _exterior_faces(occ: np.ndarray, layer_a: np.ndarray, cell_a: np.ndarray,
                     adiabatic_part: np.ndarray) -> dict[str, list[np.ndarray]]:
-    """The exterior faces (element, face number 1..6) found from the occupancy ``occ`` (layer, r cell, phi cell)
-    of the neighbours, grouped FRICTION (the top layer's tops), HUB (the inner rim) and CONVECTION (the rest);
-    none on the contact layers (``adiabatic_part``), the mirror plane z = 0 and the periodic cuts."""
+    """Exterior faces (element, face 1-6) from the occupancy of neighbours, grouped by their boundary.
+
+    The mid-plane (z = 0) and the periodic cuts (phi = 0, phi = sector) are no boundary; the joint and
+    interface layers (contact conductances) have none either.
+    """
     nl, nr, nphi = occ.shape
     ci, cj = cell_a[:, 0], cell_a[:, 1]
     pad = np.zeros((nl + 2, nr + 2, nphi + 2), dtype=bool)
@@ -274,6 +375,14 @@ def _exterior_faces(occ: np.ndarray, layer_a: np.ndarray, cell_a: np.ndarray,
     return groups
 
 
+def _volumes(nodes: np.ndarray, conn: np.ndarray) -> np.ndarray:
+    """Brick volumes, m^3: plan area of the bottom face (shoelace) times the height."""
+    xy = nodes[conn[:, :4], :2]
+    area = 0.5 * np.abs(np.sum(xy[:, :, 0] * np.roll(xy[:, :, 1], -1, axis=1)
+                               - np.roll(xy[:, :, 0], -1, axis=1) * xy[:, :, 1], axis=1))
+    return area * (nodes[conn[:, 4], 2] - nodes[conn[:, 0], 2])
+
+
 def sector_mesh(spring: SpringParams, hp: HeatPathParams, element_size_m: float) -> HeatMesh:
     """Mesh the sector (see the module docstring).
 
@@ -287,89 +396,13 @@ def sector_mesh(spring: SpringParams, hp: HeatPathParams, element_size_m: float)
         Largest in-plane element edge at the facing's mean radius, m; the layers'
         sub-division follows it.
     """
-    g = spring.geometry
     e = element_size_m
-    r_i, r_o, r_h = g.inner_radius_m, g.outer_radius_m, hp.carrier_inner_radius_m
-    if not r_h < r_i:
-        raise ValueError(f"heat_path.carrier_inner_radius_m = {r_h!r}: must be below the paddle's inner radius {r_i!r}")
-    sector = 360.0 / spring.n_pairs
-    # finer (REFINE x) across the crest's contact strip and the rivets, where the heat crowds into the lining
-    centres = rivet_centres(spring, hp)
-    band = 0.5 * hp.rivet_head_diameter_m + 1e-3
-    r_fine = [(rc_ - band, rc_ + band) for rc_, _ in centres]
-    r_axis = _refined_axis([r_h, r_i, r_o], e, r_fine)
-    r_mean = 0.5 * (r_i + r_o)
-    e_deg = math.degrees(e / r_mean)
-    b_deg = math.degrees(band / r_mean)
-    breaks = [0.0, g.clamp_start_deg, g.clamp_end_deg, *wave_breaks_deg(g), g.span_deg, sector]
-    phi_axis = _refined_axis([b for b in breaks if b <= sector], e_deg,
-                             [(c - b_deg, c + b_deg) for c in crest_angles_deg(spring)])
-    nr, nphi = len(r_axis) - 1, len(phi_axis) - 1
-    rc = 0.5 * (r_axis[:-1] + r_axis[1:])[:, None] + 0.0 * phi_axis[None, :-1]
-    pc = 0.0 * r_axis[:-1, None] + 0.5 * (phi_axis[:-1] + phi_axis[1:])[None, :]
-    on_facing = (rc > r_i) & (rc < r_o)
-    paddle = on_facing & (pc < g.span_deg)
-    clamp = paddle & (pc > g.clamp_start_deg) & (pc < g.clamp_end_deg)
-    carrier = (rc < r_i) | clamp
-
-    rr, pp, w = _cell_samples(r_axis, phi_axis)
-    h_local = interface_conductance(spring, hp, rr, pp)
-    shank = _rivet_share(rr, pp, centres, hp.rivet_shank_diameter_m / 2.0)
-    h_iface = np.sum(w * np.where(shank > 0, hp.rivet_clinch_contact_W_per_m2_K, h_local), axis=2)
-    f_rivet = np.sum(w * shank, axis=2)
-
-    # layers: (name, z planes above the previous, cell mask)
-    t_int = INTERFACE_THICKNESS_M
-    n_sub = lambda t: max(1, math.ceil(t / (0.6 * e) - 1e-9))  # noqa: E731
-    t_c2 = hp.carrier_thickness_m / 2.0
-    low = hp.facing_thickness_m * (1.0 - hp.counterbore_depth_fraction)
-    up = hp.facing_thickness_m - low
-    z = [0.0]
-    layers: list[tuple[str, int]] = []          # (part, index of the sub-layer's top plane)
-
-    def add(part: str, tops: list[float]) -> None:
-        for t in tops:
-            z.append(t)
-            layers.append((part, len(z) - 1))
-
-    add("CARRIER", _sublayers(z[-1], t_c2, n_sub(t_c2)))
-    add("JOINT", [z[-1] + t_int])
-    add("PADDLE", [z[-1] + g.thickness_m])
-    add("INTERFACE", [z[-1] + t_int])
-    add("FACING_LOW", _sublayers(z[-1], low, n_sub(low) + 1, grade=1 / 1.6))
-    add("FACING_UP", _sublayers(z[-1], up, n_sub(up) + 1, grade=1.6))
-    masks = {"CARRIER": carrier, "JOINT": clamp, "PADDLE": paddle, "INTERFACE": paddle,
-             "FACING_LOW": on_facing, "FACING_UP": on_facing}
-    nz = len(z)
-
-    # nodes on the full grid, elements where the layer has a cell
-    R, P, Z = np.meshgrid(r_axis, np.radians(phi_axis), np.array(z), indexing="ij")
-    all_nodes = np.stack([R * np.cos(P), R * np.sin(P), Z], axis=-1).reshape(-1, 3)
-    nid = lambda i, j, k: (i * (nphi + 1) + j) * nz + k  # noqa: E731
-    occ = np.zeros((len(layers), nr, nphi), dtype=bool)
-    elems, parts, layer_of, cells = [], [], [], []
-    I, J = np.meshgrid(np.arange(nr), np.arange(nphi), indexing="ij")
-    for li, (part, ktop) in enumerate(layers):
-        m = masks[part]
-        occ[li] = m
-        i, j = I[m], J[m]
-        kb = ktop - 1
-        conn = np.stack([nid(i, j, kb), nid(i + 1, j, kb), nid(i + 1, j + 1, kb), nid(i, j + 1, kb),
-                         nid(i, j, ktop), nid(i + 1, j, ktop), nid(i + 1, j + 1, ktop), nid(i, j + 1, ktop)], axis=1)
-        elems.append(conn)
-        parts += [part] * len(i)
-        layer_of.append(np.full(len(i), li))
-        cells.append(np.stack([i, j], axis=1))
-    conn = np.concatenate(elems)
-    parts_a = np.array(parts)
-    layer_a = np.concatenate(layer_of)
-    cell_a = np.concatenate(cells)
-
-    k, rho, c, col = _properties(hp, parts_a, cell_a, h_iface, f_rivet)
+    plan = _plan(spring, hp, e)
+    z, layers = _layers(spring, hp, e)
+    all_nodes, conn, parts_a, layer_a, cell_a, occ = _bricks(plan, z, layers)
+    k, rho, c, col = _properties(spring, hp, plan, parts_a, cell_a)
     joint, iface = parts_a == "JOINT", parts_a == "INTERFACE"
-    lining = (parts_a == "FACING_LOW") | (parts_a == "FACING_UP")
     groups = _exterior_faces(occ, layer_a, cell_a, joint | iface)
-    eidx = np.arange(len(conn))
 
     # drop unused nodes, renumber
     used = np.unique(conn)
@@ -377,15 +410,12 @@ def sector_mesh(spring: SpringParams, hp: HeatPathParams, element_size_m: float)
     new[used] = np.arange(len(used))
     nodes = all_nodes[used]
     conn = new[conn]
-    # volumes: plan area of the bottom face (shoelace) times the height
-    xy = nodes[conn[:, :4], :2]
-    area = 0.5 * np.abs(np.sum(xy[:, :, 0] * np.roll(xy[:, :, 1], -1, axis=1)
-                               - np.roll(xy[:, :, 0], -1, axis=1) * xy[:, :, 1], axis=1))
-    vol = area * (nodes[conn[:, 4], 2] - nodes[conn[:, 0], 2])
+    eidx = np.arange(len(conn))
+    lining = (parts_a == "FACING_LOW") | (parts_a == "FACING_UP")
     sets = {"CARRIER": eidx[parts_a == "CARRIER"], "JOINT": eidx[joint], "PADDLE": eidx[parts_a == "PADDLE"],
             "INTERFACE": eidx[iface], "FACING": eidx[lining], "RIVET": eidx[col]}
-    mesh = HeatMesh(nodes, conn, k, rho, c, vol, sets, {n: np.concatenate(v) for n, v in groups.items()}, {},
-                    2 * spring.n_pairs, e)
+    mesh = HeatMesh(nodes, conn, k, rho, c, _volumes(nodes, conn), sets,
+                    {n: np.concatenate(v) for n, v in groups.items()}, {}, 2 * spring.n_pairs, e)
     for name, fc in mesh.faces.items():
         q = nodes[mesh.face_nodes(fc)]
         d1, d2 = q[:, 2] - q[:, 0], q[:, 3] - q[:, 1]

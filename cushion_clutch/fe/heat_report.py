@@ -46,8 +46,10 @@ def numbers_markdown(result: dict) -> str:
                  "uniform_kappa_fe": f"uniform paddle temperature, carrier at the FE's κ = {ks['kappa_fe']:.3f}",
                  "field_kappa_fe": f"the FE's paddle field ({ks['field_min_over_mean']:.2f} to "
                                    f"{ks['field_max_over_mean']:.2f} of its mean rise), carrier at κ = {ks['kappa_fe']:.3f}"}
+        held = f"{ks['far_end_stiffness_N_per_m'] / 1e6:.2f} MN/m"
+        held += (" (predicted joint)" if ks.get("far_end_source", "").startswith("predicted") else " (given)")
         out += ["", f"| kiss shift at {ks['theta_degC']:g} °C (paddle mean), pair, structural mesh "
-                    f"{ks['mesh_m'] * 1e3:g} mm | Δ kiss | paper |", "|---|---|---|"]
+                    f"{ks['mesh_m'] * 1e3:g} mm, far edge held by {held} | Δ kiss | paper |", "|---|---|---|"]
         for key, label in names.items():
             v = ks["delta_kiss_m"].get(key)
             out.append(f"| {label} | {'failed: ' + ks['errors'].get(key, '') if v is None else f'{v * 1e3:.3f} mm'} | "

@@ -10,8 +10,10 @@ scaled to a paddle mean of ``theta_degC``, and compressed. Cases at ``theta_degC
 - ``uniform, kappa FE``: uniform paddle, carrier at the FE's ratio of carrier to paddle rise;
 - ``field, kappa FE``: the FE's field on the paddle, carrier at the FE's ratio.
 
-The tab stiffness stays the spring file's (hand-set to give about 0.1 mm at 195 degC with the uniform case);
-the table sets are not changed.
+All three hold the paddle's far edge with the same stiffness: the joint predicted from the spring file's
+``[joint]`` (the carrier tab's CalculiX model in series with the clamp rivets, :mod:`.joint`), or the
+spring's ``carrier.far_end_stiffness_N_per_m`` if it gives one. Nothing is fitted to the paper's 0.1 mm. The
+table sets (one uniform paddle temperature per row) are not changed here.
 """
 from __future__ import annotations
 
@@ -26,6 +28,7 @@ from scipy.interpolate import LinearNDInterpolator, NearestNDInterpolator
 from ..errors import CalculixError, ResultError
 from .ccx import run_ccx
 from .deck import paddle_deck
+from .joint import far_end_stiffness, resolve_far_end
 from .geometry import half_pair_assembly
 from .heat_mesh import HeatMesh
 from .params import SpringParams
@@ -68,7 +71,7 @@ def _kiss_travel(spring: SpringParams, theta_degC: float, workdir: Path, field: 
         s = s / s.mean()                                              # node mean = theta (uniform node spacing)
         ref = spring.material.reference_temperature_degC
         temps = ref + (theta_degC - ref) * s
-    deck, _ = paddle_deck(asm, spring, theta_degC, temps)
+    deck, _ = paddle_deck(asm, resolve_far_end(spring), theta_degC, temps)
     run_ccx(deck, workdir, threads=1, theta_degC=theta_degC)
     case = parse_case(workdir / "case.dat", theta_degC, asm.paddles)
     return curve_from_case(case, spring.n_pairs, spring.sweep.kiss_force_N).kiss_travel_m
@@ -101,12 +104,14 @@ def kiss_shift_study(spring: SpringParams, field: tuple[np.ndarray, np.ndarray, 
     return {
         "theta_degC": theta_degC, "mesh_m": KISS_MESH_M,
         "kappa_spring": spring.carrier.temperature_ratio, "kappa_fe": kappa_fe,
-        "far_end_stiffness_N_per_m": spring.carrier.far_end_stiffness_N_per_m,
+        "far_end_stiffness_N_per_m": far_end_stiffness(spring),
+        "far_end_source": ("predicted joint (fe/joint.py)" if spring.carrier.far_end_stiffness_N_per_m is None
+                           else "carrier.far_end_stiffness_N_per_m (override)"),
         "field_min_over_mean": float(shape.min()), "field_max_over_mean": float(shape.max()),
         "delta_kiss_m": {n: (None if math.isnan(v) else v) for n, v in shift.items()},
         "errors": {n: e for n, (_, e) in done.items() if e},
         "paper_delta_kiss_m": 1e-4,
-        "note": ("pair travel of the kiss point at theta minus at the reference temperature; the spring file's tab "
-                 "stiffness (hand-set for about 0.1 mm with the uniform case) is kept; structural mesh "
+        "note": ("pair travel of the kiss point at theta minus at the reference temperature; the far edge held "
+                 "by the same joint stiffness in every case; structural mesh "
                  f"{KISS_MESH_M * 1e3:g} mm"),
     }

@@ -75,7 +75,8 @@ class Geometry(Checked):
     plane. How the carrier holds the far edge (``phi = span_deg``) in the
     circumferential direction: ``"free"`` it slides freely; ``"locked"`` it
     moves only with the carrier's thermal expansion; ``"elastic"`` it is held
-    through the carrier tab's stiffness ``carrier.far_end_stiffness_N_per_m``."""
+    through the carrier tab and the rivets (``[joint]``, or the override
+    ``carrier.far_end_stiffness_N_per_m``)."""
     surface_file: str = ""
     """A fitted mid-surface (``.npz`` written by ``cushion-clutch import-scan``)
     that replaces the analytic wave: w(r, phi) is interpolated from it and
@@ -216,22 +217,66 @@ class Carrier(Checked):
     the hot facings while the carrier is further from them.
 
     ``far_end_stiffness_N_per_m`` (used with ``geometry.far_end =
-    "elastic"``) is the circumferential stiffness of the carrier tab that
-    holds the paddle's far edge, N/m over the whole edge. It decides how much
-    of the paddle-carrier length mismatch goes into growth of the wave (the
-    kiss-point shift) and how much into sliding: 0 is a free end (a few
-    micrometres of growth), infinity a locked end (tenths of a millimetre,
-    and snap-through under compression).
+    "elastic"``) is the circumferential stiffness that holds the paddle's far
+    edge against the carrier, N/m over the whole edge: the carrier tab in
+    series with the clamp zone's rivets. ``None`` (the default, and the
+    default spring's): it is predicted from the ``[joint]`` section by
+    :mod:`cushion_clutch.fe.joint` (a CalculiX model of the tab and a fastener
+    formula for the rivets). A number is an explicit override, for a user with
+    a measured value. 0 is a free end (a few micrometres of growth), infinity a
+    locked end (tenths of a millimetre, and snap-through under compression).
     """
 
     temperature_ratio: float = 0.3
-    far_end_stiffness_N_per_m: float = 4.5e6
+    far_end_stiffness_N_per_m: float | None = None
 
     _section = "carrier"
 
     def _problems(self) -> Iterable[str]:
-        yield from self._ranges({"temperature_ratio": (0.0, 1.0),
-                                 "far_end_stiffness_N_per_m": (0.0, 1e12)})
+        yield from self._ranges({"temperature_ratio": (0.0, 1.0)})
+        if self.far_end_stiffness_N_per_m is not None:
+            yield from self._ranges({"far_end_stiffness_N_per_m": (0.0, 1e12)})
+
+
+@dataclass(frozen=True)
+class Joint(Checked):
+    """What holds the paddle in the carrier's plane: the carrier tab at the far edge and the clamp rivets.
+
+    Used when ``geometry.far_end = "elastic"`` and no ``carrier.far_end_stiffness_N_per_m`` is
+    given (:mod:`cushion_clutch.fe.joint` turns it into that stiffness).
+
+    - The **tab** is a finger of the carrier sheet, in the carrier's plane, that the paddle's far edge
+      bears on circumferentially: ``tab_length_m`` from its root in the carrier body to the paddle's
+      edge (radial), ``tab_width_m`` wide (circumferential, the direction of the load) and
+      ``carrier_thickness_m`` thick. It bends in its plane (about the disc's axis) and shears; its
+      root turns in the carrier body around it.
+    - The **rivets** of the clamp zone (``rivets`` of ``rivet_diameter_m``, Young's modulus
+      ``rivet_youngs_modulus_Pa``) join the paddle (``geometry.thickness_m``, E of ``[material]`` at the
+      reference temperature) to the carrier; shank shear, bending and bearing in both sheets (Huth's
+      fastener flexibility, single shear per paddle).
+
+    The two are in series with the paddle's own in-plane path (which the paddle FE models). Lengths
+    in m, moduli in Pa.
+    """
+
+    carrier_thickness_m: float = 1.5e-3
+    carrier_youngs_modulus_Pa: float = 206e9
+    carrier_poisson_ratio: float = 0.3
+    tab_length_m: float = 8e-3
+    tab_width_m: float = 5e-3
+    rivets: int = 2
+    rivet_diameter_m: float = 4e-3
+    rivet_youngs_modulus_Pa: float = 206e9
+
+    _section = "joint"
+
+    def _problems(self) -> Iterable[str]:
+        yield from self._ranges({
+            "carrier_thickness_m": (1e-4, 0.02), "carrier_youngs_modulus_Pa": (1e9, 1e12),
+            "carrier_poisson_ratio": (0.0, 0.5, False, True),
+            "tab_length_m": (5e-4, 0.05), "tab_width_m": (5e-4, 0.05),
+            "rivets": (1, 20), "rivet_diameter_m": (5e-4, 0.02), "rivet_youngs_modulus_Pa": (1e9, 1e12)})
+        yield from self._integers("rivets")
 
 
 @dataclass(frozen=True)
@@ -459,6 +504,7 @@ class SpringParams(Checked):
     n_pairs: int = 8
     geometry: Geometry = field(default_factory=Geometry)
     carrier: Carrier = field(default_factory=Carrier)
+    joint: Joint = field(default_factory=Joint)
     material: Material = field(default_factory=Material)
     sweep: Sweep = field(default_factory=Sweep)
     mesh: Mesh = field(default_factory=Mesh)

@@ -80,6 +80,7 @@ def build_tables(params: SpringParams, outcomes: dict[float, CaseOutcome], out_d
         "date": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
         "host": platform.node(),
         "spring": params.to_dict(),
+        "far_end": far_end_metadata(params),
         "model": "half pair: paddle A against the carrier plane, composed in series "
                  "(pair travel = 2 x paddle travel)" if any_case.result.paddles == 1 else "full pair",
         "mesh": {"element_size_m": params.mesh.element_size_m, "element_type": params.mesh.element_type,
@@ -112,6 +113,21 @@ def build_tables(params: SpringParams, outcomes: dict[float, CaseOutcome], out_d
     }
     write_tables(out_dir, curves, params.material.reference_temperature_degC, metadata, crest)
     return curves, shifts
+
+
+def far_end_metadata(params: SpringParams) -> dict:
+    """How the far edge was held: its stiffness, N/m, and where it came from (the joint model or an override)."""
+    from .joint import joint_stiffness
+    if params.geometry.far_end != "elastic":
+        return {"far_end": params.geometry.far_end}
+    if params.carrier.far_end_stiffness_N_per_m is not None:
+        return {"far_end_stiffness_N_per_m": float(params.carrier.far_end_stiffness_N_per_m),
+                "source": "carrier.far_end_stiffness_N_per_m (override)"}
+    j = joint_stiffness(params)
+    return {"far_end_stiffness_N_per_m": j.series_N_per_m, "tab_N_per_m": j.tab_N_per_m,
+            "rivets_N_per_m": j.rivets_N_per_m,
+            "source": "predicted by cushion_clutch.fe.joint from [joint]: CalculiX tab model (C3D8I) in series "
+                      "with the clamp rivets (Huth 1986)"}
 
 
 def crest_growth(outcomes: dict[float, CaseOutcome], reference_degC: float) -> dict[float, float]:

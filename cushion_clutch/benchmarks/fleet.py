@@ -24,7 +24,6 @@ import argparse
 import json
 import math
 import os
-import re
 import shutil
 import sys
 import time
@@ -56,25 +55,11 @@ def part_possible(work: Path) -> dict:
 
 
 def _duty_run(fmu, sc, table, tcu):
-    """Simulate the duty; if the facings leave the FMU's or the TCU model's temperature range (800 K), rerun
-    with fewer launches (up to the one before the FMU's refusal, or 4/5 of the launches for the model's
-    ValueError) until a run stays inside; the note says where it stopped."""
-    import dataclasses
-
-    from cushion_clutch.errors import FmuCallError
+    """Simulate the duty; a run whose plant leaves the FMU's domain (a facing past 800 K) stops at the refused step
+    and keeps the launches before it (``LaunchResult.stopped``); the note then says where and why."""
     from cushion_clutch.launch.report import run_all
-    launches, note = sc.run.launches, None
-    while True:
-        s = dataclasses.replace(sc, run=dataclasses.replace(sc.run, launches=launches))
-        try:
-            return run_all(fmu, s, table, (tcu,))[tcu], note
-        except (FmuCallError, ValueError) as exc:
-            m = re.search(r"t=([0-9.eE+-]+)", str(exc))
-            stop = int(float(m.group(1)) // sc.run.period_s) + 1 if m else launches
-            launches = max(1, min(stop - 1, int(launches * 0.8)))
-            note = f"stopped after launch {launches}: {str(exc).splitlines()[0][:120]}"
-            if launches <= 1:
-                raise
+    res = run_all(fmu, sc, table, (tcu,))[tcu]
+    return res, (f"stopped early, {res.stopped[:160]}" if res.stopped else None)
 
 
 def part_duty(work: Path) -> dict:

@@ -22,9 +22,11 @@ FIGURES = {
     "protection.png": ("cushion_clutch.benchmarks.protection_figure", ["--png", "{out}"], [pytest.mark.fmu]),
     "cover_characteristics.png": ("cushion_clutch.benchmarks.cover", ["--png", "{out}"], []),
     "cover_wear.png": ("cushion_clutch.benchmarks.cover_wear", ["--png", "{out}", "--md", "{md}"], []),
-    "thermal_validation.png": ("cushion_clutch.benchmarks.thermal_validation", ["--out", "{out}"],
+    "thermal_validation.png": ("cushion_clutch.benchmarks.thermal_validation", ["--out", "{out}", "--write", "{md}"],
                                [pytest.mark.fmu]),
 }
+#: generators that also rewrite marked blocks of a page ({md}, a copy of it): docs PNG -> the page (under docs/)
+PAGES = {"cover_wear.png": "explanation/cover.md", "thermal_validation.png": "explanation/thermal.md"}
 #: figures too costly to redraw in CI (a calibration: 24 and more CalculiX cases at the 2 mm mesh, about 10 min on
 #: 2 cores): docs PNG -> (its generator command, the sources it depends on). tests/figure_inputs.json records the
 #: PNG's hash and the sources' hash at the time it was drawn; a change of either fails until the figure is
@@ -105,14 +107,15 @@ def test_committed_figure_is_its_generator_s_output(name, tmp_path, monkeypatch)
     matplotlib.use("Agg")
     module, args, _ = FIGURES[name]
     md = tmp_path / "page.md"
-    if "{md}" in args:                                  # cover_wear also rewrites its block of cover.md
-        shutil.copy(DOCS / "explanation" / "cover.md", md)
+    if "{md}" in args:                                  # the generator also rewrites its blocks of a page
+        shutil.copy(DOCS / PAGES[name], md)
     out = tmp_path / name
     monkeypatch.chdir(tmp_path)
     importlib.import_module(module).main([a.format(out=out, md=md) for a in args])
-    _compare(DOCS / name, out)
-    if "{md}" in args:
+    if "{md}" in args:                                  # the page's blocks first: they do not depend on fonts
         undated = lambda text: re.sub(r" on \d{4}-\d{2}-\d{2} ", " on DATE ", text)   # noqa: E731
         assert undated(md.read_text(encoding="utf-8")) == \
-            undated((DOCS / "explanation" / "cover.md").read_text(encoding="utf-8")), \
-            "docs/explanation/cover.md's cover_wear block is stale: python -m cushion_clutch.benchmarks.cover_wear"
+            undated((DOCS / PAGES[name]).read_text(encoding="utf-8")), \
+            f"docs/{PAGES[name]}'s generated blocks are stale: python -m {module} " + \
+            " ".join(a.format(out=f"docs/{name}", md=f"docs/{PAGES[name]}") for a in args)
+    _compare(DOCS / name, out)

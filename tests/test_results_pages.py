@@ -117,3 +117,24 @@ def test_doc_numbers_are_the_model_s():
     assert evaluate("closed_torque_Nm(20):.2f") == f"{closed_torque_Nm(20):.2f}"
     with pytest.raises(KeyError, match="nonsense"):
         evaluate("nonsense(1)")
+
+
+def test_doc_numbers_network_modes_are_the_network_s():
+    """thermal.md's slow modes: the network's eigenvalues at the default idle (open) and 1800 rpm (clamped),
+    ascending; clamping couples the facings to the metal, so every slow mode is faster clamped."""
+    import math
+
+    import numpy as np
+
+    from cushion_clutch.benchmarks.doc_numbers import evaluate, network_idle_rad_s, network_mode_s
+    from cushion_clutch.model.thermal_network import NetworkParams, ThermalNetwork
+
+    a, _ = ThermalNetwork(NetworkParams(), 293.15, 293.15).matrices(network_idle_rad_s(), 0.0, False)
+    slow = np.sort(-1.0 / np.linalg.eigvals(a).real)
+    assert network_mode_s(-1) == pytest.approx(slow[-1], rel=1e-12)
+    assert network_idle_rad_s() == pytest.approx(800.0 * math.pi / 30.0)
+    for clamped in (False, True):
+        modes = [network_mode_s(i, clamped) for i in range(-4, 0)]
+        assert all(0.0 < x <= y for x, y in zip(modes, modes[1:])), modes
+    assert all(network_mode_s(i, True) < network_mode_s(i) for i in range(-4, 0))
+    assert evaluate("network_mode_s(-1)") == f"{network_mode_s(-1):.0f}"

@@ -64,6 +64,35 @@ def engine_peak_Nm() -> float:
 
 
 @functools.lru_cache(maxsize=None)
+def _network_modes(clamped: bool) -> tuple[float, ...]:
+    import math
+
+    from cushion_clutch.launch.scenario import load_scenario
+    from cushion_clutch.model.thermal_network import NetworkParams, time_constants
+
+    if clamped:
+        w_engine = w_disc = 1800.0 * math.pi / 30.0
+    else:
+        w_engine, w_disc = load_scenario().engine.idle_speed_rpm * math.pi / 30.0, 0.0
+    return tuple(float(x) for x in time_constants(NetworkParams(), w_engine, w_disc, clamped))
+
+
+def network_mode_s(index: int, clamped: bool = False) -> float:
+    """Time constant of one mode of the default plant network (``thermal_network.time_constants`` of
+    ``NetworkParams()``, ascending; a negative ``index`` counts from the slowest), s: with the clutch open, the
+    engine at the default scenario's idle and the disc at rest, or clamped with both at 1800 rpm."""
+    return _network_modes(bool(clamped))[index]
+
+
+def network_idle_rad_s() -> float:
+    """The default scenario's engine idle, rad/s (the speed of :func:`network_mode_s`'s open clutch)."""
+    import math
+
+    from cushion_clutch.launch.scenario import load_scenario
+    return load_scenario().engine.idle_speed_rpm * math.pi / 30.0
+
+
+@functools.lru_cache(maxsize=None)
 def _thermal_bar() -> dict:
     import tempfile
     from pathlib import Path
@@ -124,6 +153,8 @@ NUMBERS: dict[str, tuple[Callable[..., float], str]] = {
     "cover_mm": (cover_mm, "g"),
     "engine_peak_Nm": (engine_peak_Nm, ".0f"),
     "thermal_bar": (thermal_bar, ".4g"),
+    "network_mode_s": (network_mode_s, ".0f"),
+    "network_idle_rad_s": (network_idle_rad_s, ".0f"),
     "joint_MN_per_m": (joint_MN_per_m, ".2f"),
     "tab_check_MN_per_m": (tab_check_MN_per_m, ".2f"),
 }

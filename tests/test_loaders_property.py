@@ -91,7 +91,8 @@ def _check(kind: str, text: str, tmp_path, doc: dict | None = None) -> None:
             # the problem starts with the exact key ("section.key: ..." or "section.key = ..."), not a
             # substring of one (a one-letter key would match almost any message)
             # (keys may hold any character, '=' and ':' included, so the heads are built from the names)
-            heads = tuple(h for n in names for h in (f"{n}:", f"{n} =", f"[{n}]:"))
+            # ("section.key[i] = v ...": one element of a list key, e.g. material.youngs_modulus_Pa[0])
+            heads = tuple(h for n in names for h in (f"{n}:", f"{n} =", f"[{n}]:", f"{n}["))
             assert (p.startswith(("TOML syntax error", "the file is empty", "cannot read the file"))
                     or p.startswith(heads)), f"problem names no key: {p!r}"
         return
